@@ -1,0 +1,3 @@
+from granulargas.cli import main
+
+raise SystemExit(main())

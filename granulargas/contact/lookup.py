@@ -1,0 +1,42 @@
+"""Compiled restitution lookup used by the engine (a numba leaf module).
+
+The table (built by :mod:`granulargas.contact.table`) is a piecewise cubic in
+``s = sqrt(beta)`` on a uniform grid ``s_k = k h``, ``k = 0..n``: on interval
+``k`` with ``t = s/h - k`` in [0, 1),
+
+    eps = c[k,0] + t (c[k,1] + t (c[k,2] + t c[k,3])).
+
+The grid in sqrt(beta) makes both contact ends smooth at beta -> 0 (the
+``force`` series runs in powers of sqrt(beta)). Out of range returns -1.0 so the
+engine can report a status code instead of extrapolating.
+"""
+
+import math
+
+from granulargas._numba import jit
+
+
+@jit
+def table_lookup(beta, inv_h, coeffs):
+    """Cubic-spline lookup of a tabulated function of beta.
+
+    Parameters
+    ----------
+    beta : float
+        Dimensionless damping, >= 0.
+    inv_h : float
+        1 / grid spacing in s = sqrt(beta).
+    coeffs : float64 array (n, 4)
+        Polynomial coefficients per interval in the local variable t.
+
+    Returns
+    -------
+    float
+        The tabulated value, or -1.0 if beta lies beyond the table.
+    """
+    x = math.sqrt(beta) * inv_h
+    k = int(x)
+    if k >= coeffs.shape[0]:
+        return -1.0
+    t = x - k
+    return coeffs[k, 0] + t * (coeffs[k, 1] + t * (coeffs[k, 2] + t * coeffs[k, 3]))
