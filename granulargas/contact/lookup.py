@@ -32,11 +32,37 @@ def table_lookup(beta, inv_h, coeffs):
     Returns
     -------
     float
-        The tabulated value, or -1.0 if beta lies beyond the table.
+        The tabulated value, or -1.0 if beta lies beyond the table
+        (beta >= table_beta_limit(inv_h, coeffs)), is negative or nan.
     """
     x = math.sqrt(beta) * inv_h
-    k = int(x)
-    if k >= coeffs.shape[0]:
+    # written so that nan (and sqrt of a negative beta) also lands here
+    if not x < coeffs.shape[0]:
         return -1.0
+    k = int(x)
     t = x - k
     return coeffs[k, 0] + t * (coeffs[k, 1] + t * (coeffs[k, 2] + t * coeffs[k, 3]))
+
+
+@jit
+def table_beta_limit(inv_h, coeffs):
+    """Largest beta the table covers: lookups need beta < this value.
+
+    The engine can compare a pair's largest possible beta with this once, or
+    test ``table_lookup(...) < 0`` per collision.
+    """
+    # a hair below (n h)^2 so that rounding in sqrt(beta) * inv_h cannot reach n
+    s = coeffs.shape[0] * (1.0 - 1e-12) / inv_h
+    return s * s
+
+
+@jit
+def table_lookup_many(betas, inv_h, coeffs, out):
+    """``out[i] = table_lookup(betas[i], inv_h, coeffs)``; returns the count of misses (-1)."""
+    misses = 0
+    for i in range(betas.shape[0]):
+        v = table_lookup(betas[i], inv_h, coeffs)
+        out[i] = v
+        if v < 0.0:
+            misses += 1
+    return misses

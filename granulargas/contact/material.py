@@ -1,0 +1,159 @@
+"""From material constants to the dimensionless damping beta, and the model's validity range.
+
+Seed eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)). The rescaled contact
+equation depends on the pair and the impact speed g only through
+
+    beta = (3/2) A rho^{2/5} g^{1/5} = k (R_eff g / m_eff^2)^{1/5},
+    k = (3/2) A (2 Y / (3 (1 - nu^2)))^{2/5}                       (ARCHITECTURE.md)
+
+so a run needs one material prefactor k and, per pair, b_ij = k (R_eff/m_eff^2)^{1/5}
+with beta = b_ij g^{1/5}. Physical durations are t_c = tau_c(beta) rho^{-2/5} g^{-1/5}.
+
+Validity (Brilliantov et al. 1996; physics notes): the viscoelastic force is a
+quasi-static theory. It needs the dissipative time A well below the collision
+time, which with A / t_c = (2/3) beta / tau_c(beta) means beta well below ~3 (we
+warn above ``BETA_VALID_MAX`` = 1), and impact speeds far below the speed of sound
+(we warn above ``MACH_VALID_MAX`` = 0.1 of the bar speed sqrt(Y / density)).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+BETA_VALID_MAX = 1.0
+MACH_VALID_MAX = 0.1
+
+
+class ContactValidityWarning(UserWarning):
+    """The viscoelastic contact model is used outside its range of validity."""
+
+
+def _positive(name, value):
+    if not (np.all(np.asarray(value) > 0) and np.all(np.isfinite(value))):
+        raise ValueError(f"{name} must be positive and finite, got {value}")
+
+
+def effective(a_i, a_j):
+    """Reduced quantity a_i a_j / (a_i + a_j) (effective radius or mass)."""
+    return a_i * a_j / (a_i + a_j)
+
+
+def rho_from_material(young_modulus, poisson_ratio, radius_eff, mass_eff):
+    """Seed eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)), in SI (m^{-1/2} s^{-2})."""
+    _positive("young_modulus", young_modulus)
+    if not (-1.0 < poisson_ratio < 0.5):
+        raise ValueError(f"poisson_ratio must lie in (-1, 0.5), got {poisson_ratio}")
+    return 2.0 * young_modulus * np.sqrt(radius_eff) / (3.0 * mass_eff * (1.0 - poisson_ratio ** 2))
+
+
+def prefactor_from_material(young_modulus: float, poisson_ratio: float, dissipation_time: float) -> float:
+    """Material prefactor k = (3/2) A (2 Y / (3 (1 - nu^2)))^{2/5}.
+
+    Parameters
+    ----------
+    young_modulus : float
+        Y in Pa.
+    poisson_ratio : float
+        nu, in (-1, 0.5).
+    dissipation_time : float
+        A in s (Brilliantov et al. 1996), >= 0.
+
+    Returns
+    -------
+    float
+        k in SI units (s^{1/5} kg^{2/5} m^{-2/5}), such that
+        beta = k (R_eff g / m_eff^2)^{1/5} with R_eff in m, g in m/s, m_eff in kg.
+    """
+    _positive("young_modulus", young_modulus)
+    if not (-1.0 < poisson_ratio < 0.5):
+        raise ValueError(f"poisson_ratio must lie in (-1, 0.5), got {poisson_ratio}")
+    if not (dissipation_time >= 0.0 and math.isfinite(dissipation_time)):
+        raise ValueError(f"dissipation_time must be >= 0, got {dissipation_time}")
+    return 1.5 * dissipation_time * (2.0 * young_modulus / (3.0 * (1.0 - poisson_ratio ** 2))) ** 0.4
+
+
+def prefactor_from_damping(damping: float, radius: float = 0.5, mass: float = 1.0) -> float:
+    """Prefactor k such that two reference particles colliding at g = 1 have beta = damping.
+
+    Parameters
+    ----------
+    damping : float
+        beta at unit impact speed for two reference particles (reduced units).
+    radius, mass : float
+        Reference particle radius and mass (reduced units: diameter 1, mass 1).
+
+    Returns
+    -------
+    float
+        k = damping / (R_eff_ref / m_eff_ref^2)^{1/5}, R_eff_ref = radius/2, m_eff_ref = mass/2.
+    """
+    if not (damping >= 0.0 and math.isfinite(damping)):
+        raise ValueError(f"damping must be >= 0, got {damping}")
+    _positive("radius", radius)
+    _positive("mass", mass)
+    return damping / ((0.5 * radius) / (0.5 * mass) ** 2) ** 0.2
+
+
+def pair_constant(prefactor, radius_i, radius_j, mass_i, mass_j):
+    """b_ij = k (R_eff / m_eff^2)^{1/5}, so that beta = b_ij g^{1/5} (vectorised)."""
+    r_eff = effective(radius_i, radius_j)
+    m_eff = effective(mass_i, mass_j)
+    return prefactor * (r_eff / m_eff ** 2) ** 0.2
+
+
+def beta_from_material(young_modulus, poisson_ratio, dissipation_time, radius_eff, mass_eff, impact_speed):
+    """beta = (3/2) A rho^{2/5} g^{1/5} (SI inputs; vectorised over impact_speed)."""
+    rho = rho_from_material(young_modulus, poisson_ratio, radius_eff, mass_eff)
+    return 1.5 * dissipation_time * rho ** 0.4 * np.asarray(impact_speed, dtype=float) ** 0.2
+
+
+def time_unit(young_modulus, poisson_ratio, radius_eff, mass_eff, impact_speed):
+    """rho^{-2/5} g^{-1/5}: multiply tau_c by this to get the duration in seconds."""
+    rho = rho_from_material(young_modulus, poisson_ratio, radius_eff, mass_eff)
+    return rho ** -0.4 * np.asarray(impact_speed, dtype=float) ** -0.2
+
+
+def sound_speed(young_modulus, density):
+    """Bar speed of sound sqrt(Y / density) in m/s."""
+    _positive("density", density)
+    return math.sqrt(young_modulus / density)
+
+
+def validity_problems(beta=None, impact_speed=None, speed_of_sound=None,
+                      beta_max=BETA_VALID_MAX, mach_max=MACH_VALID_MAX) -> list[str]:
+    """Reasons why the viscoelastic model is questionable for these values (empty if fine).
+
+    Parameters
+    ----------
+    beta : float or array, optional
+        Dimensionless damping(s); the largest is checked.
+    impact_speed, speed_of_sound : float, optional
+        Same units; the Mach number g / c is checked.
+    """
+    problems = []
+    if beta is not None:
+        b = float(np.max(beta))
+        if b > beta_max:
+            problems.append(
+                f"beta = {b:.3g} > {beta_max:g}: the quasi-static viscoelastic force needs the dissipative "
+                f"time A well below the contact time (beta well below ~3)")
+    if impact_speed is not None and speed_of_sound is not None:
+        mach = float(np.max(impact_speed)) / float(speed_of_sound)
+        if mach > mach_max:
+            problems.append(
+                f"impact speed / speed of sound = {mach:.3g} > {mach_max:g}: the quasi-static contact "
+                f"theory needs impact speeds far below the speed of sound")
+    return problems
+
+
+def check_validity(beta=None, impact_speed=None, speed_of_sound=None, *, warn: bool = True,
+                   beta_max=BETA_VALID_MAX, mach_max=MACH_VALID_MAX) -> bool:
+    """True if the model is in its range; else emit ContactValidityWarning(s) (if warn) and return False."""
+    problems = validity_problems(beta, impact_speed, speed_of_sound, beta_max, mach_max)
+    if warn:
+        for p in problems:
+            warnings.warn(p, ContactValidityWarning, stacklevel=2)
+    return not problems

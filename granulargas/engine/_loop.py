@@ -1,0 +1,272 @@
+"""The compiled event loop (numba): pop, validate, execute, re-predict.
+
+One event per particle (Smallenburg 2022; Paul 2007): particle i stores the
+earliest of (a) its predicted collision with a particle of its neighbour list
+and (b) the moment it leaves the sphere of radius shell/2 around its list
+centre ("list expiry"). The event records the partner's collision counter at
+prediction time; a popped event whose partner has collided since is stale and
+is simply re-predicted. A pair collision needs to be scheduled by only one of
+the two: whichever changes its velocity first re-predicts against all its
+neighbours, the other included.
+
+Particles stream lazily: each carries its own clock ``tcl[i]`` and is moved
+to the current time only when it takes part in an event.
+
+Status codes (the Python driver raises ``granulargas.errors`` exceptions):
+0 reached ``until``; 1 event budget of this chunk used (call again);
+2 ``max_collisions`` reached; 10 a neighbour list is full (enlarge, call
+again: nothing was lost); 20 inelastic collapse (a particle collided
+``collapse_count`` times in a row less than ``collapse_dt`` after its previous
+collision); 21 impact beyond the restitution table; 30 watchdog (an event in
+the past or an endless run of zero-time events: round-off trouble).
+"""
+
+import math
+
+from granulargas._numba import jit
+from granulargas.engine._cells import OVERFLOW, rebuild_list
+from granulargas.engine._collide import restitution
+from granulargas.engine._geometry import collision_delay, exit_delay, min_image
+from granulargas.engine._queue import heap_update
+
+DONE = 0
+BUDGET = 1
+MAX_COLLISIONS = 2
+COLLAPSE = 20
+TABLE_RANGE = 21
+WATCHDOG = 30
+
+# indices into the float and int scalar arrays
+S_TIME, S_DISSIPATED, S_VIRIAL, S_KIN_INT, S_SUM_MV2 = 0, 1, 2, 3, 4
+I_COLLISIONS, I_EVENTS, I_ERR_I, I_ERR_J = 0, 1, 2, 3
+# indices into the float parameter array
+P_EPS, P_TC, P_PREFACTOR, P_INV_H, P_SHELL, P_COLLAPSE_DT = 0, 1, 2, 3, 4, 5
+
+
+@jit(inline="always")
+def stream(i, t, r, v, tcl, img, box):
+    """Move particle i on its straight line to time t, wrapping into the box."""
+    dt = t - tcl[i]
+    for a in range(3):
+        x = r[i, a] + v[i, a] * dt
+        if x >= box[a]:
+            x -= box[a]
+            img[i, a] += 1
+        elif x < 0.0:
+            x += box[a]
+            img[i, a] -= 1
+        r[i, a] = x
+    tcl[i] = t
+
+
+@jit
+def predict(i, t, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount, box,
+            half_shell):
+    """Earliest event of particle i (streamed to t): collision or list expiry.
+
+    Sets ``partner[i]`` (-1 for expiry) and ``pcount[i]``; returns the time.
+    """
+    xi = r[i, 0]
+    yi = r[i, 1]
+    zi = r[i, 2]
+    vx = v[i, 0]
+    vy = v[i, 1]
+    vz = v[i, 2]
+    best = t + exit_delay(min_image(xi - centre[i, 0], box[0]),
+                          min_image(yi - centre[i, 1], box[1]),
+                          min_image(zi - centre[i, 2], box[2]), vx, vy, vz, half_shell)
+    p = -1
+    ri = radius[i]
+    for k in range(nbn[i]):
+        j = nbl[i, k]
+        dtj = t - tcl[j]
+        s = collision_delay(min_image(xi - (r[j, 0] + v[j, 0] * dtj), box[0]),
+                            min_image(yi - (r[j, 1] + v[j, 1] * dtj), box[1]),
+                            min_image(zi - (r[j, 2] + v[j, 2] * dtj), box[2]),
+                            vx - v[j, 0], vy - v[j, 1], vz - v[j, 2], ri + radius[j], best - t)
+        if t + s < best:
+            best = t + s
+            p = j
+    partner[i] = p
+    pcount[i] = count[p] if p >= 0 else 0
+    return best
+
+
+@jit
+def predict_all(t, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount, box,
+                half_shell, times):
+    """Predict the event of every particle (all clocks at t) into ``times``."""
+    for i in range(r.shape[0]):
+        times[i] = predict(i, t, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount,
+                           box, half_shell)
+
+
+@jit
+def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastcoll, rapid,
+            nbl, nbn, scratch, cell_head, cell_next, cell_prev, cell_of, heap_t, heap_id, hpos,
+            box, ncell, kind, fpar, coeffs, collapse_count, until, max_events, max_collisions,
+            scal, iscal):
+    """Process events in time order until ``until`` (or a budget); see module doc.
+
+    ``scal`` = [time, dissipated energy, collisional virial sum, integral of
+    sum m v^2 dt, sum m v^2]; ``iscal`` = [collisions, events, i, j of an
+    error]. Returns a status code.
+    """
+    eps_const = fpar[P_EPS]
+    tc_time = fpar[P_TC]
+    prefactor = fpar[P_PREFACTOR]
+    inv_h = fpar[P_INV_H]
+    shell = fpar[P_SHELL]
+    half_shell = 0.5 * shell * (1.0 - 1e-9)  # margin against round-off in |r - c|
+    collapse_dt = fpar[P_COLLAPSE_DT]
+    time = scal[S_TIME]
+    zero_advance = 0
+    zero_limit = 1000 + r.shape[0]
+    events_end = iscal[I_EVENTS] + max_events
+    status = DONE
+    while True:
+        if iscal[I_EVENTS] >= events_end:
+            status = BUDGET
+            break
+        te = heap_t[0]
+        i = heap_id[0]
+        if te > until or te == math.inf:
+            break
+        if te <= time:
+            if te < time:
+                iscal[I_ERR_I] = i
+                iscal[I_ERR_J] = partner[i]
+                status = WATCHDOG
+                break
+            zero_advance += 1
+            if zero_advance > zero_limit:
+                iscal[I_ERR_I] = i
+                iscal[I_ERR_J] = partner[i]
+                status = WATCHDOG
+                break
+        else:
+            zero_advance = 0
+        scal[S_KIN_INT] += scal[S_SUM_MV2] * (te - time)
+        time = te
+        j = partner[i]
+        if j >= 0 and count[j] == pcount[i]:
+            # ---- pair collision: validate, execute, re-predict both
+            stream(i, te, r, v, tcl, img, box)
+            stream(j, te, r, v, tcl, img, box)
+            dx = min_image(r[i, 0] - r[j, 0], box[0])
+            dy = min_image(r[i, 1] - r[j, 1], box[1])
+            dz = min_image(r[i, 2] - r[j, 2], box[2])
+            ux = v[i, 0] - v[j, 0]
+            uy = v[i, 1] - v[j, 1]
+            uz = v[i, 2] - v[j, 2]
+            b = dx * ux + dy * uy + dz * uz
+            if b < 0.0:
+                dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+                inv = 1.0 / dist
+                nx = dx * inv
+                ny = dy * inv
+                nz = dz * inv
+                un = b * inv  # normal relative velocity, < 0
+                mi = mass[i]
+                mj = mass[j]
+                msum = mi + mj
+                m_eff = mi * mj / msum
+                if tc_time > 0.0 and (te - lastcoll[i] < tc_time or te - lastcoll[j] < tc_time):
+                    eps = 1.0
+                else:
+                    r_eff = radius[i] * radius[j] / (radius[i] + radius[j])
+                    eps = restitution(kind, eps_const, prefactor, inv_h, coeffs, -un, r_eff,
+                                      m_eff)
+                    if eps < 0.0:
+                        iscal[I_ERR_I] = i
+                        iscal[I_ERR_J] = j
+                        status = TABLE_RANGE
+                        break
+                f = (1.0 + eps) * un / msum
+                fi = f * mj
+                fj = f * mi
+                v[i, 0] -= fi * nx
+                v[i, 1] -= fi * ny
+                v[i, 2] -= fi * nz
+                v[j, 0] += fj * nx
+                v[j, 1] += fj * ny
+                v[j, 2] += fj * nz
+                de = 0.5 * (1.0 - eps * eps) * m_eff * un * un
+                scal[S_DISSIPATED] += de
+                scal[S_SUM_MV2] -= 2.0 * de
+                scal[S_VIRIAL] -= (1.0 + eps) * m_eff * un * dist
+                count[i] += 1
+                count[j] += 1
+                iscal[I_COLLISIONS] += 1
+                # inelastic collapse watch: runs of ever faster re-collisions
+                if te - lastcoll[i] < collapse_dt:
+                    rapid[i] += 1
+                else:
+                    rapid[i] = 0
+                if te - lastcoll[j] < collapse_dt:
+                    rapid[j] += 1
+                else:
+                    rapid[j] = 0
+                lastcoll[i] = te
+                lastcoll[j] = te
+                tj = predict(j, te, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount,
+                             box, half_shell)
+                heap_update(heap_t, heap_id, hpos, j, tj)
+                if rapid[i] >= collapse_count or rapid[j] >= collapse_count:
+                    ti = predict(i, te, r, v, tcl, centre, radius, count, nbl, nbn, partner,
+                                 pcount, box, half_shell)
+                    heap_update(heap_t, heap_id, hpos, i, ti)
+                    iscal[I_EVENTS] += 1
+                    iscal[I_ERR_I] = i
+                    iscal[I_ERR_J] = j
+                    status = COLLAPSE
+                    break
+        elif j < 0:
+            # ---- list expiry: new centre and list for i
+            stream(i, te, r, v, tcl, img, box)
+            if rebuild_list(i, r, centre, radius, shell, box, ncell, cell_head, cell_next,
+                            cell_prev, cell_of, nbl, nbn, scratch) == OVERFLOW:
+                iscal[I_ERR_I] = i
+                iscal[I_ERR_J] = -1
+                status = OVERFLOW
+                break
+        else:
+            # ---- stale event: the partner changed course; just re-predict
+            stream(i, te, r, v, tcl, img, box)
+        ti = predict(i, te, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount, box,
+                     half_shell)
+        heap_update(heap_t, heap_id, hpos, i, ti)
+        iscal[I_EVENTS] += 1
+        if iscal[I_COLLISIONS] >= max_collisions:
+            status = MAX_COLLISIONS
+            break
+    scal[S_TIME] = time
+    if status == DONE and until < math.inf:
+        scal[S_KIN_INT] += scal[S_SUM_MV2] * (until - time)
+        scal[S_TIME] = until
+    return status
+
+
+@jit
+def synchronised(r, v, tcl, img, box, t, out_r, out_img):
+    """Positions and images of all particles streamed to time t (no side effect).
+
+    Positions land in [0, L): one wrap suffices because no particle is more than
+    shell/2 from its list centre, which lies in the box.
+    """
+    for i in range(r.shape[0]):
+        dt = t - tcl[i]
+        for a in range(3):
+            x = r[i, a] + v[i, a] * dt
+            k = img[i, a]
+            if x >= box[a]:
+                x -= box[a]
+                k += 1
+            elif x < 0.0:
+                x += box[a]
+                k -= 1
+                if x >= box[a]:  # -tiny + L rounds to L
+                    x = 0.0
+                    k += 1
+            out_r[i, a] = x
+            out_img[i, a] = k

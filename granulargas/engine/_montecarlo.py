@@ -1,0 +1,127 @@
+"""Compiled hard-sphere Monte Carlo sweeps for initial states (numba leaf module).
+
+Random single-particle displacements, rejected on overlap; candidates come
+from a cell grid of width >= 2 R_max (doubly linked cell lists, reused from
+:mod:`granulargas.engine._cells`). Random numbers are drawn in Python (seeded
+numpy Generator) and passed in, so the result is reproducible everywhere.
+"""
+
+from granulargas._numba import jit
+from granulargas.engine._cells import cell_coord, cell_index, cell_insert, cell_remove
+from granulargas.engine._geometry import min_image
+
+
+@jit
+def fill_cells(r, box, ncell, cell_head, cell_next, cell_prev, cell_of):
+    cell_head[:] = -1
+    for i in range(r.shape[0] - 1, -1, -1):
+        cell_insert(i, cell_index(r[i, 0], r[i, 1], r[i, 2], box, ncell), cell_head, cell_next,
+                    cell_prev, cell_of)
+
+
+@jit
+def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
+    """True if a sphere of radius[i] at (x, y, z) overlaps any particle j != i."""
+    cx = cell_coord(x, box[0], ncell[0])
+    cy = cell_coord(y, box[1], ncell[1])
+    cz = cell_coord(z, box[2], ncell[2])
+    zr = 1 if ncell[2] >= 3 else 0
+    for oz in range(-zr, zr + 1):
+        kz = (cz + oz) % ncell[2]
+        for oy in range(-1, 2):
+            ky = (cy + oy) % ncell[1]
+            for ox in range(-1, 2):
+                kx = (cx + ox) % ncell[0]
+                j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
+                while j >= 0:
+                    if j != i:
+                        dx = min_image(x - r[j, 0], box[0])
+                        dy = min_image(y - r[j, 1], box[1])
+                        dz = min_image(z - r[j, 2], box[2])
+                        s = radius[i] + radius[j]
+                        if dx * dx + dy * dy + dz * dz < s * s:
+                            return True
+                    j = cell_next[j]
+    return False
+
+
+@jit
+def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, disp):
+    """One sweep of displacement moves r_i += step * disp[i]; returns accepted count."""
+    accepted = 0
+    for i in range(r.shape[0]):
+        x = r[i, 0] + step * disp[i, 0]
+        y = r[i, 1] + step * disp[i, 1]
+        z = r[i, 2] + step * disp[i, 2]
+        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
+        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
+        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
+        if x >= box[0] or y >= box[1] or z >= box[2]:
+            continue  # -tiny + L rounded to L: skip this move
+        if overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
+            continue
+        c = cell_index(x, y, z, box, ncell)
+        if c != cell_of[i]:
+            cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
+            cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+        r[i, 0] = x
+        r[i, 1] = y
+        r[i, 2] = z
+        accepted += 1
+    return accepted
+
+
+@jit
+def min_pair_gap(r, radius, box, ncell, cell_head, cell_next):
+    """min over pairs in neighbouring cells of |r_ij| - (R_i + R_j) (debug check)."""
+    best = 1e300
+    zr = 1 if ncell[2] >= 3 else 0
+    for i in range(r.shape[0]):
+        cx = cell_coord(r[i, 0], box[0], ncell[0])
+        cy = cell_coord(r[i, 1], box[1], ncell[1])
+        cz = cell_coord(r[i, 2], box[2], ncell[2])
+        for oz in range(-zr, zr + 1):
+            kz = (cz + oz) % ncell[2]
+            for oy in range(-1, 2):
+                ky = (cy + oy) % ncell[1]
+                for ox in range(-1, 2):
+                    kx = (cx + ox) % ncell[0]
+                    j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
+                    while j >= 0:
+                        if j > i:
+                            dx = min_image(r[i, 0] - r[j, 0], box[0])
+                            dy = min_image(r[i, 1] - r[j, 1], box[1])
+                            dz = min_image(r[i, 2] - r[j, 2], box[2])
+                            g = (dx * dx + dy * dy + dz * dz) ** 0.5 - radius[i] - radius[j]
+                            if g < best:
+                                best = g
+                        j = cell_next[j]
+    return best
+
+
+@jit
+def min_pair_ratio(r, radius, box, ncell, cell_head, cell_next):
+    """min over neighbouring-cell pairs of |r_ij| / (R_i + R_j) (capped at 1e300)."""
+    best = 1e300
+    zr = 1 if ncell[2] >= 3 else 0
+    for i in range(r.shape[0]):
+        cx = cell_coord(r[i, 0], box[0], ncell[0])
+        cy = cell_coord(r[i, 1], box[1], ncell[1])
+        cz = cell_coord(r[i, 2], box[2], ncell[2])
+        for oz in range(-zr, zr + 1):
+            kz = (cz + oz) % ncell[2]
+            for oy in range(-1, 2):
+                ky = (cy + oy) % ncell[1]
+                for ox in range(-1, 2):
+                    kx = (cx + ox) % ncell[0]
+                    j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
+                    while j >= 0:
+                        if j != i:
+                            dx = min_image(r[i, 0] - r[j, 0], box[0])
+                            dy = min_image(r[i, 1] - r[j, 1], box[1])
+                            dz = min_image(r[i, 2] - r[j, 2], box[2])
+                            g = (dx * dx + dy * dy + dz * dz) ** 0.5 / (radius[i] + radius[j])
+                            if g < best:
+                                best = g
+                        j = cell_next[j]
+    return best

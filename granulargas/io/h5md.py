@@ -1,0 +1,398 @@
+"""H5MD 1.1 output (de Buyl, Colberg & Höfling, Comput. Phys. Commun. 185, 1546 (2014)).
+
+Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
+
+    h5md/                      attrs version = [1, 1]
+        author/                attrs name
+        creator/               attrs name = "granulargas", version
+    particles/all/
+        box/                   attrs dimension = d, boundary = ["periodic"] * d
+            edges/             step, time -> hard links to position/step, time
+                value          (F, d) float64 box edge lengths
+        position/  step (F,) int64 (event count), time (F,) float64, value (F, N, d) in [0, L)
+        velocity/  step, time (links), value (F, N, d)
+        image/     step, time (links), value (F, N, d) int64 periodic image counts
+        last_collision/        (TC model only) value (F, N): time of each particle's last collision
+        mass       (N,) float64         time-independent
+        radius     (N,) float64         time-independent, non-standard element
+        species    (N,) int32           time-independent
+    observables/
+        temperature, kinetic_energy, collisions, dissipated_energy, events,
+        momentum (d,), pressure:        step (S,), time (S,) shared, value (S, ...)
+    parameters/
+        config (resolved TOML text), config_source (file text), attrs
+        version, seed, model, units, prefactor, ...; restitution_table/ (the
+        exact table the engine used: inv_h, coeffs, duration_coeffs, beta_max, end)
+
+All elements with an explicit ``step`` and ``time``. ``pressure`` is the mean
+over the sampling interval that ends at ``time`` (kinetic plus collisional
+virial), NaN at the first sample of a run. All observables share one clock
+(hard-linked ``step``/``time``) and are sampled at every snapshot time too, so
+frame-indexed readers (MDAnalysis ``ts.data``) never run past their end; use
+:func:`read_observables` for the right times. The unwrapped position is
+``position + image * edges``.
+
+Crash safety: the writer calls ``flush`` after each snapshot and each
+observables sample, so a run killed in the compiled loop leaves a file that
+holds every frame written before; the readers ignore a last frame whose time
+was not yet written.
+
+The readers (:func:`read_observables`, :func:`iter_snapshots`,
+:func:`load_snapshot`, :func:`read_parameters`) read one frame at a time.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+import h5py
+import numpy as np
+
+from granulargas import __version__
+from granulargas.errors import InputFileError
+
+CREATOR = "granulargas"
+SNAPSHOT_ELEMENTS = ("position", "velocity", "image")
+SCALAR_OBSERVABLES = ("temperature", "kinetic_energy", "collisions", "events", "dissipated_energy", "pressure")
+_INT_OBSERVABLES = ("collisions", "events")
+
+
+def _frame_chunks(n: int, d: int) -> tuple:
+    # one frame per chunk (frame-by-frame readers), split beyond ~8 MB
+    per = max(1, min(n, (1 << 20) // max(d, 1)))
+    return (1, per, d) if d else (1, per)
+
+
+class H5MDWriter:
+    """Append-only H5MD writer for one run.
+
+    Parameters
+    ----------
+    path : str or Path
+        Output file; created (an existing file is replaced only with ``overwrite``).
+    box : float array (d,)
+        Periodic box edges.
+    radii, masses : float arrays (N,)
+    species : int array (N,), optional
+    parameters : dict, optional
+        Attributes of ``parameters/`` (scalars or strings); nested dicts become groups,
+        numpy arrays become datasets.
+    last_collision : bool
+        Also store each particle's last collision time per snapshot (TC model restart).
+    overwrite : bool
+    """
+
+    def __init__(self, path, box, radii, masses, species=None, *, parameters=None,
+                 last_collision=False, overwrite=False, author=None):
+        self.path = Path(path)
+        box = np.ascontiguousarray(box, dtype=np.float64)
+        self.d = int(box.shape[0])
+        self.n = int(np.asarray(radii).shape[0])
+        if self.path.exists() and not overwrite:
+            raise InputFileError(f"{self.path}: output file exists (use --overwrite to replace it)")
+        try:
+            f = h5py.File(self.path, "w")
+        except (OSError, ValueError) as exc:
+            raise InputFileError(f"{self.path}: cannot create output file ({_short(exc)})") from None
+        self.file = f
+        try:
+            self._create(box, radii, masses, species, parameters or {}, last_collision, author)
+        except BaseException:
+            self.file.close()
+            self.path.unlink(missing_ok=True)
+            raise
+        self.file.flush()
+
+    # ----------------------------------------------------------------- layout
+    def _create(self, box, radii, masses, species, parameters, last_collision, author):
+        f, n, d = self.file, self.n, self.d
+        h = f.create_group("h5md")
+        h.attrs["version"] = np.array([1, 1], dtype=np.int32)
+        h.create_group("author").attrs["name"] = author or os.environ.get("USER", "unknown")
+        c = h.create_group("creator")
+        c.attrs["name"] = CREATOR
+        c.attrs["version"] = __version__
+
+        part = f.create_group("particles/all")
+        b = part.create_group("box")
+        b.attrs["dimension"] = np.int32(d)
+        b.attrs["boundary"] = np.array(["periodic"] * d, dtype=h5py.string_dtype("ascii", 8))
+        self.box = box
+
+        pos = part.create_group("position")
+        step = pos.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(256,))
+        time = pos.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(256,))
+        chunks = _frame_chunks(n, d)
+        pos.create_dataset("value", shape=(0, n, d), maxshape=(None, n, d), dtype=np.float64, chunks=chunks)
+        groups = [pos]
+        for name, dtype in (("velocity", np.float64), ("image", np.int64)):
+            g = part.create_group(name)
+            g["step"], g["time"] = step, time  # hard links: one clock for all frames
+            g.create_dataset("value", shape=(0, n, d), maxshape=(None, n, d), dtype=dtype, chunks=chunks)
+            groups.append(g)
+        e = b.create_group("edges")
+        e["step"], e["time"] = step, time
+        e.create_dataset("value", shape=(0, d), maxshape=(None, d), dtype=np.float64, chunks=(256, d))
+        groups.append(e)
+        if last_collision:
+            g = part.create_group("last_collision")
+            g["step"], g["time"] = step, time
+            g.create_dataset("value", shape=(0, n), maxshape=(None, n), dtype=np.float64, chunks=_frame_chunks(n, 0))
+            groups.append(g)
+        self._frame_groups = groups
+        part.create_dataset("mass", data=np.asarray(masses, dtype=np.float64))
+        part.create_dataset("radius", data=np.asarray(radii, dtype=np.float64))
+        sp = np.zeros(n, np.int32) if species is None else np.asarray(species, dtype=np.int32)
+        part.create_dataset("species", data=sp)
+
+        obs = f.create_group("observables")
+        self._obs = {}
+        step = time = None
+        for name in SCALAR_OBSERVABLES + ("momentum",):
+            shape = (d,) if name == "momentum" else ()
+            dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
+            g = obs.create_group(name)
+            if step is None:
+                step = g.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(1024,))
+                time = g.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(1024,))
+            else:
+                g["step"], g["time"] = step, time  # hard links: one clock for all observables
+            g.create_dataset("value", shape=(0,) + shape, maxshape=(None,) + shape, dtype=dtype,
+                             chunks=(1024,) + shape)
+            self._obs[name] = g
+        self._obs_clock = (step, time)
+        obs["pressure"].attrs["description"] = (
+            "mean pressure (kinetic + collisional virial) over the sampling interval ending at time; "
+            "NaN at the first sample of a run"
+        )
+        _write_parameters(f.create_group("parameters"), parameters)
+
+    # ----------------------------------------------------------------- frames
+    @property
+    def frames(self) -> int:
+        return int(self.file["particles/all/position/step"].shape[0])
+
+    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None):
+        """Append one frame (synchronised state) and flush.
+
+        The frame's values are written before its step/time, so a reader of a
+        killed run never sees a time without data."""
+        k = self.frames
+        data = {"position": positions, "velocity": velocities, "image": images, "edges": self.box}
+        if last_collision is not None:
+            data["last_collision"] = last_collision
+        for g in self._frame_groups:
+            name = g.name.rsplit("/", 1)[-1]
+            v = g["value"]
+            v.resize(k + 1, axis=0)
+            if name in data:
+                v[k] = data[name]
+        pos = self.file["particles/all/position"]
+        for key, val in (("step", step), ("time", time)):
+            pos[key].resize(k + 1, axis=0)
+            pos[key][k] = val
+        self.file.flush()
+
+    def write_observables(self, step, time, values: dict, flush=True):
+        """Append one sample of every observable (``values``: name -> value;
+        a missing one is stored as NaN, or -1 for the integer counters)."""
+        unknown = set(values) - set(self._obs)
+        if unknown:
+            raise KeyError(f"unknown observables {sorted(unknown)}")
+        step_ds, time_ds = self._obs_clock
+        k = step_ds.shape[0]
+        for name, g in self._obs.items():
+            v = g["value"]
+            v.resize(k + 1, axis=0)
+            v[k] = values.get(name, -1 if name in _INT_OBSERVABLES else np.nan)
+        for ds, val in ((step_ds, step), (time_ds, time)):
+            ds.resize(k + 1, axis=0)
+            ds[k] = val
+        if flush:
+            self.file.flush()
+
+    def set_parameters(self, parameters: dict):
+        """Add entries to ``parameters/`` (e.g. the final summary)."""
+        _write_parameters(self.file["parameters"], parameters)
+        self.file.flush()
+
+    def close(self):
+        if self.file.id.valid:
+            self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+def _short(exc) -> str:
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    return text.split(" = ", 1)[-1] if "errno" in text else text
+
+
+def _write_parameters(group, params: dict):
+    for key, value in params.items():
+        if value is None:
+            continue
+        if isinstance(value, dict):
+            _write_parameters(group.require_group(key), value)
+        elif isinstance(value, np.ndarray):
+            if key in group:
+                del group[key]
+            group.create_dataset(key, data=value)
+        elif isinstance(value, str) and (len(value) > 200 or "\n" in value):
+            if key in group:
+                del group[key]
+            group.create_dataset(key, data=value, dtype=h5py.string_dtype())
+        elif isinstance(value, (list, tuple)):
+            group.attrs[key] = np.asarray(value)
+        else:
+            group.attrs[key] = value
+
+
+# --------------------------------------------------------------------- readers
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """One frame: synchronised state at ``time`` (arrays in particle-id order)."""
+
+    index: int
+    time: float
+    step: int
+    positions: np.ndarray  # (N, d) in [0, box)
+    velocities: np.ndarray  # (N, d)
+    images: np.ndarray  # (N, d) int64
+    box: np.ndarray  # (d,)
+    radii: np.ndarray  # (N,)
+    masses: np.ndarray  # (N,)
+    species: np.ndarray  # (N,)
+    last_collision: np.ndarray | None = None  # (N,) TC model only
+
+    @property
+    def unwrapped_positions(self) -> np.ndarray:
+        return self.positions + self.images * self.box
+
+
+def open_run(path, mode="r") -> h5py.File:
+    """Open one of our H5MD files; :class:`InputFileError` if missing or not ours."""
+    path = Path(path)
+    if not path.exists():
+        raise InputFileError(f"{path}: file not found")
+    if path.is_dir():
+        raise InputFileError(f"{path}: is a directory, not an H5MD file")
+    try:
+        f = h5py.File(path, mode)
+    except OSError as exc:
+        raise InputFileError(f"{path}: not an HDF5 file or unreadable ({_short(exc)})") from None
+    try:
+        creator = f["h5md/creator"].attrs.get("name", None)
+        if isinstance(creator, bytes):
+            creator = creator.decode()
+        if creator != CREATOR or "particles/all/position" not in f:
+            raise KeyError
+    except KeyError:
+        f.close()
+        raise InputFileError(f"{path}: not an H5MD file written by granulargas") from None
+    return f
+
+
+def _frame_count(f) -> int:
+    pos = f["particles/all/position"]
+    return int(min(pos["step"].shape[0], pos["time"].shape[0], pos["value"].shape[0]))
+
+
+def _snapshot(f, k, static) -> Snapshot:
+    part = f["particles/all"]
+    radii, masses, species = static
+    lc = part["last_collision/value"][k] if "last_collision" in part else None
+    return Snapshot(
+        index=k,
+        time=float(part["position/time"][k]),
+        step=int(part["position/step"][k]),
+        positions=part["position/value"][k],
+        velocities=part["velocity/value"][k],
+        images=part["image/value"][k],
+        box=part["box/edges/value"][k],
+        radii=radii,
+        masses=masses,
+        species=species,
+        last_collision=lc,
+    )
+
+
+def _static(f):
+    part = f["particles/all"]
+    return part["radius"][()], part["mass"][()], part["species"][()]
+
+
+def iter_snapshots(path) -> Iterator[Snapshot]:
+    """Yield the snapshots of a run in time order, one frame at a time."""
+    with open_run(path) as f:
+        static = _static(f)
+        for k in range(_frame_count(f)):
+            yield _snapshot(f, k, static)
+
+
+def snapshot_count(path) -> int:
+    """Number of complete snapshots in a file."""
+    with open_run(path) as f:
+        return _frame_count(f)
+
+
+def load_snapshot(path, index: int = -1) -> Snapshot:
+    """One snapshot by index (negative counts from the end; default the last)."""
+    with open_run(path) as f:
+        n = _frame_count(f)
+        if n == 0:
+            raise InputFileError(f"{path}: holds no snapshot")
+        k = index + n if index < 0 else index
+        if not 0 <= k < n:
+            raise InputFileError(f"{path}: snapshot index {index} out of range ({n} snapshots)")
+        return _snapshot(f, k, _static(f))
+
+
+def read_observables(path) -> dict:
+    """All observables: ``{name: (step, time, value)}`` as numpy arrays."""
+    out = {}
+    with open_run(path) as f:
+        for name, g in f["observables"].items():
+            n = min(g["step"].shape[0], g["time"].shape[0], g["value"].shape[0])
+            out[name] = (g["step"][:n], g["time"][:n], g["value"][:n])
+    return out
+
+
+def read_parameters(path) -> dict:
+    """The ``parameters/`` group as a nested dict (attributes and datasets), plus
+    ``creator_version``; strings decoded, ``config`` the resolved TOML text."""
+    with open_run(path) as f:
+        out = _read_group(f["parameters"])
+        out["creator_version"] = _decode(f["h5md/creator"].attrs["version"])
+    return out
+
+
+def _decode(v):
+    if isinstance(v, bytes):
+        return v.decode()
+    if isinstance(v, np.ndarray) and v.dtype.kind in "SO":
+        return [_decode(x) for x in v.tolist()]
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+def _read_group(g) -> dict:
+    out = {k: _decode(v) for k, v in g.attrs.items()}
+    for k, v in g.items():
+        if isinstance(v, h5py.Group):
+            out[k] = _read_group(v)
+        elif v.dtype.kind in "SO":
+            out[k] = _decode(v[()])
+        else:
+            out[k] = v[()]
+    return out

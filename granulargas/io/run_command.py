@@ -1,0 +1,64 @@
+"""Run a simulation from a TOML config and write an H5MD file.
+
+``granulargas run CONFIG [--overwrite] [--restart FILE] [--output FILE]
+[--set section.key=value ...] [--quiet]``: validates the config (exit 2 with
+one line on a bad value, no file written), runs with a progress bar on a
+terminal and prints a short summary.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import tomllib
+
+from granulargas.errors import ConfigError
+
+
+def configure_parser(parser):
+    parser.add_argument("config", help="TOML run configuration (see docs/readme/config.md)")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
+    parser.add_argument("--restart", metavar="FILE",
+                        help="continue from the last snapshot of FILE (same as [initial] from = FILE)")
+    parser.add_argument("--output", "-o", metavar="FILE", help="output file (overrides [output] file)")
+    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                        help="override a config value, e.g. --set collision.restitution=0.8 (repeatable)")
+    parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
+
+
+def parse_override(text: str):
+    """``section.key=value`` -> (key, value); the value is read as TOML, else as a string."""
+    key, sep, raw = text.partition("=")
+    key = key.strip()
+    if not sep or not key:
+        raise ConfigError(f"--set {text}: expected section.key=value")
+    raw = raw.strip()
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return key, value
+
+
+def _terminate(signum, frame):
+    raise KeyboardInterrupt
+
+
+def run(args) -> int:
+    from granulargas.io.config import load_config
+    from granulargas.io.runner import run_config
+
+    overrides = dict(parse_override(t) for t in args.overrides)
+    if args.restart:
+        overrides["initial.from"] = args.restart
+    if args.output:
+        overrides["output.file"] = args.output
+    config = load_config(args.config, overrides)
+    try:  # SIGTERM closes the file like Ctrl-C (SIGKILL cannot be caught; frames are flushed anyway)
+        signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:
+        pass  # not the main thread
+    summary = run_config(config, overwrite=args.overwrite, quiet=args.quiet)
+    if not args.quiet:
+        print("\n".join(summary.lines()))
+    return 0

@@ -1,0 +1,42 @@
+"""``granulargas epsilon``: both forms print every method; bad input is one clear line."""
+
+import pytest
+
+from granulargas.cli import main
+from granulargas.contact import duration, restitution
+
+
+def test_beta_form_prints_each_method(capsys, cache_dir):
+    assert main(["epsilon", "--beta", "0.1"]) == 0
+    out = capsys.readouterr().out
+    for word in ("ode", "table", "series(2)", "series(10)", "pade", "overlap", "force"):
+        assert word in out
+    assert f"{restitution(0.1):.14f}" in out
+    assert f"{duration(0.1, end='force'):.14f}" in out
+
+
+def test_beyond_radius_and_validity_are_reported(capsys, cache_dir):
+    assert main(["epsilon", "--beta", "2", "--end", "overlap"]) == 0
+    out = capsys.readouterr().out
+    assert "diverges" in out and "warning: beta = 2" in out
+
+
+def test_material_form(capsys, cache_dir):
+    args = ["epsilon", "--young", "1e7", "--poisson", "0.3", "-A", "1e-5", "--radius", "0.01",
+            "--density", "1000", "--speed", "0.1", "--end", "overlap"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "beta = 0.0215481" in out and "t_c [s]" in out
+
+
+@pytest.mark.parametrize("argv,msg", [
+    (["epsilon"], "give --beta"),
+    (["epsilon", "--beta", "-1"], "--beta"),
+    (["epsilon", "--young", "1e7"], "--poisson"),
+    (["epsilon", "--young", "1e7", "--poisson", "0.7", "-A", "1e-5", "--radius", "0.01", "--mass", "1",
+      "--speed", "1"], "--poisson 0.7"),
+])
+def test_bad_input_is_one_line(argv, msg, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert msg in err and err.count("\n") == 1

@@ -1,0 +1,34 @@
+"""The README's two commands are the project's contract with a new user."""
+
+import re
+import subprocess
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def readme_commands():
+    text = (ROOT / "README.md").read_text()
+    block = re.search(r"```bash\n(.*?)```", text, re.S).group(1)
+    return [line for line in block.splitlines() if line.strip()]
+
+
+def test_readme_opens_with_exactly_two_commands():
+    cmds = readme_commands()
+    assert len(cmds) == 2
+    assert cmds[0].startswith("pip install ") and "granulargas run configs/" in cmds[0]
+    assert cmds[1].startswith("pip install ") and "pytest" in cmds[1]
+
+
+def test_ci_runs_the_readme_test_command():
+    out = subprocess.run(
+        ["bash", "-c", "grep -m1 -E '^pip install .*pytest' README.md"],
+        cwd=ROOT, capture_output=True, text=True, check=True,
+    )
+    assert out.stdout.strip() == readme_commands()[1]
+    assert "grep -m1 -E '^pip install .*pytest' README.md" in (ROOT / ".ci" / "run").read_text()
+
+
+def test_main_job_config_exists():
+    config = readme_commands()[0].split("granulargas run ")[1].split()[0]
+    assert (ROOT / config).is_file()
