@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import statistics
 import sys
 import time
@@ -71,6 +70,28 @@ def run_granulargas(config, overrides: dict, workdir: Path, repeats: int):
         walls.append(summary.wall_time)
     obs = read_observables(out)
     return obs, walls, compile_time, summary
+
+
+def seed_spread(config, overrides: dict, workdir: Path, seeds: int, t_ref, T_ref):
+    """T_seed / T_ref - 1 of granulargas runs from other initial states (seed + 1, ...).
+
+    Two runs from the same initial state decorrelate after a few collisions
+    (molecular chaos), so this is the size of the difference expected between
+    LAMMPS and granulargas from fluctuations alone."""
+    from granulargas.io.config import parse_config
+    from granulargas.io.h5md import read_observables
+    from granulargas.io.runner import run_config
+
+    devs = []
+    for k in range(1, seeds + 1):
+        out = workdir / f"granulargas_seed{k}.h5"
+        cfg = parse_config(config.text, source=config.source, overrides={
+            **overrides, "output.file": str(out), "output.snapshots": 2,
+            "output.observables_interval": config.run.end_time / 200, "system.seed": config.system.seed + k})
+        run_config(cfg, overwrite=True, quiet=True)
+        _, t, T = read_observables(out)["temperature"]
+        devs.append(np.interp(t_ref, t, T) / T_ref - 1.0)
+    return np.array(devs)
 
 
 def run_dem(config, workdir: Path, fraction: float, steps_per_contact: int, end_time: float, reuse: bool):
@@ -137,12 +158,18 @@ def cooling(args):
                                       "loop_time": loop, "T_end": float(T_l[-1]), "max_rel_dev": dev,
                                       "wall_ratio": wall / ed_wall})
 
+    spread = seed_spread(config, overrides, workdir, args.seeds, t_ed, T_ed) if args.seeds > 1 else None
+    if spread is not None:
+        band = spread.std(axis=0, ddof=1)
+        results["granulargas"]["seed_spread_rms"] = float(np.sqrt(np.mean(band**2)))
+        print(f"granulargas, {args.seeds} other seeds: rms over time of std(T/T_ED - 1) = "
+              f"{results['granulargas']['seed_spread_rms']:.3g}")
     n = theory.number_density(s.packing_fraction, s.dimension)
     k = _prefactor(config)
     tau0 = theory.viscoelastic_tau0(k, n, config.initial.temperature, s.dimension)
     results["theory_tau0"] = tau0
     (workdir / "results.json").write_text(json.dumps(results, indent=2) + "\n")
-    plot_cooling(args.figure, config, t_ed, T_ed, ed_wall, dem, tau0)
+    plot_cooling(args.figure, config, t_ed, T_ed, ed_wall, dem, tau0, spread)
     print(f"figure {args.figure}; results {workdir / 'results.json'}")
 
 
@@ -152,7 +179,7 @@ def _prefactor(config):
     return reduced_prefactor(config)
 
 
-def plot_cooling(path, config, t_ed, T_ed, ed_wall, dem, tau0):
+def plot_cooling(path, config, t_ed, T_ed, ed_wall, dem, tau0, spread=None):
     from granulargas import theory
 
     plt = _plt()
@@ -175,10 +202,14 @@ def plot_cooling(path, config, t_ed, T_ed, ed_wall, dem, tau0):
                  f"damping {config.collision.damping:g}", fontsize=10)
     ax.legend(fontsize=8, loc="lower left")
     ax2.axhline(0, color="C0", lw=2.5)
+    if spread is not None:
+        band = 100 * spread.std(axis=0, ddof=1)
+        ax2.fill_between(t_ed, -band, band, color="0.8", zorder=0,
+                         label=f"granulargas, {len(spread)} other seeds: $\\pm$1 std")
     ax2.set_xlabel(r"time $t$ [$\sigma\sqrt{m/T_0}$]")
     ax2.set_ylabel(r"$T_{\rm LAMMPS}/T_{\rm granulargas} - 1$ [%]")
-    ax2.set_title("DEM converges to the event-driven run as the contact time shrinks", fontsize=10)
-    if dem:
+    ax2.set_title("difference from the event-driven run (same initial state)", fontsize=10)
+    if dem or spread is not None:
         ax2.legend(fontsize=8)
     fig.tight_layout()
     Path(path).parent.mkdir(parents=True, exist_ok=True)
@@ -215,7 +246,7 @@ def head_on(args):
             e = [head_on_restitution(DemContact.from_beta(beta, 1.0, 1e4, end=end), 1.0, int(n), workdir)
                  for n in steps]
             conv[(beta, end)] = np.abs(np.array(e) - ref)
-            print(f"beta = {beta:g}, {end}: |error| at t_c/n, n = {list(steps)}: "
+            print(f"beta = {beta:g}, {end}: |error| at t_c/n, n = {steps.tolist()}: "
                   + ", ".join(f"{x:.2g}" for x in conv[(beta, end)]))
 
     plt = _plt()
@@ -255,6 +286,8 @@ def main(argv=None):
                    help="LAMMPS contact time / mean free time, one run each (default 0.01 0.002)")
     p.add_argument("--steps-per-contact", type=int, default=50)
     p.add_argument("--repeats", type=int, default=3, help="granulargas runs (median wall time)")
+    p.add_argument("--seeds", type=int, default=4,
+                   help="granulargas runs from other seeds for the fluctuation band (default 4; 0: none)")
     p.add_argument("--workdir", default="runs/compare_lammps")
     p.add_argument("--reuse", action="store_true", help="reuse finished LAMMPS runs in the work directory")
     p.add_argument("--figure", default=str(ROOT / "docs" / "figures" / "lammps_cooling.png"))

@@ -116,7 +116,7 @@ def test_sonine_correction_of_collision_frequency_by_quadrature(dim):
             r2 = radial(c2) if a else 2 * c2 ** (dim - 1) * math.exp(-c2 * c2) / special.gamma(k)
             return g * r1 * r2 * angle_w(t)
 
-        return integrate.tplquad(f, 0, 6, 0, 6, 0, math.pi, epsabs=1e-9, epsrel=1e-9)[0]
+        return integrate.tplquad(f, 0, 5.5, 0, 5.5, 0, math.pi, epsabs=1e-8, epsrel=1e-7)[0]
 
     ratio = mean_g(True) / mean_g(False)
     assert ratio == pytest.approx(th.collision_frequency(1.0, 1.0, dim, a2=a2) / th.collision_frequency(1.0, 1.0, dim), rel=2e-4)

@@ -47,7 +47,11 @@ def report(analysis, rows: int = 10) -> str:
         lines.append(f"  box length {L:.4g} is {side} L_c ({p.instability_length:.4g})"
                      + ("" if L < p.instability_length else ": expect shear modes and clusters, not the homogeneous law"))
     t = h.time - a.t_offset
-    idx = np.unique(np.concatenate([[0], np.searchsorted(t, np.geomspace(max(t[1], 1e-12) if t.size > 1 else 1, t[-1], max(rows - 1, 1))).clip(0, t.size - 1)]))
+    if t.size > 1:
+        targets = np.geomspace(t[1], t[-1], max(rows - 1, 1))
+        idx = np.unique(np.concatenate([[0], np.searchsorted(t, targets).clip(0, t.size - 1)]))
+    else:
+        idx = np.array([0])
     lines.append("")
     lines.append(f"  {'t':>12} {'coll/part':>10} {'T':>12} {'T_theory':>12} {'T/T_theory':>10}")
     for i in idx:

@@ -128,7 +128,8 @@ def _root(W, P, K, beta, end, a, b):
             xn = 0.5 * (a + b)
         if not (a < xn < b):
             xn = 0.5 * (a + b)
-        if abs(xn - x) <= 1e-16 * max(1.0, abs(x)) or b - a <= 4e-16 * max(1.0, abs(x)):
+        # quadratic convergence: once the step is ~1e-15 the error is far below it
+        if abs(xn - x) <= 1e-15 * max(1.0, abs(x)) or b - a <= 4e-16 * max(1.0, abs(x)):
             x = xn
             break
         x = xn
@@ -237,15 +238,18 @@ def contact_solve(beta, end, order, tol, out):
         s += sig
         if found:
             if end == END_OVERLAP or beta == 0.0:
-                # w = 0 here: dp/ds = 0 and dt/ds = 0, so the end-time shift drops out
-                ds_db = -wb / dw
+                # w = 0 here, so dp/ds = -beta w^2 p - w^4 = 0 and dt/ds = w = 0: the shift of the
+                # end time drops out exactly. (Multiplying the round-off residues of dp, dt by
+                # ds/dbeta = -wb/(p/2) would not: at large beta p ~ eps is tiny.)
+                out[2] = -pb
+                out[3] = tb
             else:
                 gs = 2.0 * w * dw + beta * dp
                 ds_db = -(2.0 * w * wb + p + beta * pb) / gs
+                out[2] = -(pb + dp * ds_db)
+                out[3] = tb + dt * ds_db
             out[0] = -p
             out[1] = t
-            out[2] = -(pb + dp * ds_db)
-            out[3] = tb + dt * ds_db
             out[4] = s
             out[5] = step + 1
             out[6] = xmax

@@ -79,8 +79,15 @@ class ContactSolution:
     max_compression: float = math.nan
 
 
-def solve_many(beta, end="overlap", order=_taylor.ORDER, tol=_taylor.TOLERANCE):
+def solve_many(beta, end="overlap", order=_taylor.ORDER, tol=_taylor.TOLERANCE, backend="numba"):
     """Taylor-method solutions for an array of beta.
+
+    Parameters
+    ----------
+    backend : {"numba", "numpy"}
+        The compiled kernel (fast per beta; ~3 s compile on a fresh numba cache)
+        or the same algorithm vectorised in numpy (no compilation; used to build
+        tables). They agree to round-off.
 
     Returns
     -------
@@ -90,8 +97,18 @@ def solve_many(beta, end="overlap", order=_taylor.ORDER, tol=_taylor.TOLERANCE):
     betas = np.ascontiguousarray(np.atleast_1d(np.asarray(beta, dtype=np.float64)).ravel())
     if np.any(~(betas >= 0.0)):
         raise ValueError("beta must be >= 0 (and not nan)")
+    code = end_code(end)
+    if backend == "numpy":
+        from granulargas.contact import _taylor_np
+
+        out = _taylor_np.solve_many(betas, code, int(order), float(tol))
+        if np.isnan(out).any():
+            raise RuntimeError(f"Taylor contact integrator (numpy) failed for some beta in {betas}")
+        return out
+    if backend != "numba":
+        raise ValueError(f"backend must be 'numba' or 'numpy', got {backend!r}")
     out = np.empty((betas.shape[0], 7))
-    status = _taylor.contact_solve_many(betas, end_code(end), int(order), float(tol), out)
+    status = _taylor.contact_solve_many(betas, code, int(order), float(tol), out)
     if status != _taylor.STATUS_OK:
         raise RuntimeError(f"Taylor contact integrator failed (status {status}) for some beta in {betas}")
     return out
@@ -140,23 +157,36 @@ def solve_contact_scipy(beta: float, end: str = "overlap", method: str = "DOP853
     """
     from scipy.integrate import solve_ivp
 
+    from scipy.optimize import brentq
+
     beta = float(beta)
     end_code(end)
-    if end == "force" and beta > 0.0:
-        def event(s, y, beta):
-            return y[0] * y[0] + beta * y[1]
-    else:
-        def event(s, y, beta):
-            return y[0]
-    event.terminal = True
-    event.direction = -1
+
+    def x_zero(s, y, beta):
+        return y[0]
+
+    def turning(s, y, beta):
+        return y[1]
+
+    x_zero.terminal = True
+    x_zero.direction = -1
+    turning.direction = -1
     s_max = 50.0 + 200.0 * beta ** 2
     sol = solve_ivp(_rhs, (0.0, s_max), [0.0, 1.0, 0.0], method=method, rtol=rtol, atol=atol,
-                    events=event, args=(beta,))
-    if sol.status != 1 or len(sol.t_events[0]) == 0:
+                    events=[x_zero, turning], args=(beta,), dense_output=(end == "force"))
+    if sol.status != 1 or len(sol.t_events[0]) == 0 or len(sol.t_events[1]) == 0:
         raise RuntimeError(f"no end of contact found for beta={beta} (s_max={s_max})")
     s_end = sol.t_events[0][0]
     y = sol.y_events[0][0]
+    if end == "force" and beta > 0.0:
+        # x + beta x' = w^2 + beta p is > 0 at the turning point (p = 0) and beta p < 0 where
+        # x = 0, so the force end is bracketed; an event function on it can be stepped over
+        # when beta is tiny (its two roots w = +-sqrt(-beta p) are then close together)
+        def g(s):
+            w, p, _ = sol.sol(s)
+            return w * w + beta * p
+        s_end = brentq(g, sol.t_events[1][0], s_end, xtol=1e-15, rtol=1e-15)
+        y = sol.sol(s_end)
     if refine:
         again = solve_ivp(_rhs, (0.0, s_end), [0.0, 1.0, 0.0], method=method, rtol=rtol, atol=atol,
                           args=(beta,))
@@ -186,9 +216,11 @@ def solve_contact_naive(beta: float, end: str = "overlap", dt: float = 1e-3):
     """Classical RK4 at fixed step on x(t) itself, started at x = 0.
 
     The right-hand side contains sqrt(x): its third and higher derivatives diverge
-    at the start and (``overlap``) at the end, so RK4 loses its fourth order and
-    converges only like dt^{3/2}..dt^2. Kept to show that, not for use. The end is
-    found by linear interpolation inside the last step.
+    at the start and (``overlap``) at the end, so RK4 loses its fourth order
+    (about dt^{3/2} for beta > 0, tests/contact). Kept to show that, not for use. The end is located
+    inside the last step on the cubic Hermite interpolant of x (values and
+    slopes at both ends, fourth-order accurate for a smooth solution), so that
+    any loss of order is the singularity's, not the end detection's.
 
     Returns
     -------
@@ -212,8 +244,24 @@ def solve_contact_naive(beta: float, end: str = "overlap", dt: float = 1e-3):
         xn = x + dt / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
         vn = v + dt / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
         if vn < 0.0 and g(xn, vn) <= 0.0:
-            g0, g1 = g(x, v), g(xn, vn)
-            theta = g0 / (g0 - g1)
-            return -(v + theta * (vn - v)), t + theta * dt
+            # cubic Hermite x(theta), theta in [0, 1]; x' = dx/dtheta / dt
+            c0, c1 = x, v * dt
+            c2 = 3 * (xn - x) - 2 * v * dt - vn * dt
+            c3 = 2 * (x - xn) + v * dt + vn * dt
+
+            def gh(th):
+                xh = c0 + th * (c1 + th * (c2 + th * c3))
+                vh = (c1 + th * (2 * c2 + 3 * th * c3)) / dt
+                return g(xh, vh), vh
+
+            a, b = 0.0, 1.0
+            for _ in range(100):
+                m = 0.5 * (a + b)
+                if gh(m)[0] > 0.0:
+                    a = m
+                else:
+                    b = m
+            th = 0.5 * (a + b)
+            return -gh(th)[1], t + th * dt
         x, v, t = xn, vn, t + dt
     raise RuntimeError("naive integrator did not finish")

@@ -37,7 +37,7 @@ import warnings
 
 import numpy as np
 
-from granulargas.contact import _series_kernel, _taylor
+from granulargas.contact import _series_kernel
 from granulargas.contact.ode import end_code, solve_many
 
 DEFAULT_ORDER = {"overlap": 2, "force": 4}

@@ -4,7 +4,9 @@ Grid and interpolation
 ----------------------
 Nodes are uniform in s = sqrt(beta), s_k = k h with h = 1/intervals_per_unit
 (default 1/128), from s = 0 up to past sqrt(beta_max). At every node the Taylor
-integrator (:mod:`granulargas.contact._taylor`) gives eps, tau_c and their
+integrator (:mod:`granulargas.contact._taylor_np`, the numpy-vectorised twin of
+the compiled kernel, so that a fresh checkout or CI builds a table in well under
+a second without compiling anything) gives eps, tau_c and their
 beta-derivatives (sensitivity equations); on each interval the table holds the
 cubic Hermite polynomial in the local variable t = s/h - k matching values and
 s-derivatives (d/ds = 2 s d/dbeta) at both nodes, so the interpolant is C^1.
@@ -19,7 +21,9 @@ every interval midpoint against the ODE: max |eps error| ~ 2e-10 and relative
 tau_c error ~ 1e-9 (see ``parameters["max_error_restitution"]``); the build fails
 if the error exceeds 1e-8 (absolute for eps, relative for tau_c).
 
-Coverage: a table built for beta_max covers [0, beta_limit) with
+Coverage: tables go up to ``TABLE_BETA_MAX`` = 40 (far beyond the model's validity,
+beta well below ~3; beyond ~50 the overlap-end duration loses accuracy) and
+refuse larger requests with TableRangeError. A table built for beta_max covers [0, beta_limit) with
 beta_limit >= beta_max; :func:`granulargas.contact.lookup.table_lookup` returns
 -1.0 beyond, never an extrapolation. :meth:`RestitutionTable.extended` or a new
 :func:`restitution_table` call gives a larger table (same grid, so the common
@@ -50,9 +54,13 @@ from granulargas.contact.lookup import table_beta_limit, table_lookup_many
 from granulargas.contact.ode import end_code, solve_many
 from granulargas.errors import TableRangeError
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 DEFAULT_INTERVALS_PER_UNIT = 128
 MAX_ERROR = 1e-8
+# Largest beta a table may cover. The model is physical only for beta well below ~3; beyond
+# beta ~ 50 the overlap end (eps ~ 1e-8, tau_c ~ 600) loses the 1e-8 relative accuracy of tau_c
+# (the contact creeps back to x = 0 over thousands of steps).
+TABLE_BETA_MAX = 40.0
 
 
 def cache_dir() -> Path:
@@ -149,14 +157,14 @@ def _hermite(f0, f1, d0, d1):
 def _build(n: int, h: float, end: str):
     """Coefficients for n intervals of width h in s, plus midpoint errors."""
     s = np.arange(n + 1) * h
-    rows = solve_many(s * s, end)
+    rows = solve_many(s * s, end, backend="numpy")
     eps, tau = rows[:, 0], rows[:, 1]
     deps = 2.0 * s * rows[:, 2] * h  # d/dt = h d/ds = 2 s h d/dbeta
     dtau = 2.0 * s * rows[:, 3] * h
     c_eps = _hermite(eps[:-1], eps[1:], deps[:-1], deps[1:])
     c_tau = _hermite(tau[:-1], tau[1:], dtau[:-1], dtau[1:])
     # verify at interval midpoints (where the Hermite error peaks) against the ODE
-    mid = solve_many(((np.arange(n) + 0.5) * h) ** 2, end)
+    mid = solve_many(((np.arange(n) + 0.5) * h) ** 2, end, backend="numpy")
     half = np.array([1.0, 0.5, 0.25, 0.125])
     err_eps = np.abs(c_eps @ half - mid[:, 0])
     err_tau = np.abs(c_tau @ half - mid[:, 1]) / np.maximum(1.0, mid[:, 1])
@@ -170,7 +178,7 @@ def _key_parameters(end: str, intervals_per_unit: int) -> dict:
         "grid": "uniform in s = sqrt(beta)",
         "interpolation": "cubic Hermite in s (values and derivatives from sensitivity equations)",
         "intervals_per_unit": int(intervals_per_unit),
-        "ode_solver": "Taylor series in regularised variables w = sqrt(x), dt = w ds",
+        "ode_solver": "Taylor series in regularised variables w = sqrt(x), dt = w ds (numpy, vectorised)",
         "ode_order": _taylor.ORDER,
         "ode_tolerance": _taylor.TOLERANCE,
     }
@@ -230,6 +238,10 @@ def restitution_table(beta_max: float, end: str = "overlap",
     beta_max = float(beta_max)
     if not (beta_max > 0.0 and math.isfinite(beta_max)):
         raise ValueError(f"beta_max must be positive and finite, got {beta_max}")
+    if beta_max > TABLE_BETA_MAX:
+        raise TableRangeError(
+            f"restitution table requested up to beta = {beta_max:.4g}, beyond the supported {TABLE_BETA_MAX:g}: "
+            f"the viscoelastic model holds only for beta well below ~3 (lower the damping / impact speeds)")
     h = 1.0 / intervals_per_unit
     n = int(math.floor(math.sqrt(beta_max) * intervals_per_unit * (1.0 + 1e-9))) + 1
     key_params = _key_parameters(end, intervals_per_unit)
@@ -245,7 +257,8 @@ def restitution_table(beta_max: float, end: str = "overlap",
         raise RuntimeError(f"restitution table too coarse: midpoint errors {max_eps:.2e} (eps), "
                            f"{max_tau:.2e} (tau_c, relative); increase intervals_per_unit")
     params = dict(key_params)
-    params.update(beta_max=beta_max, n_intervals=n, beta_limit=float(table_beta_limit(float(intervals_per_unit), c_eps)),
+    params.update(beta_max=beta_max, n_intervals=n,
+                  beta_limit=float(table_beta_limit(float(intervals_per_unit), c_eps)),
                   max_error_restitution=max_eps, max_relative_error_duration=max_tau)
     return RestitutionTable(inv_h=float(intervals_per_unit), coeffs=c_eps, duration_coeffs=c_tau,
                             beta_max=beta_max, end=end, parameters=params)

@@ -10,6 +10,10 @@ rebuilt, from a cell grid that holds the list centres (doubly linked lists per
 cell, O(1) move), and i is added to / removed from its neighbours' lists
 (Smallenburg, Eur. Phys. J. E 45, 22 (2022)). Cells are at least
 2 R_max + shell wide, so the 27 (2D: 9) cells around c_i hold every candidate.
+
+Particle data come as one record per particle, ``rec[i] = (x, y, z, vx, vy,
+vz, t_i, R_i)`` (64 bytes, one cache line): positions at the particle's own
+clock t_i, velocity, clock and radius.
 """
 
 from granulargas._numba import jit
@@ -60,7 +64,7 @@ def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
 
 
 @jit(inline="always")
-def _collect(i, x, y, z, ri, centre, radius, shell, box, ncell, cell_head, cell_next,
+def _collect(i, x, y, z, ri, centre, rec, shell, box, ncell, cell_head, cell_next,
              nbl, nbn, scratch):
     """Candidates j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
 
@@ -96,7 +100,7 @@ def _collect(i, x, y, z, ri, centre, radius, shell, box, ncell, cell_head, cell_
                         dx = min_image(x - centre[j, 0], box[0])
                         dy = min_image(y - centre[j, 1], box[1])
                         dz = min_image(z - centre[j, 2], box[2])
-                        cut = ri + radius[j] + shell
+                        cut = ri + rec[j, 7] + shell
                         if dx * dx + dy * dy + dz * dz < cut * cut:
                             if count >= m:
                                 return -1
@@ -115,17 +119,17 @@ def _collect(i, x, y, z, ri, centre, radius, shell, box, ncell, cell_head, cell_
 
 
 @jit
-def rebuild_list(i, r, centre, radius, shell, box, ncell, cell_head, cell_next, cell_prev,
+def rebuild_list(i, rec, centre, shell, box, ncell, cell_head, cell_next, cell_prev,
                  cell_of, nbl, nbn, scratch):
     """New list centre c_i = r_i and a new neighbour list for particle i.
 
     Nothing is modified when a list would overflow (returns OVERFLOW); the
     caller enlarges ``nbl`` and calls again. Returns 0 on success.
     """
-    x = r[i, 0]
-    y = r[i, 1]
-    z = r[i, 2]
-    count = _collect(i, x, y, z, radius[i], centre, radius, shell, box, ncell, cell_head,
+    x = rec[i, 0]
+    y = rec[i, 1]
+    z = rec[i, 2]
+    count = _collect(i, x, y, z, rec[i, 7], centre, rec, shell, box, ncell, cell_head,
                      cell_next, nbl, nbn, scratch)
     if count < 0:
         return OVERFLOW
@@ -155,9 +159,9 @@ def rebuild_list(i, r, centre, radius, shell, box, ncell, cell_head, cell_next, 
 
 
 @jit
-def build_all_lists(r, centre, radius, shell, box, ncell, cell_head, cell_next, cell_prev,
+def build_all_lists(r, centre, rec, shell, box, ncell, cell_head, cell_next, cell_prev,
                     cell_of, nbl, nbn):
-    """Centres = positions, cells and all neighbour lists from scratch.
+    """Centres = positions ``r`` (= rec[:, :3]), cells and all neighbour lists from scratch.
 
     Returns 0, or OVERFLOW if some list exceeds ``nbl.shape[1]``.
     """
@@ -188,7 +192,7 @@ def build_all_lists(r, centre, radius, shell, box, ncell, cell_head, cell_next, 
                             dx = min_image(r[i, 0] - r[j, 0], box[0])
                             dy = min_image(r[i, 1] - r[j, 1], box[1])
                             dz = min_image(r[i, 2] - r[j, 2], box[2])
-                            cut = radius[i] + radius[j] + shell
+                            cut = rec[i, 7] + rec[j, 7] + shell
                             if dx * dx + dy * dy + dz * dz < cut * cut:
                                 if nbn[i] >= m or nbn[j] >= m:
                                     return OVERFLOW

@@ -9,8 +9,10 @@ is simply re-predicted. A pair collision needs to be scheduled by only one of
 the two: whichever changes its velocity first re-predicts against all its
 neighbours, the other included.
 
-Particles stream lazily: each carries its own clock ``tcl[i]`` and is moved
-to the current time only when it takes part in an event.
+Particles stream lazily: each carries its own clock and is moved to the
+current time only when it takes part in an event. The data a prediction reads
+for a neighbour sit in one 64-byte record per particle,
+``rec[i] = (x, y, z, vx, vy, vz, t_i, R_i)``, so that one cache line serves it.
 
 Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 0 reached ``until``; 1 event budget of this chunk used (call again);
@@ -38,52 +40,54 @@ WATCHDOG = 30
 
 # indices into the float and int scalar arrays
 S_TIME, S_DISSIPATED, S_VIRIAL, S_KIN_INT, S_SUM_MV2 = 0, 1, 2, 3, 4
-I_COLLISIONS, I_EVENTS, I_ERR_I, I_ERR_J = 0, 1, 2, 3
+I_COLLISIONS, I_EVENTS, I_ERR_I, I_ERR_J, I_EXPIRIES, I_STALE = 0, 1, 2, 3, 4, 5
 # indices into the float parameter array
 P_EPS, P_TC, P_PREFACTOR, P_INV_H, P_SHELL, P_COLLAPSE_DT = 0, 1, 2, 3, 4, 5
+# columns of a particle record
+T_COL, R_COL = 6, 7
 
 
 @jit(inline="always")
-def stream(i, t, r, v, tcl, img, box):
+def stream(i, t, rec, img, box):
     """Move particle i on its straight line to time t, wrapping into the box."""
-    dt = t - tcl[i]
+    dt = t - rec[i, 6]
     for a in range(3):
-        x = r[i, a] + v[i, a] * dt
+        x = rec[i, a] + rec[i, 3 + a] * dt
         if x >= box[a]:
             x -= box[a]
             img[i, a] += 1
         elif x < 0.0:
             x += box[a]
             img[i, a] -= 1
-        r[i, a] = x
-    tcl[i] = t
+        rec[i, a] = x
+    rec[i, 6] = t
 
 
 @jit
-def predict(i, t, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount, box,
-            half_shell):
+def predict(i, t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell):
     """Earliest event of particle i (streamed to t): collision or list expiry.
 
     Sets ``partner[i]`` (-1 for expiry) and ``pcount[i]``; returns the time.
     """
-    xi = r[i, 0]
-    yi = r[i, 1]
-    zi = r[i, 2]
-    vx = v[i, 0]
-    vy = v[i, 1]
-    vz = v[i, 2]
+    xi = rec[i, 0]
+    yi = rec[i, 1]
+    zi = rec[i, 2]
+    vx = rec[i, 3]
+    vy = rec[i, 4]
+    vz = rec[i, 5]
+    ri = rec[i, 7]
     best = t + exit_delay(min_image(xi - centre[i, 0], box[0]),
                           min_image(yi - centre[i, 1], box[1]),
                           min_image(zi - centre[i, 2], box[2]), vx, vy, vz, half_shell)
     p = -1
-    ri = radius[i]
     for k in range(nbn[i]):
         j = nbl[i, k]
-        dtj = t - tcl[j]
-        s = collision_delay(min_image(xi - (r[j, 0] + v[j, 0] * dtj), box[0]),
-                            min_image(yi - (r[j, 1] + v[j, 1] * dtj), box[1]),
-                            min_image(zi - (r[j, 2] + v[j, 2] * dtj), box[2]),
-                            vx - v[j, 0], vy - v[j, 1], vz - v[j, 2], ri + radius[j], best - t)
+        dtj = t - rec[j, 6]
+        s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), box[0]),
+                            min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), box[1]),
+                            min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), box[2]),
+                            vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7],
+                            best - t)
         if t + s < best:
             best = t + s
             p = j
@@ -93,16 +97,14 @@ def predict(i, t, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount, b
 
 
 @jit
-def predict_all(t, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount, box,
-                half_shell, times):
+def predict_all(t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell, times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
-    for i in range(r.shape[0]):
-        times[i] = predict(i, t, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount,
-                           box, half_shell)
+    for i in range(rec.shape[0]):
+        times[i] = predict(i, t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
 
 
 @jit
-def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastcoll, rapid,
+def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             nbl, nbn, scratch, cell_head, cell_next, cell_prev, cell_of, heap_t, heap_id, hpos,
             box, ncell, kind, fpar, coeffs, collapse_count, until, max_events, max_collisions,
             scal, iscal):
@@ -110,7 +112,7 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
 
     ``scal`` = [time, dissipated energy, collisional virial sum, integral of
     sum m v^2 dt, sum m v^2]; ``iscal`` = [collisions, events, i, j of an
-    error]. Returns a status code.
+    error, list expiries, stale events]. Returns a status code.
     """
     eps_const = fpar[P_EPS]
     tc_time = fpar[P_TC]
@@ -121,7 +123,7 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
     collapse_dt = fpar[P_COLLAPSE_DT]
     time = scal[S_TIME]
     zero_advance = 0
-    zero_limit = 1000 + r.shape[0]
+    zero_limit = 1000 + rec.shape[0]
     events_end = iscal[I_EVENTS] + max_events
     status = DONE
     while True:
@@ -151,14 +153,14 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
         j = partner[i]
         if j >= 0 and count[j] == pcount[i]:
             # ---- pair collision: validate, execute, re-predict both
-            stream(i, te, r, v, tcl, img, box)
-            stream(j, te, r, v, tcl, img, box)
-            dx = min_image(r[i, 0] - r[j, 0], box[0])
-            dy = min_image(r[i, 1] - r[j, 1], box[1])
-            dz = min_image(r[i, 2] - r[j, 2], box[2])
-            ux = v[i, 0] - v[j, 0]
-            uy = v[i, 1] - v[j, 1]
-            uz = v[i, 2] - v[j, 2]
+            stream(i, te, rec, img, box)
+            stream(j, te, rec, img, box)
+            dx = min_image(rec[i, 0] - rec[j, 0], box[0])
+            dy = min_image(rec[i, 1] - rec[j, 1], box[1])
+            dz = min_image(rec[i, 2] - rec[j, 2], box[2])
+            ux = rec[i, 3] - rec[j, 3]
+            uy = rec[i, 4] - rec[j, 4]
+            uz = rec[i, 5] - rec[j, 5]
             b = dx * ux + dy * uy + dz * uz
             if b < 0.0:
                 dist = math.sqrt(dx * dx + dy * dy + dz * dz)
@@ -174,7 +176,7 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
                 if tc_time > 0.0 and (te - lastcoll[i] < tc_time or te - lastcoll[j] < tc_time):
                     eps = 1.0
                 else:
-                    r_eff = radius[i] * radius[j] / (radius[i] + radius[j])
+                    r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
                     eps = restitution(kind, eps_const, prefactor, inv_h, coeffs, -un, r_eff,
                                       m_eff)
                     if eps < 0.0:
@@ -185,12 +187,12 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
                 f = (1.0 + eps) * un / msum
                 fi = f * mj
                 fj = f * mi
-                v[i, 0] -= fi * nx
-                v[i, 1] -= fi * ny
-                v[i, 2] -= fi * nz
-                v[j, 0] += fj * nx
-                v[j, 1] += fj * ny
-                v[j, 2] += fj * nz
+                rec[i, 3] -= fi * nx
+                rec[i, 4] -= fi * ny
+                rec[i, 5] -= fi * nz
+                rec[j, 3] += fj * nx
+                rec[j, 4] += fj * ny
+                rec[j, 5] += fj * nz
                 de = 0.5 * (1.0 - eps * eps) * m_eff * un * un
                 scal[S_DISSIPATED] += de
                 scal[S_SUM_MV2] -= 2.0 * de
@@ -209,12 +211,12 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
                     rapid[j] = 0
                 lastcoll[i] = te
                 lastcoll[j] = te
-                tj = predict(j, te, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount,
-                             box, half_shell)
+                tj = predict(j, te, rec, centre, count, nbl, nbn, partner, pcount, box,
+                             half_shell)
                 heap_update(heap_t, heap_id, hpos, j, tj)
                 if rapid[i] >= collapse_count or rapid[j] >= collapse_count:
-                    ti = predict(i, te, r, v, tcl, centre, radius, count, nbl, nbn, partner,
-                                 pcount, box, half_shell)
+                    ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box,
+                                 half_shell)
                     heap_update(heap_t, heap_id, hpos, i, ti)
                     iscal[I_EVENTS] += 1
                     iscal[I_ERR_I] = i
@@ -223,18 +225,19 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
                     break
         elif j < 0:
             # ---- list expiry: new centre and list for i
-            stream(i, te, r, v, tcl, img, box)
-            if rebuild_list(i, r, centre, radius, shell, box, ncell, cell_head, cell_next,
-                            cell_prev, cell_of, nbl, nbn, scratch) == OVERFLOW:
+            stream(i, te, rec, img, box)
+            if rebuild_list(i, rec, centre, shell, box, ncell, cell_head, cell_next, cell_prev,
+                            cell_of, nbl, nbn, scratch) == OVERFLOW:
                 iscal[I_ERR_I] = i
                 iscal[I_ERR_J] = -1
                 status = OVERFLOW
                 break
+            iscal[I_EXPIRIES] += 1
         else:
             # ---- stale event: the partner changed course; just re-predict
-            stream(i, te, r, v, tcl, img, box)
-        ti = predict(i, te, r, v, tcl, centre, radius, count, nbl, nbn, partner, pcount, box,
-                     half_shell)
+            stream(i, te, rec, img, box)
+            iscal[I_STALE] += 1
+        ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
         heap_update(heap_t, heap_id, hpos, i, ti)
         iscal[I_EVENTS] += 1
         if iscal[I_COLLISIONS] >= max_collisions:
@@ -248,16 +251,16 @@ def advance(r, v, tcl, img, centre, radius, mass, count, partner, pcount, lastco
 
 
 @jit
-def synchronised(r, v, tcl, img, box, t, out_r, out_img):
+def synchronised(rec, img, box, t, out_r, out_img):
     """Positions and images of all particles streamed to time t (no side effect).
 
     Positions land in [0, L): one wrap suffices because no particle is more than
     shell/2 from its list centre, which lies in the box.
     """
-    for i in range(r.shape[0]):
-        dt = t - tcl[i]
+    for i in range(rec.shape[0]):
+        dt = t - rec[i, 6]
         for a in range(3):
-            x = r[i, a] + v[i, a] * dt
+            x = rec[i, a] + rec[i, 3 + a] * dt
             k = img[i, a]
             if x >= box[a]:
                 x -= box[a]

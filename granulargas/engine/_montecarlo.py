@@ -125,3 +125,219 @@ def min_pair_ratio(r, radius, box, ncell, cell_head, cell_next):
                                 best = g
                         j = cell_next[j]
     return best
+
+
+@jit
+def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
+    """Sum over j != i of max(0, R_i + R_j - |r_ij|) for particle i placed at (x, y, z)."""
+    cx = cell_coord(x, box[0], ncell[0])
+    cy = cell_coord(y, box[1], ncell[1])
+    cz = cell_coord(z, box[2], ncell[2])
+    zr = 1 if ncell[2] >= 3 else 0
+    total = 0.0
+    for oz in range(-zr, zr + 1):
+        kz = (cz + oz) % ncell[2]
+        for oy in range(-1, 2):
+            ky = (cy + oy) % ncell[1]
+            for ox in range(-1, 2):
+                kx = (cx + ox) % ncell[0]
+                j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
+                while j >= 0:
+                    if j != i:
+                        dx = min_image(x - r[j, 0], box[0])
+                        dy = min_image(y - r[j, 1], box[1])
+                        dz = min_image(z - r[j, 2], box[2])
+                        s = radius[i] + radius[j]
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if d2 < s * s:
+                            total += s - d2**0.5
+                    j = cell_next[j]
+    return total
+
+
+@jit
+def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, disp):
+    """Sweep of moves accepted when the moved particle's overlap depth does not grow.
+
+    Non-overlapping particles therefore move as hard spheres while overlapping
+    ones are pushed apart (zero-temperature overlap relaxation). Returns the
+    number of particles still overlapping after their move.
+    """
+    overlapping = 0
+    for i in range(r.shape[0]):
+        old = overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
+                            cell_next)
+        x = r[i, 0] + step * disp[i, 0]
+        y = r[i, 1] + step * disp[i, 1]
+        z = r[i, 2] + step * disp[i, 2]
+        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
+        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
+        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
+        if x >= box[0] or y >= box[1] or z >= box[2]:
+            if old > 0.0:
+                overlapping += 1
+            continue
+        new = overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next)
+        if new > old or (old > 0.0 and new == old):
+            if old > 0.0:
+                overlapping += 1
+            continue
+        c = cell_index(x, y, z, box, ncell)
+        if c != cell_of[i]:
+            cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
+            cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+        r[i, 0] = x
+        r[i, 1] = y
+        r[i, 2] = z
+        if new > 0.0:
+            overlapping += 1
+    return overlapping
+
+
+@jit
+def _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, out, m):
+    """Append i's overlap partners to out[m:], return the new length."""
+    cx = cell_coord(x, box[0], ncell[0])
+    cy = cell_coord(y, box[1], ncell[1])
+    cz = cell_coord(z, box[2], ncell[2])
+    zr = 1 if ncell[2] >= 3 else 0
+    for oz in range(-zr, zr + 1):
+        kz = (cz + oz) % ncell[2]
+        for oy in range(-1, 2):
+            ky = (cy + oy) % ncell[1]
+            for ox in range(-1, 2):
+                kx = (cx + ox) % ncell[0]
+                j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
+                while j >= 0:
+                    if j != i:
+                        dx = min_image(x - r[j, 0], box[0])
+                        dy = min_image(y - r[j, 1], box[1])
+                        dz = min_image(z - r[j, 2], box[2])
+                        s = radius[i] + radius[j]
+                        if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
+                            out[m] = j
+                            m += 1
+                    j = cell_next[j]
+    return m
+
+
+@jit
+def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
+    """Indices of all particles overlapping some other one, into out; returns the count."""
+    m = 0
+    for i in range(r.shape[0]):
+        if overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
+                         cell_next) > 0.0:
+            out[m] = i
+            m += 1
+    return m
+
+
+@jit
+def relax_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, disp,
+               out):
+    """Overlap-relaxation moves of the particles ``idx`` (see :func:`relax_sweep`).
+
+    Writes the particles still involved in overlaps after the moves (with
+    repetitions) into ``out`` and returns their number.
+    """
+    m = 0
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        old = overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
+                            cell_next)
+        if old == 0.0:
+            continue
+        x = r[i, 0] + step * disp[k, 0]
+        y = r[i, 1] + step * disp[k, 1]
+        z = r[i, 2] + step * disp[k, 2]
+        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
+        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
+        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
+        if x < box[0] and y < box[1] and z < box[2]:
+            new = overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next)
+            if new < old:
+                c = cell_index(x, y, z, box, ncell)
+                if c != cell_of[i]:
+                    cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
+                    cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+                r[i, 0] = x
+                r[i, 1] = y
+                r[i, 2] = z
+        m0 = m
+        m = _overlap_partners(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
+                              cell_next, out, m)
+        if m > m0 and m < out.shape[0]:
+            out[m] = i
+            m += 1
+    return m
+
+
+@jit
+def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, kick, out):
+    """Push each particle of ``idx`` out of its overlaps (Gauss-Seidel descent).
+
+    Particle i moves by sum_j [(R_i + R_j - d_ij)/2 + 1e-3 (R_i + R_j)] n_ij,
+    i.e. by a little more than its half of every overlap, so that overlaps
+    disappear in a finite number of passes; the push is scaled by ``kick[k]``
+    (random, around 1) to break the symmetric deadlocks of a particle squeezed
+    between two others. Writes the particles still
+    involved in overlaps (with repetitions) into ``out``; returns their number.
+    """
+    m = 0
+    zr = 1 if ncell[2] >= 3 else 0
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        x = r[i, 0]
+        y = r[i, 1]
+        z = r[i, 2]
+        px = 0.0
+        py = 0.0
+        pz = 0.0
+        cx = cell_coord(x, box[0], ncell[0])
+        cy = cell_coord(y, box[1], ncell[1])
+        cz = cell_coord(z, box[2], ncell[2])
+        for oz in range(-zr, zr + 1):
+            kz = (cz + oz) % ncell[2]
+            for oy in range(-1, 2):
+                ky = (cy + oy) % ncell[1]
+                for ox in range(-1, 2):
+                    kx = (cx + ox) % ncell[0]
+                    j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
+                    while j >= 0:
+                        if j != i:
+                            dx = min_image(x - r[j, 0], box[0])
+                            dy = min_image(y - r[j, 1], box[1])
+                            dz = min_image(z - r[j, 2], box[2])
+                            s = radius[i] + radius[j]
+                            d2 = dx * dx + dy * dy + dz * dz
+                            if d2 < s * s and d2 > 0.0:
+                                dd = d2**0.5
+                                f = (0.5 * (s - dd) + 1e-3 * s) / dd
+                                px += f * dx
+                                py += f * dy
+                                pz += f * dz
+                        j = cell_next[j]
+        if px == 0.0 and py == 0.0 and pz == 0.0:
+            continue
+        x += kick[k] * px
+        y += kick[k] * py
+        z += kick[k] * pz
+        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
+        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
+        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
+        if x >= box[0] or y >= box[1] or z >= box[2]:
+            continue
+        c = cell_index(x, y, z, box, ncell)
+        if c != cell_of[i]:
+            cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
+            cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+        r[i, 0] = x
+        r[i, 1] = y
+        r[i, 2] = z
+        m0 = m
+        m = _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, out, m)
+        if m > m0 and m < out.shape[0]:
+            out[m] = i
+            m += 1
+    return m

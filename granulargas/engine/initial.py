@@ -138,21 +138,40 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         acc = mc.sweep(r3, rad, box3, ncell, head, nxt, prv, cof, state["step"], disp) / n
         state["step"] = min(0.5 * float(box.min()), state["step"] * min(2.0, max(0.5, acc / 0.4)))
 
-    # Lattice too tight for the largest particles (polydisperse or very dense):
-    # shrink all radii by lam, then alternate MC sweeps and growth to the largest
-    # lam without overlap (Lubachevsky-Stillinger style, without velocities).
-    lam = min(1.0, dist / dmax * (1.0 - 1e-9))
-    for _ in range(2000):
-        if lam >= 1.0:
-            break
-        do_sweep(radii * lam)
-        do_sweep(radii * lam)
-        ratio = mc.min_pair_ratio(r3, radii, box3, ncell, head, nxt)
-        lam = max(lam, min(1.0, ratio * (1.0 - 1e-9)))
-    else:
-        eta = float(np.sum(particle_volume(radii, d))) / float(np.prod(box))
-        raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
-                          f"radii (reached {lam:.4f} of the target size)")
+    # Dense systems (and lattices too tight for the largest particles) start
+    # diluted, radii scaled by lam so that the packing is <= 0.25 and the sweeps
+    # melt the lattice; then the radii grow in steps of a few per cent, the
+    # overlaps each step creates are pushed apart (Gauss-Seidel descent on the
+    # overlaps, :func:`_montecarlo.push_some`), and a hard-sphere sweep follows.
+    eta = float(np.sum(particle_volume(radii, d))) / float(np.prod(box))
+    lam = min(1.0, dist / dmax * (1.0 - 1e-9), (0.25 / eta) ** (1.0 / d))
+    if lam < 1.0:
+        for _ in range(int(sweeps)):
+            do_sweep(radii * lam)
+    buf = np.empty(max(64, 40 * n), dtype=np.int64)
+    grow = 0.05
+    while lam < 1.0:
+        if grow < 1e-4:
+            raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
+                              f"radii (reached {lam:.4f} of the target size)")
+        saved = r3.copy()
+        trial = min(1.0, lam * (1.0 + grow))
+        rad = radii * trial
+        idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
+        for _ in range(500):
+            if len(idx) == 0:
+                break
+            kick = rng.uniform(0.5, 1.5, size=len(idx))
+            m = mc.push_some(idx, r3, rad, box3, ncell, head, nxt, prv, cof, kick, buf)
+            idx = np.unique(buf[:m])
+        if len(idx):  # stuck: undo, grow more gently
+            r3[:] = saved
+            mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
+            grow *= 0.5
+            continue
+        lam = trial
+        rad = radii * lam
+        do_sweep(rad)
     for _ in range(int(sweeps)):
         do_sweep(radii)
     out = np.empty((n, d))

@@ -55,6 +55,13 @@ def _part1by2(x):
     return x
 
 
+def _aligned_records(n):
+    """Zeroed (n, 8) float64 array whose rows start on 64-byte boundaries (cache lines)."""
+    buf = np.zeros(n * 8 + 8)
+    offset = (-buf.ctypes.data % 64) // 8
+    return buf[offset : offset + n * 8].reshape(n, 8)
+
+
 def morton_order(positions3, box3, ncell):
     """Stable permutation sorting particles by the Z-order key of their cell."""
     key = np.zeros(positions3.shape[0], dtype=np.uint64)
@@ -193,16 +200,17 @@ class Simulation:
         order = morton_order(p3, self._box3, self._ncell)
         self._order = order
         s = {}
-        s["r"] = np.ascontiguousarray(p3[order])
-        v3 = np.zeros((n, 3))
-        v3[:, :d] = self._velocities[order]
-        s["v"] = v3
-        s["tcl"] = np.full(n, self._time)
+        rec = _aligned_records(n)
+        rec[:, :3] = p3[order]
+        rec[:, 3:6] = 0.0
+        rec[:, 3 : 3 + d] = self._velocities[order]
+        rec[:, 6] = self._time
+        rec[:, 7] = self._radii[order]
+        s["rec"] = rec
         img = np.zeros((n, 3), dtype=np.int32)
         img[:, :d] = self._images[order]
         s["img"] = img
         s["centre"] = np.empty((n, 3))
-        s["radius"] = np.ascontiguousarray(self._radii[order])
         s["mass"] = np.ascontiguousarray(self._masses[order])
         s["count"] = np.zeros(n, dtype=np.int32)
         s["partner"] = np.full(n, -1, dtype=np.int32)
@@ -214,26 +222,27 @@ class Simulation:
         s["cell_prev"] = np.empty(n, dtype=np.int32)
         s["cell_of"] = np.empty(n, dtype=np.int32)
         s["nbn"] = np.zeros(n, dtype=np.int32)
+        pos = np.ascontiguousarray(rec[:, :3])
         while True:
             s["nbl"] = np.empty((n, self._nb_width), dtype=np.int32)
-            st = build_all_lists(s["r"], s["centre"], s["radius"], self.shell, self._box3,
-                                 self._ncell, s["cell_head"], s["cell_next"], s["cell_prev"],
-                                 s["cell_of"], s["nbl"], s["nbn"])
+            st = build_all_lists(pos, s["centre"], rec, self.shell, self._box3, self._ncell,
+                                 s["cell_head"], s["cell_next"], s["cell_prev"], s["cell_of"],
+                                 s["nbl"], s["nbn"])
             if st != OVERFLOW:
                 break
             self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
         s["scratch"] = np.empty(self._nb_width, dtype=np.int32)
         times = np.empty(n)
-        _loop.predict_all(self._time, s["r"], s["v"], s["tcl"], s["centre"], s["radius"], s["count"],
-                          s["nbl"], s["nbn"], s["partner"], s["pcount"], self._box3,
-                          0.5 * self.shell * (1.0 - 1e-9), times)
+        _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
+                          s["partner"], s["pcount"], self._box3, 0.5 * self.shell * (1.0 - 1e-9),
+                          times)
         s["heap_t"] = np.empty(n)
         s["heap_id"] = np.empty(n, dtype=np.int32)
         s["hpos"] = np.empty(n, dtype=np.int32)
         heap_build(s["heap_t"], s["heap_id"], s["hpos"], times)
         s["scal"] = np.array([self._time, self._dissipated, self._virial, self._kin_int,
                               float(np.sum(self._masses[:, None] * self._velocities**2))])
-        s["iscal"] = np.array([self._collisions, self._events, -1, -1], dtype=np.int64)
+        s["iscal"] = np.array([self._collisions, self._events, -1, -1, 0, 0], dtype=np.int64)
         self._s = s
         self._built = True
 
@@ -280,12 +289,12 @@ class Simulation:
         target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
         kind, eps, tc, pref, inv_h, coeffs = self.rule.kernel_arguments()
         v2 = s["scal"][4] / float(np.sum(s["mass"]))
-        scale = 2.0 * float(s["radius"].min()) / math.sqrt(v2) if v2 > 0 else 1.0
+        scale = 2.0 * float(self._radii.min()) / math.sqrt(v2) if v2 > 0 else 1.0
         fpar = np.array([eps, tc, pref, inv_h, self.shell, 1e-10 * scale])
-        chunk = max(1_000_000, 2 * s["r"].shape[0])
+        chunk = max(1_000_000, 2 * self.n)
         while True:
             status = _loop.advance(
-                s["r"], s["v"], s["tcl"], s["img"], s["centre"], s["radius"], s["mass"], s["count"],
+                s["rec"], s["img"], s["centre"], s["mass"], s["count"],
                 s["partner"], s["pcount"], s["lastcoll"], s["rapid"], s["nbl"], s["nbn"], s["scratch"],
                 s["cell_head"], s["cell_next"], s["cell_prev"], s["cell_of"], s["heap_t"],
                 s["heap_id"], s["hpos"], self._box3, self._ncell, kind, fpar, coeffs,
@@ -301,7 +310,7 @@ class Simulation:
                 break
             self._raise(status)
         dt = self.time - start_time
-        self._rate = 2.0 * (self.collisions - start_coll) / (len(s["r"]) * dt) if dt > 0 else float("nan")
+        self._rate = 2.0 * (self.collisions - start_coll) / (self.n * dt) if dt > 0 else float("nan")
         if progress is not None:
             progress(self)
         return self
@@ -333,7 +342,7 @@ class Simulation:
             n, d = self._positions.shape
             inv = self._order
             vel = np.empty((n, d))
-            vel[inv] = s["v"][:, :d]
+            vel[inv] = s["rec"][:, 3 : 3 + d]
             self._velocities = vel
             lc = np.empty(n)
             lc[inv] = s["lastcoll"]
@@ -351,7 +360,7 @@ class Simulation:
         n, d = self._positions.shape
         r = np.empty((n, 3))
         img = np.empty((n, 3), dtype=np.int32)
-        _loop.synchronised(s["r"], s["v"], s["tcl"], s["img"], self._box3, s["scal"][0], r, img)
+        _loop.synchronised(s["rec"], s["img"], self._box3, s["scal"][0], r, img)
         pos = np.empty((n, d))
         pos[self._order] = r[:, :d]
         im = np.empty((n, d), dtype=np.int64)
@@ -395,7 +404,7 @@ class Simulation:
         if not self._built:
             return self._velocities.copy()
         out = np.empty_like(self._velocities)
-        out[self._order] = self._s["v"][:, : self.dimension]
+        out[self._order] = self._s["rec"][:, 3 : 3 + self.dimension]
         return out
 
     @property
@@ -421,7 +430,7 @@ class Simulation:
     # ------------------------------------------------------------ observables
     def _vm(self):
         if self._built:
-            return self._s["v"][:, : self.dimension], self._s["mass"]
+            return self._s["rec"][:, 3 : 3 + self.dimension], self._s["mass"]
         return self._velocities, self._masses
 
     @property

@@ -30,6 +30,7 @@ from granulargas.errors import ConfigError
 MAX_PACKING = {3: math.pi / (3.0 * math.sqrt(2.0)), 2: math.pi / (2.0 * math.sqrt(3.0))}
 MODELS = ("elastic", "constant", "viscoelastic")
 CONTACT_ENDS = ("overlap", "force")
+DEFAULT_SNAPSHOTS = 20
 
 
 @dataclass(frozen=True)
@@ -98,7 +99,8 @@ class CollisionConfig:
 @dataclass(frozen=True)
 class RunSection:
     """``[run]``: stop at ``end_time`` or after ``collisions_per_particle``,
-    whichever comes first (at least one is required)."""
+    whichever comes first (at least one is required). Collisions per particle
+    count each pair collision for both partners: s = 2 C / N (kinetic theory)."""
 
     end_time: float | None = None
     collisions_per_particle: float | None = None
@@ -108,13 +110,17 @@ class RunSection:
 class OutputConfig:
     """``[output]``: H5MD file and the output schedule.
 
-    ``snapshots`` full snapshots (including the initial and the final state),
-    log-spaced in time from ``first_snapshot`` to the end unless
-    ``snapshot_interval`` asks for even spacing; observables every
+    ``snapshots`` full snapshots (including the initial and the final state;
+    default :data:`DEFAULT_SNAPSHOTS`), log-spaced in time from ``first_snapshot``
+    to the end, or evenly spaced every ``snapshot_interval``; observables every
     ``observables_interval`` and at every snapshot."""
 
+    @property
+    def snapshot_count(self) -> int:
+        return DEFAULT_SNAPSHOTS if self.snapshots is None else self.snapshots
+
     file: str = "runs/run.h5"
-    snapshots: int = 20
+    snapshots: int | None = None  # None: DEFAULT_SNAPSHOTS (log-spaced) unless snapshot_interval
     snapshot_interval: float | None = None
     first_snapshot: float | None = None
     observables_interval: float | None = None
@@ -429,8 +435,10 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
     file = r.string("file", default_file)
     if not file.strip():
         r.fail("file", file, "must be a file name")
-    snapshots = r.integer("snapshots", OutputConfig.snapshots, minimum=1)
+    snapshots = r.integer("snapshots", None, minimum=2)
     snap_dt = r.number("snapshot_interval", None, low=0.0)
+    if snapshots is not None and snap_dt is not None:
+        r.fail("snapshot_interval", snap_dt, "give either snapshots (log-spaced) or snapshot_interval, not both")
     first = r.number("first_snapshot", None, low=0.0)
     obs_dt = r.number("observables_interval", None, low=0.0)
     if snap_dt is not None and first is not None:

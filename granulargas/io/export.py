@@ -176,6 +176,7 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
         directory, state.positions, state.velocities, state.radii, state.masses, state.box, prefactor,
         end=end, end_time=end_time, thermo_interval=interval, contact_fraction=contact_fraction,
         steps_per_contact=steps_per_contact, poisson_ratio=poisson_ratio, name=name, source=config.source,
+        time_origin=state.time,
     )
 
 

@@ -32,10 +32,11 @@ frame-indexed readers (MDAnalysis ``ts.data``) never run past their end; use
 :func:`read_observables` for the right times. The unwrapped position is
 ``position + image * edges``.
 
-Crash safety: the writer calls ``flush`` after each snapshot and each
-observables sample, so a run killed in the compiled loop leaves a file that
-holds every frame written before; the readers ignore a last frame whose time
-was not yet written.
+Crash safety: the writer flushes the file after each snapshot (observables
+are buffered for at most ``flush_seconds`` of wall time and always written
+before a snapshot), so a run killed in the compiled loop leaves a file that
+holds every frame written before, readable by any HDF5 reader (no SWMR flag to
+clear); the readers ignore a last frame whose time was not yet written.
 
 The readers (:func:`read_observables`, :func:`iter_snapshots`,
 :func:`load_snapshot`, :func:`read_parameters`) read one frame at a time.
@@ -48,6 +49,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
 
+import re
+import time as _time
+
 import h5py
 import numpy as np
 
@@ -55,7 +59,7 @@ from granulargas import __version__
 from granulargas.errors import InputFileError
 
 CREATOR = "granulargas"
-SNAPSHOT_ELEMENTS = ("position", "velocity", "image")
+_wall = _time.monotonic
 SCALAR_OBSERVABLES = ("temperature", "kinetic_energy", "collisions", "events", "dissipated_energy", "pressure")
 _INT_OBSERVABLES = ("collisions", "events")
 
@@ -104,7 +108,12 @@ class H5MDWriter:
             self.file.close()
             self.path.unlink(missing_ok=True)
             raise
+        self._pending = []
+        self._last_flush = _wall()
         self.file.flush()
+
+    #: longest wall time (s) observables samples stay buffered in memory
+    flush_seconds = 2.0
 
     # ----------------------------------------------------------------- layout
     def _create(self, box, radii, masses, species, parameters, last_collision, author):
@@ -180,6 +189,7 @@ class H5MDWriter:
 
         The frame's values are written before its step/time, so a reader of a
         killed run never sees a time without data."""
+        self.flush_observables()
         k = self.frames
         data = {"position": positions, "velocity": velocities, "image": images, "edges": self.box}
         if last_collision is not None:
@@ -198,30 +208,48 @@ class H5MDWriter:
 
     def write_observables(self, step, time, values: dict, flush=True):
         """Append one sample of every observable (``values``: name -> value;
-        a missing one is stored as NaN, or -1 for the integer counters)."""
+        a missing one is stored as NaN, or -1 for the integer counters).
+
+        Samples are buffered in memory and written in one block (h5py's cost
+        per call dominates small writes) when ``flush`` is true, before each
+        snapshot, at :meth:`close`, and at least every ``flush_seconds`` of
+        wall time."""
         unknown = set(values) - set(self._obs)
         if unknown:
             raise KeyError(f"unknown observables {sorted(unknown)}")
-        step_ds, time_ds = self._obs_clock
-        k = step_ds.shape[0]
-        for name, g in self._obs.items():
-            v = g["value"]
-            v.resize(k + 1, axis=0)
-            v[k] = values.get(name, -1 if name in _INT_OBSERVABLES else np.nan)
-        for ds, val in ((step_ds, step), (time_ds, time)):
-            ds.resize(k + 1, axis=0)
-            ds[k] = val
-        if flush:
-            self.file.flush()
+        self._pending.append((int(step), float(time), values))
+        if flush or _wall() - self._last_flush > self.flush_seconds:
+            self.flush_observables()
+
+    def flush_observables(self):
+        """Write the buffered observables samples and flush the file."""
+        if self._pending:
+            step_ds, time_ds = self._obs_clock
+            k, m = step_ds.shape[0], len(self._pending)
+            for name, g in self._obs.items():
+                fill = -1 if name in _INT_OBSERVABLES else np.nan
+                v = g["value"]
+                block = np.array([p[2].get(name, fill) for p in self._pending], dtype=v.dtype)
+                v.resize(k + m, axis=0)
+                v[k:k + m] = block
+            for ds, col in ((step_ds, 0), (time_ds, 1)):
+                ds.resize(k + m, axis=0)
+                ds[k:k + m] = [p[col] for p in self._pending]
+            self._pending = []
+        self.file.flush()
+        self._last_flush = _wall()
 
     def set_parameters(self, parameters: dict):
         """Add entries to ``parameters/`` (e.g. the final summary)."""
         _write_parameters(self.file["parameters"], parameters)
-        self.file.flush()
+        self.flush_observables()
 
     def close(self):
         if self.file.id.valid:
-            self.file.close()
+            try:
+                self.flush_observables()
+            finally:
+                self.file.close()
 
     def __enter__(self):
         return self
@@ -231,8 +259,14 @@ class H5MDWriter:
 
 
 def _short(exc) -> str:
-    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-    return text.split(" = ", 1)[-1] if "errno" in text else text
+    """The useful part of an HDF5 error message."""
+    text = str(exc).strip()
+    m = re.search(r"error message = '([^']*)'", text)
+    if m:
+        return m.group(1)
+    text = text.splitlines()[0] if text else type(exc).__name__
+    m = re.search(r"\(([^()]*)\)\s*$", text)
+    return m.group(1) if m else text
 
 
 def _write_parameters(group, params: dict):
@@ -289,7 +323,14 @@ def open_run(path, mode="r") -> h5py.File:
     try:
         f = h5py.File(path, mode)
     except OSError as exc:
-        raise InputFileError(f"{path}: not an HDF5 file or unreadable ({_short(exc)})") from None
+        if "lock" not in str(exc) or mode != "r":
+            raise InputFileError(f"{path}: not an HDF5 file or unreadable ({_short(exc)})") from None
+        # a running simulation holds the HDF5 lock; it flushes after every snapshot,
+        # so reading without the lock sees the frames written so far
+        try:
+            f = h5py.File(path, mode, locking=False)
+        except OSError:
+            raise InputFileError(f"{path}: locked by a running simulation; try again when it has finished") from None
     try:
         creator = f["h5md/creator"].attrs.get("name", None)
         if isinstance(creator, bytes):

@@ -278,15 +278,19 @@ def loop_time(text: str) -> float:
 
 
 def head_on_input(contact: DemContact, speed: float, timestep: float, steps: int,
-                  radius: float = 0.5, mass: float = 1.0) -> str:
-    """LAMMPS input for a head-on collision of two like spheres at relative speed ``speed``.
+                  radii=(0.5, 0.5), masses=(1.0, 1.0)) -> str:
+    """LAMMPS input for a head-on collision of two spheres at relative speed ``speed``.
 
-    The spheres touch at step 0 (zero overlap) and approach along x; after
-    ``steps`` steps the script prints ``GRANULARGAS_RESULT <g_after>``, the
-    relative separation speed (positive when receding).
+    Sphere 1 (atom type 1) and sphere 2 (type 2) touch at step 0 (zero
+    overlap) and approach along x with zero total momentum; eta_n0 is set per
+    pair of types from the pair's m_eff. After ``steps`` steps the script
+    prints ``GRANULARGAS_RESULT <g_after>``, the relative separation speed
+    (positive when receding).
     """
-    d = 2.0 * radius
-    eps_line = contact.pair_coeff("*", "*", mass_eff=mass / 2.0)
+    (r1, r2), (m1, m2) = radii, masses
+    span = 4.0 * (r1 + r2) + 1.0
+    coeffs = "\n".join(contact.pair_coeff(i, j, mi * mj / (mi + mj))
+                        for i, j, mi, mj in ((1, 1, m1, m1), (1, 2, m1, m2), (2, 2, m2, m2)))
     return f"""\
 # head-on collision of two viscoelastic spheres (granulargas.io.lammps.head_on_input)
 units lj
@@ -295,18 +299,20 @@ atom_modify map array
 dimension 3
 boundary m p p
 comm_modify vel yes
-region box block {-4 * d - 1.0} {4 * d + 1.0} {-2 * d} {2 * d} {-2 * d} {2 * d} units box
-create_box 1 box
-create_atoms 1 single {-radius:.17g} 0 0 units box
-create_atoms 1 single {radius:.17g} 0 0 units box
-set atom * diameter {d:.17g}
-set atom * mass {mass:.17g}
+region box block {-span} {span} {-span / 2} {span / 2} {-span / 2} {span / 2} units box
+create_box 2 box
+create_atoms 1 single {-r1:.17g} 0 0 units box
+create_atoms 2 single {r2:.17g} 0 0 units box
+set atom 1 diameter {2 * r1:.17g}
+set atom 2 diameter {2 * r2:.17g}
+set atom 1 mass {m1:.17g}
+set atom 2 mass {m2:.17g}
 velocity all set 0 0 0 units box
-set atom 1 vx {0.5 * speed:.17g}
-set atom 2 vx {-0.5 * speed:.17g}
+set atom 1 vx {m2 / (m1 + m2) * speed:.17g}
+set atom 2 vx {-m1 / (m1 + m2) * speed:.17g}
 pair_style granular
-{eps_line}
-neighbor {0.2 * d} bin
+{coeffs}
+neighbor {0.2 * (r1 + r2)} bin
 timestep {timestep:.17g}
 fix integrate all nve/sphere
 variable g equal vx[2]-vx[1]
@@ -319,14 +325,15 @@ print "{_RESULT} ${{g}}"
 
 
 def head_on_restitution(contact: DemContact, speed: float, steps_per_contact: int, workdir: str | Path,
-                        radius: float = 0.5, mass: float = 1.0, lmp: str | None = None) -> float:
+                        radii=(0.5, 0.5), masses=(1.0, 1.0), lmp: str | None = None) -> float:
     """Coefficient of restitution of one LAMMPS head-on collision.
 
-    The timestep is the elastic Hertz contact time / ``steps_per_contact``;
+    The timestep is the pair's elastic Hertz contact time / ``steps_per_contact``;
     the run lasts long enough for any damping (the ``overlap`` end's
     duration grows with beta), then eps = g_after / g_before.
     """
-    r_eff, m_eff = radius / 2.0, mass / 2.0
+    (r1, r2), (m1, m2) = radii, masses
+    r_eff, m_eff = r1 * r2 / (r1 + r2), m1 * m2 / (m1 + m2)
     t_c = contact.hertz_contact_time(speed, r_eff, m_eff)
     beta = contact.beta(speed, r_eff, m_eff)
     dt = t_c / steps_per_contact
@@ -335,7 +342,7 @@ def head_on_restitution(contact: DemContact, speed: float, steps_per_contact: in
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     inp = workdir / "in.head_on"
-    inp.write_text(head_on_input(contact, speed, dt, steps, radius, mass))
+    inp.write_text(head_on_input(contact, speed, dt, steps, radii, masses))
     text = run_lammps(inp, workdir, lmp=lmp)
     match = re.search(rf"^{_RESULT} (\S+)", text, flags=re.M)
     if match is None:
@@ -393,7 +400,7 @@ MAX_MASS_TYPES = 32
 
 def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefactor, *, end="overlap",
                      end_time, thermo_interval=None, contact_fraction=0.01, steps_per_contact=50,
-                     poisson_ratio=DEFAULT_POISSON, name="granulargas", source="") -> LammpsExport:
+                     poisson_ratio=DEFAULT_POISSON, name="granulargas", source="", time_origin=0.0) -> LammpsExport:
     """Write a LAMMPS data file and input script equivalent to one of our runs.
 
     Parameters
@@ -420,6 +427,8 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         initial temperature; sets the stiffness Y.
     steps_per_contact : int
         Timestep <= contact time / steps_per_contact, a whole number of steps to end_time.
+    time_origin : float
+        Our time at the exported state (a restart); LAMMPS's time starts at 0.
 
     Notes
     -----
@@ -459,6 +468,8 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         packing = float(np.sum(math.pi * radii**2)) / volume
     peculiar = velocities - np.sum(masses[:, None] * velocities, axis=0) / np.sum(masses)
     temperature = float(np.sum(masses[:, None] * peculiar**2)) / (d * n)
+    if not temperature > 0.0:
+        raise UserError("initial temperature is 0: the stiffness is set from the thermal impact speed")
     tau_free = enskog_mean_free_time(d, packing, sigma, mass, temperature)
     r_eff, m_eff = sigma / 4.0, mass / 2.0
     g_thermal = math.sqrt(2.0 * temperature / m_eff)
@@ -493,6 +504,7 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         f"{g_thermal:.6g} = {contact_fraction:g} x Enskog mean free time {tau_free:.6g}.",
         f"# Timestep {dt:.6g} <= contact time / {steps_per_contact}; {steps} steps to t = {end_time:.6g}.",
         "# Thermo: c_granT = m<c^2>/d (peculiar velocity c, d N degrees of freedom).",
+        f"# LAMMPS time 0 is granulargas time {time_origin:.17g}.",
         "units lj",
         f"dimension {d}",
         "boundary p p p",
@@ -527,7 +539,8 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     input_file.write_text("\n".join(lines))
     export = LammpsExport(input_file, data_file, contact, dt, steps, thermo_every, t_contact, tau_free,
                           contact_fraction, steps_per_contact, g_thermal, eta, tuple(float(m) for m in type_masses))
-    (directory / "granulargas_lammps.json").write_text(json.dumps(export.summary(), indent=2) + "\n")
+    summary = {**export.summary(), "time_origin": float(time_origin)}
+    (directory / "granulargas_lammps.json").write_text(json.dumps(summary, indent=2) + "\n")
     return export
 
 

@@ -9,7 +9,6 @@ terminal and prints a short summary.
 from __future__ import annotations
 
 import signal
-import sys
 import tomllib
 
 from granulargas.errors import ConfigError
@@ -23,7 +22,7 @@ def configure_parser(parser):
     parser.add_argument("--output", "-o", metavar="FILE", help="output file (overrides [output] file)")
     parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                         help="override a config value, e.g. --set collision.restitution=0.8 (repeatable)")
-    parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
+    parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar (the summary is still printed)")
 
 
 def parse_override(text: str):
@@ -55,10 +54,13 @@ def run(args) -> int:
         overrides["output.file"] = args.output
     config = load_config(args.config, overrides)
     try:  # SIGTERM closes the file like Ctrl-C (SIGKILL cannot be caught; frames are flushed anyway)
-        signal.signal(signal.SIGTERM, _terminate)
+        previous = signal.signal(signal.SIGTERM, _terminate)
     except ValueError:
-        pass  # not the main thread
-    summary = run_config(config, overwrite=args.overwrite, quiet=args.quiet)
-    if not args.quiet:
-        print("\n".join(summary.lines()))
+        previous = None  # not the main thread
+    try:
+        summary = run_config(config, overwrite=args.overwrite, quiet=args.quiet)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+    print("\n".join(summary.lines()))
     return 0

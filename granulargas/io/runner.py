@@ -5,7 +5,8 @@ is created can fail without leaving a file)::
 
     check the output path (exists without overwrite? same as the restart file?)
     setup = io.setup.prepare(config)          # rule, table, initial state
-    sim = Simulation(...); writer = H5MDWriter(...)
+    sim = Simulation(...); sim.run(until=start)   # JIT compile / queue build, untimed
+    writer = H5MDWriter(...)                     # the file exists from here on
     sample observables and write a snapshot at the start time
     for each output target (time, or collision count without run.end_time):
         sim.run(until=target, max_collisions=budget)   # compiled chunks
@@ -30,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from granulargas.errors import InputFileError
+from granulargas.errors import ConfigError, InputFileError, SimulationError
 from granulargas.io.config import RunConfig
 
 #: default number of evenly spaced observables samples (plus every snapshot time)
@@ -52,13 +53,15 @@ class RunSummary:
     stop_reason: str
     particles: int = 0
     warnings: tuple = field(default_factory=tuple)
+    startup_time: float = 0.0
 
     def lines(self) -> list[str]:
-        per = self.collisions / self.particles if self.particles else float("nan")
+        per = 2.0 * self.collisions / self.particles if self.particles else float("nan")
         return [
             f"collisions   {self.collisions} ({per:.4g} per particle), {self.events} events",
             f"time         {self.time:.6g} (stopped by {self.stop_reason})",
-            f"wall time    {self.wall_time:.3g} s ({self.collisions_per_second:.4g} collisions/s)",
+            f"wall time    {self.wall_time:.3g} s ({self.collisions_per_second:.4g} collisions/s)"
+            f" + {self.startup_time:.3g} s start-up (JIT compile or cache load, queue build)",
             f"temperature  {self.final_temperature:.6g} (final)",
             f"output       {self.output} ({self.snapshots} snapshots)",
         ]
@@ -101,6 +104,12 @@ def mean_free_time(config: RunConfig) -> float:
     return 1.0 / omega
 
 
+def collision_budget(config: RunConfig) -> int:
+    """Pair collisions for ``run.collisions_per_particle``: each collision counts
+    for both partners (the kinetic-theory s = 2 C / N), so C = s N / 2."""
+    return max(1, int(round(0.5 * config.run.collisions_per_particle * config.system.particles)))
+
+
 def _even(interval: float, end: float) -> np.ndarray:
     k = np.arange(1, int(math.floor(end / interval * (1 + 1e-12))) + 1)
     return np.append(k * interval, end)
@@ -110,7 +119,7 @@ def output_schedule(config: RunConfig) -> Schedule:
     """The output schedule of a config (start time 0; a restart skips the
     targets at or before its start)."""
     out, run = config.output, config.run
-    nsnap = out.snapshots
+    nsnap = out.snapshot_count
     if run.end_time is not None:
         end = run.end_time
         if out.snapshot_interval is not None:
@@ -127,9 +136,8 @@ def output_schedule(config: RunConfig) -> Schedule:
         obs = _even(obs_dt, end)
         clock = "time"
     else:
-        total = int(round(run.collisions_per_particle * config.system.particles))
-        total = max(total, 1)
-        n = config.system.particles
+        total = collision_budget(config)
+        n = max(1, config.system.particles // 2)  # one collision per particle
         if nsnap <= 2:
             snaps = np.array([total])
         elif total <= n:
@@ -271,19 +279,32 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         (log or _stderr)(w)
     schedule = output_schedule(config)
     st = setup.state
+    run = config.run
+    if run.end_time is not None and st.time >= run.end_time:
+        raise ConfigError(f"{config.source}: run.end_time = {run.end_time:g}: the restart file "
+                          f"{st.source} is already at t = {st.time:g}; nothing to run")
+    if run.collisions_per_particle is not None and st.collisions >= collision_budget(config):
+        raise ConfigError(f"{config.source}: run.collisions_per_particle = {run.collisions_per_particle:g}: the "
+                          f"restart file {st.source} already has {st.collisions} collisions; nothing to run")
 
     sim = Simulation(
         st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
         time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
         events=st.events, dissipated_energy=st.dissipated_energy,
     )
+    # a zero-length run compiles (or loads) the engine and builds its queue before
+    # the file exists and outside the timed part, so collisions/s measures the
+    # event loop; both paths of a restart do it, so restart equality is unaffected
+    w = _time.perf_counter()
+    sim.run(until=sim.time)
+    startup = _time.perf_counter() - w
 
     start_key = st.time if schedule.clock == "time" else st.collisions
     keep = schedule.targets > start_key
     targets, is_snap = schedule.targets[keep], schedule.snapshot[keep]
     budget = None
     if config.run.collisions_per_particle is not None:
-        budget = int(round(config.run.collisions_per_particle * len(st.radii)))
+        budget = collision_budget(config)
 
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -313,9 +334,6 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     wall0 = _time.perf_counter()
     c0 = sim.collisions
     stop_reason = "end_time" if schedule.clock == "time" else "collisions_per_particle"
-    if budget is not None and st.collisions >= budget:
-        stop_reason = "collisions_per_particle"
-        targets = targets[:0]
     try:
         writer.write_observables(sim.events, sim.time, _observables(sim, False), flush=False)
         snapshot()
@@ -327,7 +345,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
             else:
                 sim.run(until=math.inf, max_collisions=int(target) - sim.collisions, progress=callback)
                 hit_budget = False
-            writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=not snap)
+            writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
             if snap or hit_budget:
                 snapshot()
             if callback is not None:
@@ -340,10 +358,13 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         try:
             writer.set_parameters({"summary": {"stop_reason": reason, "time": float(sim.time),
                                                "collisions": int(sim.collisions)}})
+            kept = writer.frames
         finally:
             writer.close()
             if bar is not None:
                 bar.close()
+        if isinstance(exc, SimulationError) and type(exc).__init__ is Exception.__init__:
+            raise type(exc)(f"{exc} ({path} keeps {kept} snapshots)") from None
         raise
     wall = _time.perf_counter() - wall0
     done = sim.collisions - c0
@@ -359,10 +380,12 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         stop_reason=stop_reason,
         particles=len(st.radii),
         warnings=tuple(setup.warnings),
+        startup_time=startup,
     )
     writer.set_parameters({"summary": {
         "stop_reason": stop_reason, "time": summary.time, "collisions": summary.collisions,
         "events": summary.events, "wall_time": wall, "collisions_per_second": summary.collisions_per_second,
+        "startup_time": startup,
     }})
     writer.close()
     if bar is not None:

@@ -54,7 +54,7 @@ def _sample_sonine(dim, a2, a3, n, rng):
 def test_sonine_coefficients_recover_a_known_distribution(dim):
     rng = np.random.default_rng(7)
     a2, a3 = 0.08, -0.03
-    v = _sample_sonine(dim, a2, a3, 400_000, rng)
+    v = _sample_sonine(dim, a2, a3, 150_000, rng)
     m2, m3 = ac.sonine_coefficients(v)
     assert m2 == pytest.approx(a2, abs=0.012)
     assert m3 == pytest.approx(a3, abs=0.03)

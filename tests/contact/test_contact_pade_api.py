@@ -1,6 +1,5 @@
 """Public API by each method, Pade approximant, and where the methods fail."""
 
-import warnings
 
 import numpy as np
 import pytest
@@ -33,7 +32,8 @@ def test_pade_is_percent_accurate_for_the_force_end():
     assert np.max(np.abs(p - exact)) < 0.01
     # through u^5 it is the force series: 1 - C1 b + C2 b^2 + (4/15) b^{5/2}
     b = 1e-4
-    assert restitution_pade(b) == pytest.approx(1 - C1 * b + C2 * b ** 2 + 4 / 15 * b ** 2.5, abs=1e-12)  # next term ~ u^6 = 1e-12
+    expected = 1 - C1 * b + C2 * b ** 2 + 4 / 15 * b ** 2.5
+    assert restitution_pade(b) == pytest.approx(expected, abs=1e-12)  # next term ~ u^6 = 1e-12
     with pytest.warns(UserWarning, match="force"):
         restitution(0.1, method="pade", end="overlap")
 
@@ -49,14 +49,16 @@ def test_bad_method_or_end():
 
 @pytest.mark.parametrize("end", ["overlap", "force"])
 def test_naive_integrator_from_x0_loses_accuracy(end):
-    # RK4 on x(t) started at x = 0: the sqrt(x) singularity caps the order well below 4
+    # RK4 on x(t) started at x = 0 (end located to fourth order): the sqrt(x) singularity caps the
+    # observed order near 3/2 instead of 4
     b = 0.5
     exact = ode.solve_many(b, end)[0, 0]
-    errs = np.array([abs(ode.solve_contact_naive(b, end, dt)[0] - exact) for dt in (0.02, 0.01)])
-    order = np.log2(errs[0] / errs[1])
-    assert order < 3.0
-    # and the regularised integrator at ~200x fewer steps is ~1e6 times more accurate
-    assert errs[1] > 1e-9
+    dts = np.array([0.02, 0.01, 0.005])
+    errs = np.array([abs(ode.solve_contact_naive(b, end, dt)[0] - exact) for dt in dts])
+    order = np.polyfit(np.log(dts), np.log(errs), 1)[0]
+    assert 1.0 < order < 2.5
+    # even at 650 steps it is far worse than the regularised integrator's ~15 steps (1e-15)
+    assert errs[-1] > 1e-7
     assert ode.solve_many(b, end)[0, 5] < 30
 
 

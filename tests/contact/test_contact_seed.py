@@ -1,6 +1,5 @@
 """The seed's own route (eqs. 13-33) against closed forms and the ODE."""
 
-import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 

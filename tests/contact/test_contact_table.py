@@ -76,3 +76,20 @@ def test_parameters_are_plain_scalars(cache_dir):
     for k, v in t.parameters.items():
         assert isinstance(v, (int, float, str)), k
     assert t.parameters["end"] == "force" and t.parameters["beta_max"] == 2.0
+
+
+def test_table_beyond_supported_range_is_a_clear_error(cache_dir):
+    from granulargas.contact.table import TABLE_BETA_MAX
+
+    with pytest.raises(TableRangeError, match="well below ~3"):
+        restitution_table(2 * TABLE_BETA_MAX)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("end", ["overlap", "force"])
+def test_largest_table_meets_the_target(end, cache_dir):
+    from granulargas.contact.table import TABLE_BETA_MAX
+
+    t = restitution_table(TABLE_BETA_MAX, end=end)
+    assert t.parameters["max_error_restitution"] <= 1e-8
+    assert t.parameters["max_relative_error_duration"] <= 1e-8

@@ -27,3 +27,28 @@ def next_engine_collision(sim):
     return sim.time, int(changed[0]), int(changed[1])
 
 
+
+
+C1 = 1.15344
+
+
+def pade_eps(beta):
+    """Müller & Pöschel (2011) Padé approximant of the viscoelastic eps(beta) (physics.md)."""
+    u = np.sqrt(beta)
+    a = 2.0 / (3.0 * C1**2)
+    return (1 + a * u) / (1 + a * u + C1 * u**2 + a * C1 * u**3 + 0.4 * C1**2 * u**4)
+
+
+def hermite_table(func, beta_max=25.0, n=4000):
+    """A restitution-table stand-in: cubic Hermite pieces of func(s^2) on a uniform grid in s."""
+    h = np.sqrt(beta_max) / n
+    s = np.arange(n + 1) * h
+    f = func(s**2)
+    ds = 1e-6 * h
+    fp = (func((s + ds) ** 2) - func(np.abs(s - ds) ** 2)) / (2 * ds)
+    fp[0] = (func(ds**2) - f[0]) / ds
+    f0, f1, d0, d1 = f[:-1], f[1:], h * fp[:-1], h * fp[1:]
+    coeffs = np.stack([f0, d0, 3 * (f1 - f0) - 2 * d0 - d1, 2 * (f0 - f1) + d0 + d1], axis=1)
+    from types import SimpleNamespace
+
+    return SimpleNamespace(inv_h=1.0 / h, coeffs=np.ascontiguousarray(coeffs), beta_max=beta_max)

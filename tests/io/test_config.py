@@ -118,7 +118,8 @@ BAD = [
     ("[particles]\ndiameter = { min = 1.2, max = 0.8 }", "needs min <= max"),
     ("[particles]\ndiameter = -1", "particles.diameter = -1: must be a number > 0"),
     ("[initial]\ntemperature = nan", "initial.temperature = nan: must be a number > 0"),
-    ("[output]\nsnapshots = 0", "output.snapshots = 0: must be an integer >= 1"),
+    ("[output]\nsnapshots = 1", "output.snapshots = 1: must be an integer >= 2"),
+    ("[output]\nsnapshots = 5\nsnapshot_interval = 1.0", "output.snapshot_interval = 1: give either snapshots"),
     ("[output]\nsnapshot_interval = true", "output.snapshot_interval = true: must be a number"),
     ("[collision.material]\nyoung_modulus = 1e7", "collision.material: missing key(s)"),
 ]

@@ -8,7 +8,7 @@ timestep. The reference eps(beta) is an independent ODE solve written here
 (w = sqrt(x), dt = 2 w ds removes the sqrt singularity at x = 0), and our
 contact module when it is importable.
 
-Needs the ``lmp`` executable; skipped with a reason otherwise.
+The LAMMPS tests need the ``lmp`` executable and skip with a reason otherwise.
 """
 
 import math
@@ -19,9 +19,7 @@ from scipy.integrate import solve_ivp
 
 from granulargas.io.lammps import DemContact, find_lmp, head_on_restitution
 
-pytestmark = pytest.mark.skipif(
-    find_lmp() is None, reason="LAMMPS executable `lmp` not installed (apt-get install lammps)"
-)
+needs_lmp = pytest.mark.skipif(find_lmp() is None, reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
 
 
 def eps_reference(beta, end):
@@ -61,6 +59,7 @@ def _contact(beta, end, speed=1.0):
     return DemContact.from_beta(beta, speed, young_modulus=1e4, end=end)
 
 
+@needs_lmp
 @pytest.mark.parametrize("end", ["force", "overlap"])
 def test_limit_damping_selects_the_end_of_contact(tmp_path, end):
     """At beta = 0.1 the two ends differ by 7e-4; LAMMPS at t_c/800 must pick the right one."""
@@ -71,6 +70,7 @@ def test_limit_damping_selects_the_end_of_contact(tmp_path, end):
     assert abs(eps - eps_reference(beta, other)) > 5e-4
 
 
+@needs_lmp
 @pytest.mark.parametrize("end", ["force", "overlap"])
 def test_first_order_convergence_in_timestep(tmp_path, end):
     """beta = 1: the error halves with the timestep; Richardson extrapolation hits the ODE."""
@@ -84,6 +84,7 @@ def test_first_order_convergence_in_timestep(tmp_path, end):
     assert abs(err[2]) < 1e-4
 
 
+@needs_lmp
 def test_impact_speed_scaling(tmp_path):
     """One material, two impact speeds: beta scales as g^{1/5} (seed eq. 2 scaling)."""
     contact = _contact(1.0, "force", speed=1.0)
@@ -94,10 +95,28 @@ def test_impact_speed_scaling(tmp_path):
     assert abs(eps - eps_reference(beta, "force")) < 1e-4
 
 
+@needs_lmp
 def test_against_contact_module(tmp_path):
-    contact_mod = pytest.importorskip("granulargas.contact")
-    if not hasattr(contact_mod, "restitution"):
-        pytest.skip("granulargas.contact.restitution not available yet")
+    """LAMMPS vs our contact module (the same comparison as the ODE above, at beta = 0.3)."""
+    from granulargas.contact import restitution
+
     for beta, end in [(0.3, "force"), (0.3, "overlap")]:
         eps = head_on_restitution(_contact(beta, end), 1.0, 1600, tmp_path / end)
-        assert abs(eps - float(contact_mod.restitution(beta, method="ode", end=end))) < 3e-5
+        assert abs(eps - float(restitution(beta, method="ode", end=end))) < 3e-5
+
+
+@needs_lmp
+@pytest.mark.parametrize("end", ["force", "overlap"])
+def test_unequal_spheres(tmp_path, end):
+    """Radii 0.3 / 0.7, masses 0.4 / 2.5: eta_n0 per type pair makes LAMMPS's eps the
+    eps(beta) of our pair prefactor, beta = k (R_eff g / m_eff^2)^{1/5} (ARCHITECTURE.md)."""
+    k = 0.4
+    contact = DemContact.from_prefactor(k, young_modulus=3e4, end=end)
+    radii, masses = (0.3, 0.7), (0.4, 2.5)
+    r_eff, m_eff = 0.21, 0.4 * 2.5 / 2.9
+    speed = 1.7
+    beta = k * (r_eff * speed / m_eff**2) ** 0.2
+    eps = head_on_restitution(contact, speed, 800, tmp_path, radii=radii, masses=masses)
+    assert abs(eps - eps_reference(beta, end)) < 1e-4
+    # with one eta_n0 for all pairs (that of two reference particles) it would be off
+    assert abs(eps_reference(beta * m_eff / 0.5, end) - eps_reference(beta, end)) > 1e-2

@@ -83,7 +83,7 @@ def test_hertz_duration_and_stiffness():
 
 
 def test_enskog_mean_free_time_dilute_limit():
-    # dilute 3D: omega -> sqrt(2) pi n sigma^2 <v>-based rate 4 sqrt(pi) n sigma^2 sqrt(T/m)
+    # dilute 3D (chi -> 1): omega = 4 sqrt(pi) n sigma^2 sqrt(T/m)
     eta = 1e-6
     n = 6 * eta / math.pi
     assert enskog_mean_free_time(3, eta) == pytest.approx(1.0 / (4 * math.sqrt(math.pi) * n), rel=1e-5)

@@ -1,0 +1,131 @@
+"""Public state, restart equality, invariants, error paths."""
+
+import numpy as np
+import pytest
+
+from granulargas.engine import CollisionRule, Simulation
+from granulargas.engine.invariants import check
+from granulargas.errors import ConfigError
+
+from engine_factories import hermite_table, make_sim, pade_eps
+
+RULES = [CollisionRule.elastic(), CollisionRule.constant(0.8, tc_time=1e-3),
+         CollisionRule.viscoelastic(0.4, hermite_table(pade_eps))]
+
+
+def _public(sim):
+    return dict(positions=sim.positions, velocities=sim.velocities, radii=sim.radii,
+                masses=sim.masses, box=sim.box, time=sim.time, collisions=sim.collisions,
+                images=sim.images, last_collision=sim.last_collision, events=sim.events,
+                dissipated_energy=sim.dissipated_energy)
+
+
+@pytest.mark.parametrize("rule", RULES, ids=["elastic", "constant-tc", "viscoelastic"])
+@pytest.mark.parametrize("d", [2, 3])
+def test_restart_equality_bit_for_bit(rule, d):
+    """run(t); synchronise; run(2t)  ==  restart from the state at t; run(2t)."""
+    a = make_sim(n=200, packing=0.35, dimension=d, seed=5, rule=rule)
+    a.run(3.0)
+    a.synchronise()
+    saved = _public(a)
+    a.run(6.0)
+    b = Simulation(**{k: saved[k] for k in ("positions", "velocities", "radii", "masses", "box")},
+                   rule=rule, **{k: saved[k] for k in ("time", "collisions", "images",
+                                                      "last_collision", "events", "dissipated_energy")})
+    b.run(6.0)
+    assert a.collisions == b.collisions > saved["collisions"]
+    assert a.events == b.events
+    for k in ("positions", "velocities", "images", "last_collision"):
+        np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
+    assert a.dissipated_energy == b.dissipated_energy
+
+
+def test_observables_do_not_disturb_the_run():
+    a = make_sim(n=150, packing=0.3, seed=6)
+    b = make_sim(n=150, packing=0.3, seed=6)
+    for t in np.linspace(0.5, 5.0, 10):
+        a.run(t)
+        a.positions, a.temperature, a.momentum, a.images, a.pressure_window()
+    b.run(5.0)
+    np.testing.assert_array_equal(a.positions, b.positions)
+    np.testing.assert_array_equal(a.velocities, b.velocities)
+
+
+def test_deterministic_for_a_seed_and_chunking():
+    a = make_sim(n=150, packing=0.3, seed=7)
+    b = make_sim(n=150, packing=0.3, seed=7)
+    calls = []
+    a.run(4.0, progress=lambda s: calls.append(s.time))
+    b.run(4.0)
+    np.testing.assert_array_equal(a.positions, b.positions)
+    assert calls and calls[-1] == 4.0
+
+
+def test_synchronised_state_in_box_and_consistent():
+    sim = make_sim(n=200, packing=0.3, seed=8)
+    sim.run(7.3)
+    pos, img = sim.positions, sim.images
+    assert np.all(pos >= 0) and np.all(pos < sim.box)
+    sim.synchronise()
+    np.testing.assert_array_equal(sim.positions, pos)
+    np.testing.assert_array_equal(sim.images, img)
+    assert sim.time == 7.3
+    assert check(sim) == []
+
+
+def test_unwrapped_displacement_matches_free_flight_between_collisions():
+    sim = make_sim(n=100, packing=0.05, seed=9)
+    u0 = sim.unwrapped_positions
+    v0 = sim.velocities
+    # the first collision time: before it everybody flies freely
+    probe = make_sim(n=100, packing=0.05, seed=9)
+    probe.run(np.inf, max_collisions=1)
+    t = 0.999 * probe.time
+    sim.run(t)
+    assert sim.collisions == 0
+    np.testing.assert_allclose(sim.unwrapped_positions, u0 + v0 * t, rtol=1e-12, atol=1e-12)
+
+
+def test_invariants_hold_during_dense_runs():
+    for d, eta in [(3, 0.45), (2, 0.7)]:
+        sim = make_sim(n=300, packing=eta, dimension=d, seed=10)
+        for t in (0.5, 1.0, 2.0):
+            sim.run(t)
+            assert check(sim) == [], (d, eta, t)
+
+
+def test_neighbour_lists_grow_when_full():
+    sim = make_sim(n=300, packing=0.45, seed=12, shell=1.0)
+    sim._nb_width = 4  # force overflow in the first build and during the run
+    sim.run(2.0)
+    assert sim._nb_width > 4
+    assert check(sim) == []
+
+
+def test_max_collisions_stops_right_after_that_collision():
+    sim = make_sim(n=100, packing=0.3, seed=13)
+    sim.run(100.0, max_collisions=250)
+    assert sim.collisions == 250 and sim.time < 100.0
+    t = sim.time
+    sim.run(t)  # nothing else happens at the same time (generic state)
+    assert sim.collisions == 250
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(box=[2.0, 2.0, 2.0]), "too small"),
+    (dict(radii=-1.0), "radii"),
+    (dict(masses=0.0), "masses"),
+])
+def test_bad_input_raises_config_error(kwargs, match):
+    base = dict(positions=np.random.default_rng(0).uniform(0, 5, (4, 3)),
+                velocities=np.zeros((4, 3)), radii=0.5, masses=1.0, box=[10.0, 10.0, 10.0])
+    base.update(kwargs)
+    with pytest.raises(ConfigError, match=match):
+        Simulation(**base, rule=CollisionRule.elastic())
+
+
+def test_run_backwards_rejected():
+    sim = make_sim(n=50, packing=0.1)
+    sim.run(1.0)
+    with pytest.raises(ValueError):
+        sim.run(0.5)
