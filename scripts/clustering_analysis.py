@@ -131,6 +131,9 @@ def figure_snapshot(snap, info, cells, k_max, path, theory_law):
         ax[4].axvline(2 * math.pi / lc, color="C3", lw=0.8, label="$2\\pi/L_c$")
         ax[4].legend(fontsize=8)
     ax[4].set(xlabel="$k\\sigma$", ylabel="$E(k)/T$")
+    from matplotlib.ticker import NullFormatter
+
+    ax[4].xaxis.set_minor_formatter(NullFormatter())
     ax[4].set_title(f"flow energy spectrum ({vcells} cells per side)", fontsize=9)
     tl = f"t = {snap.time:.4g}"
     if theory_law is not None and math.isfinite(theory_law.tau0):

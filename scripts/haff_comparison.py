@@ -19,6 +19,7 @@ predicted tau0 and exponents.
     python scripts/haff_comparison.py                # ~10 min on 2 cores
     python scripts/haff_comparison.py --quick        # smaller, to check the script
     python scripts/haff_comparison.py --reuse        # re-analyse existing runs
+    python scripts/haff_comparison.py --a2-scan      # only: HCS a2 against van Noije-Ernst, eps 0.3-0.9 (~3 min)
 """
 
 from __future__ import annotations
@@ -205,6 +206,35 @@ def figure_instability(small, large, path):
     print(f"wrote {path}")
 
 
+def a2_scan(outdir, seeds, reuse, eps_values=(0.3, 0.5, 0.7, 0.9)):
+    """HCS a2 (3D, packing 0.05, box 0.5 L_c, snapshots every 30/39 tau0 after 2 tau0)."""
+    from granulargas.analysis.run import sonine_history
+    from granulargas.io.config import parse_config
+    from granulargas.io.runner import run_config
+
+    eta = 0.05
+    n = th.number_density(eta, 3)
+    print(f"\nHCS a2, 3D, packing {eta}, L = 0.5 L_c, {len(seeds)} seeds (error assumes independent snapshots)")
+    for eps in eps_values:
+        N = int(n * (0.5 * th.instability_length(eps, n)) ** 3)
+        tau0 = th.haff_tau0(eps, n)
+        vals = []
+        for seed in seeds:
+            path = Path(outdir) / f"a2_eps{eps}_N{N}_seed{seed}.h5"
+            if not (reuse and path.exists()):
+                path.parent.mkdir(parents=True, exist_ok=True)
+                text = TEMPLATE.format(dim=3, n=N, eta=eta, seed=seed,
+                                       collision=f'model = "constant"\nrestitution = {eps}\ntc_time = 1e-4',
+                                       end=30 * tau0, dt=tau0, snapshots=1, first=1.0, file=path)
+                text = text.replace("snapshots = 1\nfirst_snapshot = 1.0", f"snapshot_interval = {30 * tau0 / 39}")
+                run_config(parse_config(text, source="a2"), overwrite=True)
+            t, a2, _ = sonine_history(path)
+            vals.append(a2[t > 2 * tau0])
+        v = np.concatenate(vals)
+        print(f"  eps {eps}: N = {N}, a2 = {v.mean():+.4f} +- {v.std(ddof=1) / math.sqrt(v.size):.4f}"
+              f" ({v.size} snapshots)   van Noije-Ernst {th.sonine_a2(eps, 3):+.4f}", flush=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=4)
@@ -212,7 +242,11 @@ def main(argv=None):
     ap.add_argument("--figdir", default="docs/figures")
     ap.add_argument("--reuse", action="store_true", help="analyse existing run files instead of re-running")
     ap.add_argument("--quick", action="store_true", help="small, short runs (checks the script, not the physics)")
+    ap.add_argument("--a2-scan", action="store_true", help="only the HCS a2 scan over eps (20 seeds)")
     args = ap.parse_args(argv)
+    if args.a2_scan:
+        a2_scan(args.outdir, list(range(1, (3 if args.quick else 20) + 1)), args.reuse)
+        return 0
 
     q = args.quick
     seeds = list(range(1, (2 if q else args.seeds) + 1))

@@ -248,7 +248,7 @@ class Simulation:
 
     def _grow_lists(self):
         s = self._s
-        n = s["r"].shape[0]
+        n = self.n
         new = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
         if new <= self._nb_width:
             raise SimulationError("neighbour list cannot grow further (internal error)")

@@ -4,7 +4,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy import special, stats
 
 from granulargas.analysis import cooling as ac
 from granulargas import theory as th
