@@ -35,10 +35,8 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import json
 import os
 import sys
-import tempfile
 import time
 import tomllib
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
@@ -46,8 +44,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from granulargas.errors import ConfigError, InputFileError
+from granulargas.io.sweep_index import INDEX_NAME, read_index, write_index
 
-INDEX_NAME = "index.json"
 _TOP_KEYS = {"base", "output_dir", "mode", "set", "vary", "name"}
 
 
@@ -190,26 +188,11 @@ def run_one(base: str, overrides: dict) -> dict:
         return {"status": "failed", "error": f"{type(exc).__name__}: {exc}", "wall_time": time.perf_counter() - start}
 
 
-def read_index(path: str | os.PathLike) -> dict:
-    """The sweep index: ``{"sweep": ..., "base": ..., "runs": [entry, ...]}``."""
-    path = Path(path)
-    if path.is_dir():
-        path = path / INDEX_NAME
-    with open(path) as fh:
-        return json.load(fh)
-
-
 def _write_index(sweep: Sweep, entries: dict) -> None:
-    sweep.output_dir.mkdir(parents=True, exist_ok=True)
-    payload = {
-        "sweep": str(sweep.path.resolve()),
-        "base": str(sweep.base),
-        "runs": [entries[r.name] for r in sweep.runs],
-    }
-    fd, tmp = tempfile.mkstemp(dir=sweep.output_dir, prefix=".index.", suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(payload, fh, indent=1)
-    os.replace(tmp, sweep.index_path)
+    write_index(
+        sweep.output_dir,
+        {"sweep": str(sweep.path.resolve()), "base": str(sweep.base), "runs": [entries[r.name] for r in sweep.runs]},
+    )
 
 
 def _file_is_readable(file: str) -> bool:

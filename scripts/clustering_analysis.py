@@ -133,6 +133,7 @@ def figure_snapshot(snap, info, cells, k_max, path, theory_law):
     ax[4].set(xlabel="$k\\sigma$", ylabel="$E(k)/T$")
     from matplotlib.ticker import NullFormatter
 
+    ax[3].xaxis.set_minor_formatter(NullFormatter())
     ax[4].xaxis.set_minor_formatter(NullFormatter())
     ax[4].set_title(f"flow energy spectrum ({vcells} cells per side)", fontsize=9)
     tl = f"t = {snap.time:.4g}"
@@ -194,6 +195,7 @@ def main(argv=None):
     ap.add_argument("--cell", type=float, default=None, help="coarse-graining cell size (default ~ 2 mean free paths, >= 4 sigma)")
     ap.add_argument("--kmax", type=float, default=None, help="largest k for S(k) (default 2 pi * 48 / L, at most 2 pi)")
     ap.add_argument("--factor", type=float, default=1.1, help="cluster bond: distance < factor * contact distance")
+    ap.add_argument("--no-series", action="store_true", help="only the per-snapshot figures")
     args = ap.parse_args(argv)
 
     info = RunInfo.from_file(args.file)
@@ -209,6 +211,8 @@ def main(argv=None):
           f"{info.model}; L_c(T0) = {pred.instability_length:.4g}; {nframes} snapshots; grid {cells}^{info.dimension}")
 
     rows = []
+    if args.no_series:
+        args.every = 10**9  # only frame 0 below; the series figure is skipped
     print(f"{'t':>10} {'t/tau0':>8} {'T':>10} {'S_max':>8} {'k(S_max)':>8} {'S(kmin)':>8} {'largest':>8} "
           f"{'clusters':>8} {'flowKE/T':>9} {'L/L_c':>7}")
     for _, r in snapshot_series(args.file, lambda s: frame_measures(s, info, cells, k_max, args.factor), args.every):
@@ -216,7 +220,8 @@ def main(argv=None):
         x = r["time"] / pred.tau0 if math.isfinite(pred.tau0) else math.nan
         print(f"{r['time']:10.4g} {x:8.3g} {r['T']:10.4g} {r['S_max']:8.3g} {r['k_at_max']:8.3g} {r['S_kmin']:8.3g} "
               f"{r['largest']:8.3f} {r['clusters']:8d} {r['flow_ke_over_T']:9.3g} {r['L_over_Lc']:7.3g}", flush=True)
-    figure_series(rows, info, hist, pred, f"{prefix}_series.png")
+    if not args.no_series:
+        figure_series(rows, info, hist, pred, f"{prefix}_series.png")
 
     frames = args.frames
     if frames is None:

@@ -21,7 +21,7 @@ import numpy as np
 
 from granulargas.analysis.cooling import fit_cooling_law
 from granulargas.io.h5md import read_observables
-from granulargas.sweep import read_index
+from granulargas.io.sweep_index import read_index
 
 SEED_KEY = "system.seed"
 

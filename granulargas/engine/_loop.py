@@ -105,7 +105,7 @@ def predict_all(t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shel
 
 @jit
 def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
-            nbl, nbn, scratch, cell_head, cell_next, cell_prev, cell_of, heap_t, heap_id, hpos,
+            nbl, nbn, scratch, cell_head, cell_next, cell_prev, cell_of, heap, hpos,
             box, ncell, kind, fpar, coeffs, collapse_count, until, max_events, max_collisions,
             scal, iscal):
     """Process events in time order until ``until`` (or a budget); see module doc.
@@ -130,8 +130,8 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         if iscal[I_EVENTS] >= events_end:
             status = BUDGET
             break
-        te = heap_t[0]
-        i = heap_id[0]
+        te = heap[0, 0]
+        i = int(heap[0, 1])
         if te > until or te == math.inf:
             break
         if te <= time:
@@ -213,11 +213,11 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
                 lastcoll[j] = te
                 tj = predict(j, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                              half_shell)
-                heap_update(heap_t, heap_id, hpos, j, tj)
+                heap_update(heap, hpos, j, tj)
                 if rapid[i] >= collapse_count or rapid[j] >= collapse_count:
                     ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                                  half_shell)
-                    heap_update(heap_t, heap_id, hpos, i, ti)
+                    heap_update(heap, hpos, i, ti)
                     iscal[I_EVENTS] += 1
                     iscal[I_ERR_I] = i
                     iscal[I_ERR_J] = j
@@ -238,7 +238,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             stream(i, te, rec, img, box)
             iscal[I_STALE] += 1
         ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
-        heap_update(heap_t, heap_id, hpos, i, ti)
+        heap_update(heap, hpos, i, ti)
         iscal[I_EVENTS] += 1
         if iscal[I_COLLISIONS] >= max_collisions:
             status = MAX_COLLISIONS

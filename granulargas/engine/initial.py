@@ -158,9 +158,14 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         trial = min(1.0, lam * (1.0 + grow))
         rad = radii * trial
         idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
-        for _ in range(500):
+        for it in range(600):
             if len(idx) == 0:
                 break
+            if it % 100 == 99:  # jammed spots: let the hard-sphere surroundings make room
+                disp[:, :d] = rng.uniform(-1.0, 1.0, size=(n, d))
+                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, disp)
+                idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
+                continue
             kick = rng.uniform(0.5, 1.5, size=len(idx))
             m = mc.push_some(idx, r3, rad, box3, ncell, head, nxt, prv, cof, kick, buf)
             idx = np.unique(buf[:m])
@@ -169,6 +174,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
             grow *= 0.5
             continue
+        grow = min(0.05, grow * 1.5)
         lam = trial
         rad = radii * lam
         do_sweep(rad)

@@ -27,7 +27,7 @@ def check(sim, overlap_tol: float = 1e-9) -> list[str]:
     box = sim._box3
     t = float(s["scal"][0])
     problems = []
-    if not heap_check(s["heap_t"], s["heap_id"], s["hpos"]):
+    if not heap_check(s["heap"], s["hpos"]):
         problems.append("heap order or index broken")
     rec = s["rec"]
     r = rec[:, :3] + rec[:, 3:6] * (t - rec[:, 6])[:, None]

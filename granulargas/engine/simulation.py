@@ -20,7 +20,7 @@ import numpy as np
 
 from granulargas.engine import _loop
 from granulargas.engine._cells import OVERFLOW, build_all_lists
-from granulargas.engine._queue import heap_build
+from granulargas.engine._queue import allocate_heap, heap_build
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import (
     ConfigError,
@@ -39,10 +39,10 @@ def default_shell(packing: float) -> float:
     with density (tuned with ``scripts/bench_engine.py``).
     """
     if packing < 0.15:
-        return 0.6
-    if packing < 0.35:
-        return 0.4
-    return 0.25
+        return 1.2
+    if packing < 0.4:
+        return 0.7
+    return 0.45
 
 
 def _part1by2(x):
@@ -231,17 +231,22 @@ class Simulation:
             if st != OVERFLOW:
                 break
             self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
+        # compact the lists to what this state needs (+ a margin; they grow on demand)
+        width = min(n - 1, int(s["nbn"].max()) + 6)
+        if width < self._nb_width:
+            s["nbl"] = np.ascontiguousarray(s["nbl"][:, :width])
+            self._nb_width = width
         s["scratch"] = np.empty(self._nb_width, dtype=np.int32)
         times = np.empty(n)
         _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
                           s["partner"], s["pcount"], self._box3, 0.5 * self.shell * (1.0 - 1e-9),
                           times)
-        s["heap_t"] = np.empty(n)
-        s["heap_id"] = np.empty(n, dtype=np.int32)
+        s["heap"] = allocate_heap(n)
         s["hpos"] = np.empty(n, dtype=np.int32)
-        heap_build(s["heap_t"], s["heap_id"], s["hpos"], times)
-        s["scal"] = np.array([self._time, self._dissipated, self._virial, self._kin_int,
-                              float(np.sum(self._masses[:, None] * self._velocities**2))])
+        heap_build(s["heap"], s["hpos"], times)
+        with np.errstate(over="ignore", under="ignore"):
+            mv2 = float(np.sum(self._masses[:, None] * self._velocities**2))
+        s["scal"] = np.array([self._time, self._dissipated, self._virial, self._kin_int, mv2])
         s["iscal"] = np.array([self._collisions, self._events, -1, -1, 0, 0], dtype=np.int64)
         self._s = s
         self._built = True
@@ -249,7 +254,7 @@ class Simulation:
     def _grow_lists(self):
         s = self._s
         n = self.n
-        new = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
+        new = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.2)))
         if new <= self._nb_width:
             raise SimulationError("neighbour list cannot grow further (internal error)")
         nbl = np.empty((n, new), dtype=np.int32)
@@ -287,6 +292,11 @@ class Simulation:
         s = self._s
         start_time, start_coll = self.time, self.collisions
         target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
+        vmax = float(np.max(np.abs(s["rec"][:, 3:6])))
+        if not (vmax < 1e150) or (0.0 < vmax < 1e-150):
+            raise SimulationError(f"velocities out of range at t = {self.time:.12g} (max |v_a| = "
+                                  f"{vmax:.3g}): squared speeds must stay within float64; rescale "
+                                  f"the units")
         kind, eps, tc, pref, inv_h, coeffs = self.rule.kernel_arguments()
         v2 = s["scal"][4] / float(np.sum(s["mass"]))
         scale = 2.0 * float(self._radii.min()) / math.sqrt(v2) if v2 > 0 else 1.0
@@ -296,8 +306,8 @@ class Simulation:
             status = _loop.advance(
                 s["rec"], s["img"], s["centre"], s["mass"], s["count"],
                 s["partner"], s["pcount"], s["lastcoll"], s["rapid"], s["nbl"], s["nbn"], s["scratch"],
-                s["cell_head"], s["cell_next"], s["cell_prev"], s["cell_of"], s["heap_t"],
-                s["heap_id"], s["hpos"], self._box3, self._ncell, kind, fpar, coeffs,
+                s["cell_head"], s["cell_next"], s["cell_prev"], s["cell_of"], s["heap"],
+                s["hpos"], self._box3, self._ncell, kind, fpar, coeffs,
                 self.collapse_count, until, chunk, target, s["scal"], s["iscal"])
             if status == _loop.BUDGET:
                 if progress is not None:

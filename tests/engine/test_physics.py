@@ -63,14 +63,17 @@ def test_pressure_and_collision_frequency_vs_theory(d, eta, n):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("d, eta", [(3, 0.1), (3, 0.3), (3, 0.45), (2, 0.3), (2, 0.6)])
-def test_equation_of_state_precise(d, eta):
+@pytest.mark.parametrize("d, eta, tol", [
+    (3, 0.1, 0.006), (3, 0.3, 0.006), (3, 0.45, 0.006),  # Carnahan-Starling ~0.3 % + statistics
+    (2, 0.3, 0.012), (2, 0.5, 0.012),                    # Henderson well below 1 % here
+    (2, 0.6, 0.025),                                     # Henderson 1-2 % off at 0.6
+])
+def test_equation_of_state_precise(d, eta, tol):
     sim = make_sim(n=4000, packing=eta, dimension=d, seed=22)
     sim.run(10.0)
     sim.pressure_window()
     sim.run(210.0)
     z = sim.pressure_window() * np.prod(sim.box) / (sim.n * sim.temperature)
-    tol = 0.006 if d == 3 else 0.012  # CS ~0.3 %, Henderson ~1 % + statistics
     assert z == pytest.approx(z_theory(eta, d), rel=tol)
     assert sim.collision_rate == pytest.approx(enskog_frequency(eta, d, sim.temperature), rel=tol)
 

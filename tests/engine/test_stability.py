@@ -49,26 +49,55 @@ def test_power_of_two_velocity_rescaling_is_exact(dimension, k):
     assert sc.temperature == ref.temperature * scale**2
 
 
-def test_cooling_through_many_decades_keeps_haff_rate_per_collision():
-    # constant eps in a small dilute box (below the instability length): per
-    # collision per particle ln T drops by (1 - eps^2)(1 + 3 a2/16)/d, at any T
-    eps, n = 0.5, 300
-    st = random_state(n=n, packing=0.05, dimension=3, temperature=1.0, seed=5)
-    box = float(st.box[0])
-    assert box < theory.instability_length(eps, theory.number_density(0.05, 3), 3)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps))
-    lnT, s = [], []
-    while not lnT or lnT[-1] > math.log(1e-150):
+def _cool(sim, n, stop_lnT, remove_drift):
+    """Run chunks of 10 n collisions until ln T < stop_lnT; optionally restart each chunk
+    in the centre-of-mass frame (a Galilean shift, through the public API)."""
+    lnT, s, events = [], [], []
+    while not lnT or lnT[-1] > stop_lnT:
+        e0, c0 = sim.events, sim.collisions
         sim.run(until=math.inf, max_collisions=10 * n)
         lnT.append(math.log(sim.temperature))
         s.append(2.0 * sim.collisions / n)
-    lnT, s = np.array(lnT), np.array(s)
+        events.append((sim.events - e0) / (sim.collisions - c0))
+        if remove_drift:
+            sim.synchronise()
+            v = sim.velocities
+            v -= (sim.masses[:, None] * v).sum(axis=0) / sim.masses.sum()
+            sim = Simulation(sim.positions, v, sim.radii, sim.masses, sim.box, sim.rule, time=sim.time,
+                             collisions=sim.collisions, images=sim.images, events=sim.events)
+    return sim, np.array(lnT), np.array(s), np.array(events)
+
+
+def cooling_state(n=300):
+    return random_state(n=n, packing=0.05, dimension=3, temperature=1.0, seed=5)
+
+
+def test_cooling_through_150_decades_keeps_haff_rate_per_collision():
+    # constant eps in a small dilute box (below the instability length): per
+    # collision per particle ln T drops by (1 - eps^2)(1 + 3 a2/16)/d, at any T
+    eps, n = 0.5, 300
+    st = cooling_state(n)
+    assert float(st.box[0]) < theory.instability_length(eps, theory.number_density(0.05, 3), 3)
+    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps))
+    sim, lnT, s, events = _cool(sim, n, math.log(1e-150), remove_drift=True)
     slope_theory = -(1 - eps**2) * (1 + 3 * theory.sonine_a2(eps, 3) / 16) / 3
     early = np.polyfit(s[s < 0.3 * s[-1]], lnT[s < 0.3 * s[-1]], 1)[0]
     late = np.polyfit(s[s > 0.7 * s[-1]], lnT[s > 0.7 * s[-1]], 1)[0]
     assert early == pytest.approx(slope_theory, rel=0.05)
     assert late == pytest.approx(early, rel=0.05)  # nothing changes over 150 decades
+    assert np.max(events) < 3 * np.median(events)  # the cost per collision stays flat
     assert np.isfinite(sim.positions).all()
+
+
+@pytest.mark.xfail(reason="engine gap (reported): the centre-of-mass velocity left by round-off "
+                          "(~1e-16 of the initial thermal speed) overtakes the thermal speed below "
+                          "T/T0 ~ 1e-32; the drift then costs ever more neighbour-list events per "
+                          "collision (x500 by T/T0 = 1e-40)", strict=False)
+def test_cooling_below_round_off_of_the_momentum_keeps_the_cost_per_collision():
+    n = 300
+    sim = Simulation(**cooling_state(n).as_kwargs(), rule=CollisionRule.constant(0.5))
+    _, lnT, _, events = _cool(sim, n, math.log(1e-38), remove_drift=False)
+    assert np.max(events) < 3 * np.median(events)
 
 
 @pytest.mark.xfail(reason="engine gap (reported): squared velocities below the float64 range are not "

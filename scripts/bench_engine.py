@@ -1,0 +1,179 @@
+"""Benchmark of the event-driven engine: collisions per second, JIT time, memory.
+
+Each case runs in its own process (clean peak memory): random initial state,
+warm-up (1 collision per particle), then ``--repeats`` timed runs of about
+``max(2e5, N)`` collisions each; the median rate is printed, with the wall-clock
+rate and the CPU-time rate of the process (the CPU rate is less sensitive to a
+loaded machine). Memory: bytes per particle of the engine's internal state
+(``sum of array sizes / N``) and the growth of the process's peak RSS during
+the case divided by N (includes the initial-state construction).
+
+JIT: the first compile is measured in a fresh process with the numba cache
+disabled (``GRANULARGAS_NO_CACHE=1``); the cached load in a fresh process with
+the cache on (import plus a first tiny run).
+
+Usage::
+
+    python scripts/bench_engine.py            # full table (N = 1e4, 1e5, 1e6; 3D eta 0.1/0.3/0.5, 2D, viscoelastic)
+    python scripts/bench_engine.py --quick    # N = 1e4, 1e5 at eta = 0.3 only, fewer repeats
+    python scripts/bench_engine.py --sizes 1e5 --packings 0.3 --dims 3 --rules elastic
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _peak_rss_bytes():
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def run_case(n, packing, dim, rule_name, repeats, seed=1):
+    """One benchmark case in this process; returns a dict."""
+    import numpy as np
+
+    from granulargas.engine import CollisionRule, Simulation
+    from granulargas.engine.initial import random_state
+
+    # compile (from cache) before measuring memory
+    warm = random_state(64, 0.2, dim, seed=0)
+    Simulation(**warm.as_kwargs(), rule=CollisionRule.elastic()).run(0.1)
+    rss0 = _peak_rss_bytes()
+    t0 = time.perf_counter()
+    st = random_state(n, packing, dim, seed=seed)
+    t_init = time.perf_counter() - t0
+    if rule_name == "elastic":
+        rule = CollisionRule.elastic()
+    elif rule_name == "viscoelastic":
+        from granulargas.contact import prefactor_from_damping, restitution_table
+
+        k = prefactor_from_damping(0.1)
+        # largest impact speed: twice the fastest particle (with margin); reference pair
+        gmax = 2.5 * float(np.max(np.linalg.norm(st.velocities, axis=1)))
+        beta_max = min(40.0, 1.5 * k * (0.25 * gmax / 0.25) ** 0.2 + 0.1)
+        rule = CollisionRule.viscoelastic(prefactor=k, table=restitution_table(beta_max))
+    else:
+        rule = CollisionRule.constant(float(rule_name))
+    sim = Simulation(**st.as_kwargs(), rule=rule)
+    t0 = time.perf_counter()
+    sim.run(np.inf, max_collisions=n // 2)  # build + warm-up: 1 collision per particle
+    t_build = time.perf_counter() - t0
+    per_run = max(200_000, n)
+    wall, cpu = [], []
+    for _ in range(repeats):
+        c0 = sim.collisions
+        w0, p0 = time.perf_counter(), time.process_time()
+        sim.run(np.inf, max_collisions=per_run)
+        w1, p1 = time.perf_counter(), time.process_time()
+        wall.append((sim.collisions - c0) / (w1 - w0))
+        cpu.append((sim.collisions - c0) / (p1 - p0))
+    state_bytes = sum(a.nbytes for a in sim._s.values() if hasattr(a, "nbytes"))
+    iscal = sim._s["iscal"]
+    return dict(
+        n=n, packing=packing, dim=dim, rule=rule_name,
+        rate_wall=statistics.median(wall), rate_cpu=statistics.median(cpu),
+        rate_wall_all=wall,
+        bytes_per_particle=state_bytes / n,
+        peak_rss_per_particle=(_peak_rss_bytes() - rss0) / n,
+        events_per_collision=sim.events / max(1, sim.collisions),
+        expiries_per_collision=float(iscal[4]) / max(1, sim.collisions),
+        stale_per_collision=float(iscal[5]) / max(1, sim.collisions),
+        init_seconds=t_init, build_seconds=t_build, list_width=sim._nb_width,
+    )
+
+
+def jit_times():
+    """(first compile s, cached load s), each in a fresh process."""
+    code = ("import time; t=time.perf_counter(); "
+            "from granulargas.engine import Simulation, CollisionRule; "
+            "from granulargas.engine.initial import random_state; "
+            "st=random_state(64, 0.2, 3, seed=0); "
+            "Simulation(**st.as_kwargs(), rule=CollisionRule.elastic()).run(0.5); "
+            "print(time.perf_counter()-t)")
+    env = dict(os.environ, GRANULARGAS_NO_CACHE="1")
+    first = float(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                                 text=True, check=True).stdout.strip())
+    subprocess.run([sys.executable, "-c", code], capture_output=True, check=True)  # fill cache
+    cached = [float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                   check=True).stdout.strip()) for _ in range(3)]
+    return first, statistics.median(cached)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--quick", action="store_true", help="N = 1e4, 1e5 at packing 0.3 (3D elastic, "
+                   "2D, viscoelastic), 3 repeats")
+    p.add_argument("--sizes", type=float, nargs="+", default=None)
+    p.add_argument("--packings", type=float, nargs="+", default=None)
+    p.add_argument("--dims", type=int, nargs="+", default=None)
+    p.add_argument("--rules", nargs="+", default=None, help="elastic, viscoelastic or a constant eps")
+    p.add_argument("--repeats", type=int, default=None)
+    p.add_argument("--no-jit", action="store_true", help="skip the JIT timing")
+    p.add_argument("--json", default=None, help="also write the results to this JSON file")
+    p.add_argument("--case", nargs=4, default=None, help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+
+    if args.case:
+        n, eta, dim, rule = args.case
+        print(json.dumps(run_case(int(float(n)), float(eta), int(dim), rule, args.repeats or 5)))
+        return 0
+
+    if args.quick:
+        sizes, packings = [1e4, 1e5], [0.3]
+        repeats = args.repeats or 3
+    else:
+        sizes, packings = [1e4, 1e5, 1e6], [0.1, 0.3, 0.5]
+        repeats = args.repeats or 5
+    sizes = args.sizes or sizes
+    packings = args.packings or packings
+    cases = []
+    for n in sizes:
+        for dim in (args.dims or [3]):
+            for eta in packings:
+                for rule in (args.rules or ["elastic"]):
+                    cases.append((n, eta if dim == 3 else min(0.7, eta * 5 / 3), dim, rule))
+    if args.dims is None and args.rules is None:  # the standard extras: 2D and viscoelastic
+        for n in sizes:
+            cases.append((n, 0.5, 2, "elastic"))
+            cases.append((n, 0.3, 3, "viscoelastic"))
+
+    print(f"# granulargas engine benchmark, {time.strftime('%Y-%m-%d %H:%M')}, "
+          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f} at start")
+    if not args.no_jit:
+        first, cached = jit_times()
+        print(f"# JIT: first compile + tiny run {first:.1f} s (no cache); cached load + tiny run {cached:.2f} s")
+    print("# rate = median pair collisions per second over repeats (wall clock; CPU time of the process)")
+    header = (f"{'N':>9} {'d':>2} {'eta':>5} {'rule':>12} {'Mcoll/s wall':>13} {'Mcoll/s cpu':>12} "
+              f"{'B/particle':>10} {'peakRSS B/p':>11} {'ev/coll':>8} {'init s':>7}")
+    print(header)
+    results = []
+    for n, eta, dim, rule in cases:
+        out = subprocess.run([sys.executable, os.path.abspath(__file__), "--case", str(int(n)), str(eta),
+                              str(dim), rule, "--repeats", str(repeats)],
+                             capture_output=True, text=True)
+        if out.returncode != 0:
+            print(f"{int(n):>9} {dim:>2} {eta:>5} {rule:>12}  FAILED: {out.stderr.strip().splitlines()[-1]}")
+            continue
+        r = json.loads(out.stdout.strip().splitlines()[-1])
+        results.append(r)
+        print(f"{r['n']:>9} {r['dim']:>2} {r['packing']:>5} {r['rule']:>12} {r['rate_wall'] / 1e6:>13.3f} "
+              f"{r['rate_cpu'] / 1e6:>12.3f} {r['bytes_per_particle']:>10.0f} "
+              f"{r['peak_rss_per_particle']:>11.0f} {r['events_per_collision']:>8.2f} "
+              f"{r['init_seconds']:>7.1f}", flush=True)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(results, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
