@@ -42,13 +42,13 @@ from granulargas.errors import InelasticCollapseError
 
 
 def record(sim, t_end, dt, budget):
-    """Run in steps of dt to t_end (or until the collision budget); (t, C, T, rate), error or None."""
+    """Run in steps of max(dt, 5 % of t) to t_end (or the collision budget); (t, C, T, rate), error or None."""
     rows = [(sim.time, sim.collisions, sim.temperature, math.nan)]
     err = None
     wall0 = time.perf_counter()
     while sim.time < t_end and sim.collisions < budget:
         try:
-            sim.run(until=min(sim.time + dt, t_end), max_collisions=budget - sim.collisions)
+            sim.run(until=min(sim.time + max(dt, 0.05 * sim.time), t_end), max_collisions=budget - sim.collisions)
         except InelasticCollapseError as exc:
             err = exc
             break
@@ -67,7 +67,7 @@ def main(argv=None):
     n, eta, eps = args.particles, args.packing, args.restitution
     budget = 6_000_000
     if args.quick:
-        n, budget = 500, 1_000_000
+        n, budget = 1000, 1_000_000
     wall0 = time.perf_counter()
     st = random_state(n=n, packing=eta, dimension=2, temperature=1.0, seed=1)
     dens = theory.number_density(eta, 2)

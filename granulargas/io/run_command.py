@@ -44,8 +44,10 @@ def _terminate(signum, frame):
 
 
 def run(args) -> int:
+    from granulargas.advise import summary_line
     from granulargas.io.config import load_config
     from granulargas.io.runner import run_config
+    from granulargas.validity import raise_if_invalid
 
     overrides = dict(parse_override(t) for t in args.overrides)
     if args.restart:
@@ -53,6 +55,7 @@ def run(args) -> int:
     if args.output:
         overrides["output.file"] = args.output
     config = load_config(args.config, overrides)
+    validity = raise_if_invalid(config)  # refuses runs that would leave float64; predicts T range, t_c/t_free
     try:  # SIGTERM closes the file like Ctrl-C (SIGKILL cannot be caught; frames are flushed anyway)
         previous = signal.signal(signal.SIGTERM, _terminate)
     except ValueError:
@@ -62,5 +65,6 @@ def run(args) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
-    print("\n".join(summary.lines()))
+    advice = summary_line(config)
+    print("\n".join(summary.lines() + validity.lines() + ([advice] if advice else [])))
     return 0

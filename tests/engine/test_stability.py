@@ -89,6 +89,7 @@ def test_cooling_through_150_decades_keeps_haff_rate_per_collision():
     assert np.isfinite(sim.positions).all()
 
 
+@pytest.mark.slow
 @pytest.mark.xfail(reason="engine gap (reported): the centre-of-mass velocity left by round-off "
                           "(~1e-16 of the initial thermal speed) overtakes the thermal speed below "
                           "T/T0 ~ 1e-32; the drift then costs ever more neighbour-list events per "
@@ -100,8 +101,6 @@ def test_cooling_below_round_off_of_the_momentum_keeps_the_cost_per_collision():
     assert np.max(events) < 3 * np.median(events)
 
 
-@pytest.mark.xfail(reason="engine gap (reported): squared velocities below the float64 range are not "
-                          "detected; the run continues with wrong collision times", strict=False)
 def test_velocity_underflow_is_a_clear_error():
     st = state()
     sim = sim_from(st, CollisionRule.elastic(), 1e-170)  # v^2 ~ 1e-340 underflows to 0

@@ -173,3 +173,12 @@ def test_bad_set_override_in_process(tmp_path, capsys):
     assert main(["run", str(cfg), "--set", "nonsense"]) == 2
     assert "expected section.key=value" in capsys.readouterr().err
     assert not (tmp_path / "o.h5").exists()
+
+
+def test_summary_reports_validity_and_advice(case):
+    """Issue 7: the run summary says whether a constant eps would do and reports the model range."""
+    visco = GOOD.replace('model = "constant"\nrestitution = 0.9', 'model = "viscoelastic"\ndamping = 0.1')
+    rc, out, err, _, _ = case(visco, "--overwrite")
+    assert rc == 0, err
+    assert "advice" in out and "best constant eps" in out
+    assert "t_c/t_free" in out
