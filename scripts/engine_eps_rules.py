@@ -30,6 +30,7 @@ Writes ``docs/figures/choice_eps_rule.png``. Timings on a shared machine.
 
 from __future__ import annotations
 
+from dataclasses import replace
 import argparse
 import math
 import time
@@ -272,7 +273,6 @@ def main(argv=None):
     for end in ("overlap", "force"):
         T_ref[end], _ = engine_runs(n, b, ref[end], seeds, t_end, times)
         cost_ref[end] = time_engine(ref[end], b, **timing)
-        from dataclasses import replace
         pred_ref[end] = V.viscoelastic_cooling(replace(gas, end=end), restitution=tabulated(ref[end]))
     rows = []
     for label, family, end, table, key in cands:
@@ -285,7 +285,6 @@ def main(argv=None):
         mean = ratio.mean(axis=0) - 1
         sem = ratio.std(axis=0, ddof=1) / math.sqrt(seeds)
         k = int(np.argmax(np.abs(mean)))
-        from dataclasses import replace
         curve = V.viscoelastic_cooling(replace(gas, end=end), restitution=tabulated(table))
         pred = float(np.max(np.abs(curve.temperature_at(times) / pred_ref[end].temperature_at(times) - 1)))
         c_iso, c_diff = iso(key)

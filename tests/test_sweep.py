@@ -1,7 +1,6 @@
 """Sweeps: expansion, local pool, Dask, skipping finished runs, failures."""
 
 import json
-import textwrap
 from concurrent.futures import ThreadPoolExecutor
 
 import h5py
