@@ -14,6 +14,17 @@ current time only when it takes part in an event. The data a prediction reads
 for a neighbour sit in one 64-byte record per particle,
 ``rec[i] = (x, y, z, vx, vy, vz, t_i, R_i)``, so that one cache line serves it.
 
+Prefetching: events hit particles in random memory order, so at N >~ 10^5 an
+event waits mostly on cache misses (the particle's record and list row, then
+one record per neighbour). After each event the loop issues prefetch hints
+(:mod:`granulargas.engine._prefetch`, no effect on results) for the records of
+the next event's partner and neighbours, and for the record and list row of
+the earliest child of the heap root (the likely event after that), so these
+misses overlap with the current work. Measured (3D elastic, packing 0.3,
+interleaved with the plain loop on a shared 2-core machine): N = 10^5, median
++15 % collisions per second over 10 pairs (faster in 9); N = 10^6, +18 % (one
+pair); N = 10^4 neutral.
+
 Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 0 reached ``until``; 1 event budget of this chunk used (call again);
 2 ``max_collisions`` reached; 10 a neighbour list is full (enlarge, call
@@ -29,6 +40,7 @@ from granulargas._numba import jit
 from granulargas.engine._cells import OVERFLOW, rebuild_list
 from granulargas.engine._collide import restitution
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image
+from granulargas.engine._prefetch import prefetch
 from granulargas.engine._queue import heap_update
 
 DONE = 0
@@ -240,6 +252,28 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
         heap_update(heap, hpos, i, ti)
         iscal[I_EVENTS] += 1
+        # ---- prefetch hints (no effect on results): the next event's partner and
+        # neighbour records, and the rows of the likely event after it (the earliest
+        # child of the root), so that their cache misses overlap with work
+        i1 = int(heap[0, 1])
+        p1 = partner[i1]
+        if p1 >= 0:
+            prefetch(rec, p1)
+        for k in range(nbn[i1]):
+            prefetch(rec, nbl[i1, k])
+        if heap.shape[0] > 4:
+            c2 = 1
+            t2 = heap[1, 0]
+            for q in range(2, 5):
+                if heap[q, 0] < t2:
+                    t2 = heap[q, 0]
+                    c2 = q
+            i2 = int(heap[c2, 1])
+            prefetch(rec, i2)
+            prefetch(nbl, i2)
+            prefetch(nbn, i2)
+            prefetch(partner, i2)
+            prefetch(centre, i2)
         if iscal[I_COLLISIONS] >= max_collisions:
             status = MAX_COLLISIONS
             break
