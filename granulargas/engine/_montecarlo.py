@@ -72,62 +72,6 @@ def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step,
 
 
 @jit
-def min_pair_gap(r, radius, box, ncell, cell_head, cell_next):
-    """min over pairs in neighbouring cells of |r_ij| - (R_i + R_j) (debug check)."""
-    best = 1e300
-    zr = 1 if ncell[2] >= 3 else 0
-    for i in range(r.shape[0]):
-        cx = cell_coord(r[i, 0], box[0], ncell[0])
-        cy = cell_coord(r[i, 1], box[1], ncell[1])
-        cz = cell_coord(r[i, 2], box[2], ncell[2])
-        for oz in range(-zr, zr + 1):
-            kz = (cz + oz) % ncell[2]
-            for oy in range(-1, 2):
-                ky = (cy + oy) % ncell[1]
-                for ox in range(-1, 2):
-                    kx = (cx + ox) % ncell[0]
-                    j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                    while j >= 0:
-                        if j > i:
-                            dx = min_image(r[i, 0] - r[j, 0], box[0])
-                            dy = min_image(r[i, 1] - r[j, 1], box[1])
-                            dz = min_image(r[i, 2] - r[j, 2], box[2])
-                            g = (dx * dx + dy * dy + dz * dz) ** 0.5 - radius[i] - radius[j]
-                            if g < best:
-                                best = g
-                        j = cell_next[j]
-    return best
-
-
-@jit
-def min_pair_ratio(r, radius, box, ncell, cell_head, cell_next):
-    """min over neighbouring-cell pairs of |r_ij| / (R_i + R_j) (capped at 1e300)."""
-    best = 1e300
-    zr = 1 if ncell[2] >= 3 else 0
-    for i in range(r.shape[0]):
-        cx = cell_coord(r[i, 0], box[0], ncell[0])
-        cy = cell_coord(r[i, 1], box[1], ncell[1])
-        cz = cell_coord(r[i, 2], box[2], ncell[2])
-        for oz in range(-zr, zr + 1):
-            kz = (cz + oz) % ncell[2]
-            for oy in range(-1, 2):
-                ky = (cy + oy) % ncell[1]
-                for ox in range(-1, 2):
-                    kx = (cx + ox) % ncell[0]
-                    j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                    while j >= 0:
-                        if j != i:
-                            dx = min_image(r[i, 0] - r[j, 0], box[0])
-                            dy = min_image(r[i, 1] - r[j, 1], box[1])
-                            dz = min_image(r[i, 2] - r[j, 2], box[2])
-                            g = (dx * dx + dy * dy + dz * dz) ** 0.5 / (radius[i] + radius[j])
-                            if g < best:
-                                best = g
-                        j = cell_next[j]
-    return best
-
-
-@jit
 def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     """Sum over j != i of max(0, R_i + R_j - |r_ij|) for particle i placed at (x, y, z)."""
     cx = cell_coord(x, box[0], ncell[0])
