@@ -41,6 +41,26 @@ def cell_index(x, y, z, box, ncell):
 
 
 @jit(inline="always")
+def stencil_size(ncell):
+    """Cells around a point: 27 in 3D, 9 with a single layer in z (2D)."""
+    return 27 if ncell[2] >= 3 else 9
+
+
+@jit(inline="always")
+def stencil_cell(cx, cy, cz, k, ncell):
+    """Flat index of the k-th cell around cell (cx, cy, cz), periodic.
+
+    k runs over ``stencil_size(ncell)`` cells with x fastest, then y, then z
+    (offsets -1, 0, 1; z offset 0 in 2D).
+    """
+    zr = 1 if ncell[2] >= 3 else 0
+    kx = (cx + k % 3 - 1) % ncell[0]
+    ky = (cy + (k // 3) % 3 - 1) % ncell[1]
+    kz = (cz + k // 9 - zr) % ncell[2]
+    return kx + ncell[0] * (ky + ncell[1] * kz)
+
+
+@jit(inline="always")
 def cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of):
     h = cell_head[c]
     cell_next[i] = h
@@ -175,30 +195,24 @@ def build_all_lists(r, centre, rec, shell, box, ncell, cell_head, cell_next, cel
         cell_insert(i, cell_index(r[i, 0], r[i, 1], r[i, 2], box, ncell), cell_head,
                     cell_next, cell_prev, cell_of)
     nbn[:] = 0
-    zr = 1 if ncell[2] >= 3 else 0
     for i in range(n):
         cx = cell_coord(r[i, 0], box[0], ncell[0])
         cy = cell_coord(r[i, 1], box[1], ncell[1])
         cz = cell_coord(r[i, 2], box[2], ncell[2])
-        for oz in range(-zr, zr + 1):
-            kz = (cz + oz) % ncell[2]
-            for oy in range(-1, 2):
-                ky = (cy + oy) % ncell[1]
-                for ox in range(-1, 2):
-                    kx = (cx + ox) % ncell[0]
-                    j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                    while j >= 0:
-                        if j > i:
-                            dx = min_image(r[i, 0] - r[j, 0], box[0])
-                            dy = min_image(r[i, 1] - r[j, 1], box[1])
-                            dz = min_image(r[i, 2] - r[j, 2], box[2])
-                            cut = rec[i, 7] + rec[j, 7] + shell
-                            if dx * dx + dy * dy + dz * dz < cut * cut:
-                                if nbn[i] >= m or nbn[j] >= m:
-                                    return OVERFLOW
-                                nbl[i, nbn[i]] = j
-                                nbn[i] += 1
-                                nbl[j, nbn[j]] = i
-                                nbn[j] += 1
-                        j = cell_next[j]
+        for k in range(stencil_size(ncell)):
+            j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
+            while j >= 0:
+                if j > i:
+                    dx = min_image(r[i, 0] - r[j, 0], box[0])
+                    dy = min_image(r[i, 1] - r[j, 1], box[1])
+                    dz = min_image(r[i, 2] - r[j, 2], box[2])
+                    cut = rec[i, 7] + rec[j, 7] + shell
+                    if dx * dx + dy * dy + dz * dz < cut * cut:
+                        if nbn[i] >= m or nbn[j] >= m:
+                            return OVERFLOW
+                        nbl[i, nbn[i]] = j
+                        nbn[i] += 1
+                        nbl[j, nbn[j]] = i
+                        nbn[j] += 1
+                j = cell_next[j]
     return 0

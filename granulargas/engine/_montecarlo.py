@@ -7,7 +7,8 @@ numpy Generator) and passed in, so the result is reproducible everywhere.
 """
 
 from granulargas._numba import jit
-from granulargas.engine._cells import cell_coord, cell_index, cell_insert, cell_remove
+from granulargas.engine._cells import (cell_coord, cell_index, cell_insert, cell_remove, stencil_cell,
+                                       stencil_size)
 from granulargas.engine._geometry import min_image
 
 
@@ -25,23 +26,17 @@ def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
-    zr = 1 if ncell[2] >= 3 else 0
-    for oz in range(-zr, zr + 1):
-        kz = (cz + oz) % ncell[2]
-        for oy in range(-1, 2):
-            ky = (cy + oy) % ncell[1]
-            for ox in range(-1, 2):
-                kx = (cx + ox) % ncell[0]
-                j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                while j >= 0:
-                    if j != i:
-                        dx = min_image(x - r[j, 0], box[0])
-                        dy = min_image(y - r[j, 1], box[1])
-                        dz = min_image(z - r[j, 2], box[2])
-                        s = radius[i] + radius[j]
-                        if dx * dx + dy * dy + dz * dz < s * s:
-                            return True
-                    j = cell_next[j]
+    for k in range(stencil_size(ncell)):
+        j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
+        while j >= 0:
+            if j != i:
+                dx = min_image(x - r[j, 0], box[0])
+                dy = min_image(y - r[j, 1], box[1])
+                dz = min_image(z - r[j, 2], box[2])
+                s = radius[i] + radius[j]
+                if dx * dx + dy * dy + dz * dz < s * s:
+                    return True
+            j = cell_next[j]
     return False
 
 
@@ -77,25 +72,19 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
-    zr = 1 if ncell[2] >= 3 else 0
     total = 0.0
-    for oz in range(-zr, zr + 1):
-        kz = (cz + oz) % ncell[2]
-        for oy in range(-1, 2):
-            ky = (cy + oy) % ncell[1]
-            for ox in range(-1, 2):
-                kx = (cx + ox) % ncell[0]
-                j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                while j >= 0:
-                    if j != i:
-                        dx = min_image(x - r[j, 0], box[0])
-                        dy = min_image(y - r[j, 1], box[1])
-                        dz = min_image(z - r[j, 2], box[2])
-                        s = radius[i] + radius[j]
-                        d2 = dx * dx + dy * dy + dz * dz
-                        if d2 < s * s:
-                            total += s - d2**0.5
-                    j = cell_next[j]
+    for k in range(stencil_size(ncell)):
+        j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
+        while j >= 0:
+            if j != i:
+                dx = min_image(x - r[j, 0], box[0])
+                dy = min_image(y - r[j, 1], box[1])
+                dz = min_image(z - r[j, 2], box[2])
+                s = radius[i] + radius[j]
+                d2 = dx * dx + dy * dy + dz * dz
+                if d2 < s * s:
+                    total += s - d2**0.5
+            j = cell_next[j]
     return total
 
 
@@ -144,24 +133,18 @@ def _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, o
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
-    zr = 1 if ncell[2] >= 3 else 0
-    for oz in range(-zr, zr + 1):
-        kz = (cz + oz) % ncell[2]
-        for oy in range(-1, 2):
-            ky = (cy + oy) % ncell[1]
-            for ox in range(-1, 2):
-                kx = (cx + ox) % ncell[0]
-                j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                while j >= 0:
-                    if j != i:
-                        dx = min_image(x - r[j, 0], box[0])
-                        dy = min_image(y - r[j, 1], box[1])
-                        dz = min_image(z - r[j, 2], box[2])
-                        s = radius[i] + radius[j]
-                        if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
-                            out[m] = j
-                            m += 1
-                    j = cell_next[j]
+    for k in range(stencil_size(ncell)):
+        j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
+        while j >= 0:
+            if j != i:
+                dx = min_image(x - r[j, 0], box[0])
+                dy = min_image(y - r[j, 1], box[1])
+                dz = min_image(z - r[j, 2], box[2])
+                s = radius[i] + radius[j]
+                if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
+                    out[m] = j
+                    m += 1
+            j = cell_next[j]
     return m
 
 
@@ -229,7 +212,6 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
     involved in overlaps (with repetitions) into ``out``; returns their number.
     """
     m = 0
-    zr = 1 if ncell[2] >= 3 else 0
     for k in range(idx.shape[0]):
         i = idx[k]
         x = r[i, 0]
@@ -241,27 +223,22 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
         cx = cell_coord(x, box[0], ncell[0])
         cy = cell_coord(y, box[1], ncell[1])
         cz = cell_coord(z, box[2], ncell[2])
-        for oz in range(-zr, zr + 1):
-            kz = (cz + oz) % ncell[2]
-            for oy in range(-1, 2):
-                ky = (cy + oy) % ncell[1]
-                for ox in range(-1, 2):
-                    kx = (cx + ox) % ncell[0]
-                    j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                    while j >= 0:
-                        if j != i:
-                            dx = min_image(x - r[j, 0], box[0])
-                            dy = min_image(y - r[j, 1], box[1])
-                            dz = min_image(z - r[j, 2], box[2])
-                            s = radius[i] + radius[j]
-                            d2 = dx * dx + dy * dy + dz * dz
-                            if d2 < s * s and d2 > 0.0:
-                                dd = d2**0.5
-                                f = (0.5 * (s - dd) + 1e-3 * s) / dd
-                                px += f * dx
-                                py += f * dy
-                                pz += f * dz
-                        j = cell_next[j]
+        for q in range(stencil_size(ncell)):
+            j = cell_head[stencil_cell(cx, cy, cz, q, ncell)]
+            while j >= 0:
+                if j != i:
+                    dx = min_image(x - r[j, 0], box[0])
+                    dy = min_image(y - r[j, 1], box[1])
+                    dz = min_image(z - r[j, 2], box[2])
+                    s = radius[i] + radius[j]
+                    d2 = dx * dx + dy * dy + dz * dz
+                    if d2 < s * s and d2 > 0.0:
+                        dd = d2**0.5
+                        f = (0.5 * (s - dd) + 1e-3 * s) / dd
+                        px += f * dx
+                        py += f * dy
+                        pz += f * dz
+                j = cell_next[j]
         if px == 0.0 and py == 0.0 and pz == 0.0:
             continue
         x += kick[k] * px
