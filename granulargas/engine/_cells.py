@@ -18,8 +18,10 @@ clock t_i, velocity, clock and radius.
 
 from granulargas._numba import jit
 from granulargas.engine._geometry import min_image
+from granulargas.engine._prefetch import prefetch
 
 OVERFLOW = 10
+CELL_OVERFLOW = 11
 
 
 @jit(inline="always")
@@ -84,94 +86,182 @@ def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
 
 
 @jit(inline="always")
-def _collect(i, x, y, z, ri, centre, rec, shell, box, ncell, cell_head, cell_next,
-             nbl, nbn, scratch):
-    """Candidates j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
+def slot_insert(i, c, cell_ids, cell_n, cell_of, slot_of):
+    """Append particle i to cell c (the caller has checked the capacity)."""
+    q = cell_n[c]
+    cell_ids[c, q] = i
+    cell_n[c] = q + 1
+    cell_of[i] = c
+    slot_of[i] = q
 
-    Returns their number, or -1 if a list would overflow.
+
+@jit(inline="always")
+def slot_remove(i, cell_ids, cell_n, cell_of, slot_of):
+    """Remove particle i from its cell (the cell's last entry takes its slot)."""
+    c = cell_of[i]
+    q = slot_of[i]
+    last = cell_n[c] - 1
+    m = cell_ids[c, last]
+    cell_ids[c, q] = m
+    slot_of[m] = q
+    cell_n[c] = last
+
+
+@jit(inline="always")
+def _wrap_cell(c, n, length):
+    """Periodic cell coordinate and the shift (0 or +-L) that brings its contents next to c."""
+    if c < 0:
+        return c + n, -length
+    if c >= n:
+        return c - n, length
+    return c, 0.0
+
+
+@jit(inline="always")
+def _collect(i, x, y, z, ri, rmax, centre, rec, shell, box, ncell, cell_ids, cell_n, scratch,
+             stencil):
+    """Particles j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
+
+    Three passes, so that the cache misses of one pass overlap: (1) the 27 (2D:
+    9) cells around (x, y, z) into ``stencil`` (a prefetch for each cell's
+    row), (2) a prefetch for the centre of every particle in them, (3) the
+    distance tests. Each cell is tested with the query point shifted by the
+    cell's periodic offset, so the inner loop needs no minimum image; the
+    test uses R_i + R_max + shell first and reads R_j only for the hits.
+    Returns the number found, or -1 if ``scratch`` would overflow.
     """
-    m = nbl.shape[1]
+    m = scratch.shape[0]
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
     zr = 1 if ncell[2] >= 3 else 0
-    count = 0
+    ns = 0
     for oz in range(-zr, zr + 1):
-        kz = cz + oz
-        if kz < 0:
-            kz += ncell[2]
-        elif kz >= ncell[2]:
-            kz -= ncell[2]
+        kz = _wrap(cz + oz, ncell[2])
         for oy in range(-1, 2):
-            ky = cy + oy
-            if ky < 0:
-                ky += ncell[1]
-            elif ky >= ncell[1]:
-                ky -= ncell[1]
+            ky = _wrap(cy + oy, ncell[1])
+            row = ncell[0] * (ky + ncell[1] * kz)
             for ox in range(-1, 2):
-                kx = cx + ox
-                if kx < 0:
-                    kx += ncell[0]
-                elif kx >= ncell[0]:
-                    kx -= ncell[0]
-                j = cell_head[kx + ncell[0] * (ky + ncell[1] * kz)]
-                while j >= 0:
-                    if j != i:
-                        dx = min_image(x - centre[j, 0], box[0])
-                        dy = min_image(y - centre[j, 1], box[1])
-                        dz = min_image(z - centre[j, 2], box[2])
+                c = _wrap(cx + ox, ncell[0]) + row
+                stencil[ns] = c
+                prefetch(cell_ids, c)
+                ns += 1
+    for k in range(ns):
+        c = stencil[k]
+        for q in range(cell_n[c]):
+            prefetch(centre, cell_ids[c, q])
+    cut_max = ri + rmax + shell
+    cut_max2 = cut_max * cut_max
+    count = 0
+    k = 0
+    for oz in range(-zr, zr + 1):
+        qz = z - _shift(cz + oz, ncell[2], box[2])
+        for oy in range(-1, 2):
+            qy = y - _shift(cy + oy, ncell[1], box[1])
+            for ox in range(-1, 2):
+                qx = x - _shift(cx + ox, ncell[0], box[0])
+                c = stencil[k]
+                k += 1
+                for q in range(cell_n[c]):
+                    j = cell_ids[c, q]
+                    dx = qx - centre[j, 0]
+                    dy = qy - centre[j, 1]
+                    dz = qz - centre[j, 2]
+                    d2 = dx * dx + dy * dy + dz * dz
+                    if d2 < cut_max2 and j != i:
                         cut = ri + rec[j, 7] + shell
-                        if dx * dx + dy * dy + dz * dz < cut * cut:
+                        if d2 < cut * cut:
                             if count >= m:
                                 return -1
-                            if nbn[j] >= m:
-                                # j is full: fine only if i is already listed there
-                                found = False
-                                for k in range(nbn[j]):
-                                    if nbl[j, k] == i:
-                                        found = True
-                                if not found:
-                                    return -1
                             scratch[count] = j
                             count += 1
-                    j = cell_next[j]
     return count
 
 
+@jit(inline="always")
+def _wrap(c, n):
+    if c < 0:
+        return c + n
+    if c >= n:
+        return c - n
+    return c
+
+
+@jit(inline="always")
+def _shift(c, n, length):
+    """Periodic offset of unwrapped cell coordinate c: the cell's contents sit at x + shift."""
+    if c < 0:
+        return -length
+    if c >= n:
+        return length
+    return 0.0
+
+
+@jit(inline="always")
+def _contains(a, row, n, v):
+    for k in range(n):
+        if a[row, k] == v:
+            return True
+    return False
+
+
+@jit(inline="always")
+def _in(a, n, v):
+    for k in range(n):
+        if a[k] == v:
+            return True
+    return False
+
+
 @jit
-def rebuild_list(i, rec, centre, shell, box, ncell, cell_head, cell_next, cell_prev,
-                 cell_of, nbl, nbn, scratch):
+def rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell_of, slot_of,
+                 nbl, nbn, scratch, stencil):
     """New list centre c_i = r_i and a new neighbour list for particle i.
 
-    Nothing is modified when a list would overflow (returns OVERFLOW); the
-    caller enlarges ``nbl`` and calls again. Returns 0 on success.
+    Only the differences to the old list touch other particles' lists: i is
+    removed from the lists of old neighbours that are not new ones, and added
+    to those of new ones that were not old ones. Nothing is modified when a
+    list or a cell would overflow (returns OVERFLOW or CELL_OVERFLOW); the
+    caller enlarges ``nbl`` or ``cell_ids`` and calls again. Returns 0 on success.
     """
     x = rec[i, 0]
     y = rec[i, 1]
     z = rec[i, 2]
-    count = _collect(i, x, y, z, rec[i, 7], centre, rec, shell, box, ncell, cell_head,
-                     cell_next, nbl, nbn, scratch)
-    if count < 0:
+    c = cell_index(x, y, z, box, ncell)
+    if c != cell_of[i] and cell_n[c] >= cell_ids.shape[1]:
+        return CELL_OVERFLOW
+    m = nbl.shape[1]
+    count = _collect(i, x, y, z, rec[i, 7], rmax, centre, rec, shell, box, ncell, cell_ids,
+                     cell_n, scratch, stencil)
+    if count < 0 or count > m:
         return OVERFLOW
-    # drop i from its old neighbours' lists (swap with the last entry)
-    for k in range(nbn[i]):
-        j = nbl[i, k]
-        last = nbn[j] - 1
-        for q in range(last + 1):
-            if nbl[j, q] == i:
-                nbl[j, q] = nbl[j, last]
-                nbn[j] = last
-                break
+    nold = nbn[i]
     for k in range(count):
         j = scratch[k]
-        nbl[i, k] = j
-        nbl[j, nbn[j]] = i
-        nbn[j] += 1
+        if nbn[j] >= m and not _contains(nbl, i, nold, j):
+            return OVERFLOW
+    # old neighbours that are not new ones lose i (swap with their last entry)
+    for k in range(nold):
+        j = nbl[i, k]
+        if not _in(scratch, count, j):
+            last = nbn[j] - 1
+            for q in range(last + 1):
+                if nbl[j, q] == i:
+                    nbl[j, q] = nbl[j, last]
+                    nbn[j] = last
+                    break
+    # new neighbours that were not old ones gain i
+    for k in range(count):
+        j = scratch[k]
+        if not _contains(nbl, i, nold, j):
+            nbl[j, nbn[j]] = i
+            nbn[j] += 1
+    for k in range(count):
+        nbl[i, k] = scratch[k]
     nbn[i] = count
-    c = cell_index(x, y, z, box, ncell)
     if c != cell_of[i]:
-        cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
-        cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+        slot_remove(i, cell_ids, cell_n, cell_of, slot_of)
+        slot_insert(i, c, cell_ids, cell_n, cell_of, slot_of)
     centre[i, 0] = x
     centre[i, 1] = y
     centre[i, 2] = z
@@ -179,29 +269,33 @@ def rebuild_list(i, rec, centre, shell, box, ncell, cell_head, cell_next, cell_p
 
 
 @jit
-def build_all_lists(r, centre, rec, shell, box, ncell, cell_head, cell_next, cell_prev,
-                    cell_of, nbl, nbn):
+def build_all_lists(r, centre, rec, shell, box, ncell, cell_ids, cell_n, cell_of, slot_of,
+                    nbl, nbn):
     """Centres = positions ``r`` (= rec[:, :3]), cells and all neighbour lists from scratch.
 
-    Returns 0, or OVERFLOW if some list exceeds ``nbl.shape[1]``.
+    Returns 0, CELL_OVERFLOW if some cell holds more than ``cell_ids.shape[1]``
+    particles, or OVERFLOW if some list exceeds ``nbl.shape[1]``.
     """
     n = r.shape[0]
     m = nbl.shape[1]
-    cell_head[:] = -1
-    for i in range(n - 1, -1, -1):
+    cell_n[:] = 0
+    for i in range(n):
         centre[i, 0] = r[i, 0]
         centre[i, 1] = r[i, 1]
         centre[i, 2] = r[i, 2]
-        cell_insert(i, cell_index(r[i, 0], r[i, 1], r[i, 2], box, ncell), cell_head,
-                    cell_next, cell_prev, cell_of)
+        c = cell_index(r[i, 0], r[i, 1], r[i, 2], box, ncell)
+        if cell_n[c] >= cell_ids.shape[1]:
+            return CELL_OVERFLOW
+        slot_insert(i, c, cell_ids, cell_n, cell_of, slot_of)
     nbn[:] = 0
     for i in range(n):
         cx = cell_coord(r[i, 0], box[0], ncell[0])
         cy = cell_coord(r[i, 1], box[1], ncell[1])
         cz = cell_coord(r[i, 2], box[2], ncell[2])
         for k in range(stencil_size(ncell)):
-            j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
-            while j >= 0:
+            c = stencil_cell(cx, cy, cz, k, ncell)
+            for q in range(cell_n[c]):
+                j = cell_ids[c, q]
                 if j > i:
                     dx = min_image(r[i, 0] - r[j, 0], box[0])
                     dy = min_image(r[i, 1] - r[j, 1], box[1])
@@ -214,5 +308,4 @@ def build_all_lists(r, centre, rec, shell, box, ncell, cell_head, cell_next, cel
                         nbn[i] += 1
                         nbl[j, nbn[j]] = i
                         nbn[j] += 1
-                j = cell_next[j]
     return 0

@@ -37,11 +37,11 @@ the past or an endless run of zero-time events: round-off trouble).
 import math
 
 from granulargas._numba import jit
-from granulargas.engine._cells import OVERFLOW, rebuild_list
+from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, rebuild_list
 from granulargas.engine._collide import restitution
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image
 from granulargas.engine._prefetch import prefetch
-from granulargas.engine._queue import heap_update
+from granulargas.engine._calendar import cal_peek, cal_update
 
 DONE = 0
 BUDGET = 1
@@ -54,7 +54,7 @@ WATCHDOG = 30
 S_TIME, S_DISSIPATED, S_VIRIAL, S_KIN_INT, S_SUM_MV2 = 0, 1, 2, 3, 4
 I_COLLISIONS, I_EVENTS, I_ERR_I, I_ERR_J, I_EXPIRIES, I_STALE = 0, 1, 2, 3, 4, 5
 # indices into the float parameter array
-P_EPS, P_TC, P_PREFACTOR, P_INV_H, P_SHELL, P_COLLAPSE_DT = 0, 1, 2, 3, 4, 5
+P_EPS, P_TC, P_PREFACTOR, P_INV_H, P_SHELL, P_COLLAPSE_DT, P_RMAX = 0, 1, 2, 3, 4, 5, 6
 # columns of a particle record
 T_COL, R_COL = 6, 7
 
@@ -117,7 +117,8 @@ def predict_all(t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shel
 
 @jit
 def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
-            nbl, nbn, scratch, cell_head, cell_next, cell_prev, cell_of, heap, hpos,
+            nbl, nbn, scratch, stencil, cell_ids, cell_n, cell_of, slot_of,
+            qt, qlink, qwhere, small, heads, qi, qf,
             box, ncell, kind, fpar, coeffs, collapse_count, until, max_events, max_collisions,
             scal, iscal):
     """Process events in time order until ``until`` (or a budget); see module doc.
@@ -133,6 +134,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
     shell = fpar[P_SHELL]
     half_shell = 0.5 * shell * (1.0 - 1e-9)  # margin against round-off in |r - c|
     collapse_dt = fpar[P_COLLAPSE_DT]
+    rmax = fpar[P_RMAX]
     time = scal[S_TIME]
     zero_advance = 0
     zero_limit = 1000 + rec.shape[0]
@@ -142,8 +144,10 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         if iscal[I_EVENTS] >= events_end:
             status = BUDGET
             break
-        te = heap[0, 0]
-        i = int(heap[0, 1])
+        i = cal_peek(qt, qlink, qwhere, small, heads, qi, qf)
+        if i < 0:
+            break
+        te = qt[i]
         if te > until or te == math.inf:
             break
         if te <= time:
@@ -225,11 +229,11 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
                 lastcoll[j] = te
                 tj = predict(j, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                              half_shell)
-                heap_update(heap, hpos, j, tj)
+                cal_update(j, tj, qt, qlink, qwhere, small, heads, qi, qf)
                 if rapid[i] >= collapse_count or rapid[j] >= collapse_count:
                     ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                                  half_shell)
-                    heap_update(heap, hpos, i, ti)
+                    cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf)
                     iscal[I_EVENTS] += 1
                     iscal[I_ERR_I] = i
                     iscal[I_ERR_J] = j
@@ -238,11 +242,12 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         elif j < 0:
             # ---- list expiry: new centre and list for i
             stream(i, te, rec, img, box)
-            if rebuild_list(i, rec, centre, shell, box, ncell, cell_head, cell_next, cell_prev,
-                            cell_of, nbl, nbn, scratch) == OVERFLOW:
+            st = rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell_of,
+                              slot_of, nbl, nbn, scratch, stencil)
+            if st != 0:
                 iscal[I_ERR_I] = i
                 iscal[I_ERR_J] = -1
-                status = OVERFLOW
+                status = st
                 break
             iscal[I_EXPIRIES] += 1
         else:
@@ -250,30 +255,32 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             stream(i, te, rec, img, box)
             iscal[I_STALE] += 1
         ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
-        heap_update(heap, hpos, i, ti)
+        cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf)
         iscal[I_EVENTS] += 1
         # ---- prefetch hints (no effect on results): the next event's partner and
         # neighbour records, and the rows of the likely event after it (the earliest
         # child of the root), so that their cache misses overlap with work
-        i1 = int(heap[0, 1])
-        p1 = partner[i1]
-        if p1 >= 0:
-            prefetch(rec, p1)
-        for k in range(nbn[i1]):
-            prefetch(rec, nbl[i1, k])
-        if heap.shape[0] > 4:
-            c2 = 1
-            t2 = heap[1, 0]
-            for q in range(2, 5):
-                if heap[q, 0] < t2:
-                    t2 = heap[q, 0]
-                    c2 = q
-            i2 = int(heap[c2, 1])
-            prefetch(rec, i2)
-            prefetch(nbl, i2)
-            prefetch(nbn, i2)
-            prefetch(partner, i2)
-            prefetch(centre, i2)
+        i1 = cal_peek(qt, qlink, qwhere, small, heads, qi, qf)
+        if i1 >= 0:
+            p1 = partner[i1]
+            if p1 >= 0:
+                prefetch(rec, p1)
+            for k in range(nbn[i1]):
+                prefetch(rec, nbl[i1, k])
+            size = qi[0]
+            if size > 1:
+                c2 = 1
+                t2 = small[1, 0]
+                for q in range(2, min(5, size)):
+                    if small[q, 0] < t2:
+                        t2 = small[q, 0]
+                        c2 = q
+                i2 = int(small[c2, 1])
+                prefetch(rec, i2)
+                prefetch(nbl, i2)
+                prefetch(nbn, i2)
+                prefetch(partner, i2)
+                prefetch(centre, i2)
         if iscal[I_COLLISIONS] >= max_collisions:
             status = MAX_COLLISIONS
             break

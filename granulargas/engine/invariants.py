@@ -1,7 +1,7 @@
 """Invariant checks of the engine's internal state (debugging and tests; O(N^2)).
 
 :func:`check` returns a list of violated invariants (empty when all hold):
-heap order and index; every particle within shell/2 of its list centre; the
+event calendar order and index; every particle within shell/2 of its list centre; the
 neighbour lists symmetric and complete (every pair with nearest-image centre
 distance below R_i + R_j + shell listed both ways); no two particles
 overlapping beyond round-off; each particle's scheduled event not later than
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from granulargas.engine._queue import heap_check
+from granulargas.engine._calendar import cal_check
 
 
 def _min_image(d, box):
@@ -27,8 +27,8 @@ def check(sim, overlap_tol: float = 1e-9) -> list[str]:
     box = sim._box3
     t = float(s["scal"][0])
     problems = []
-    if not heap_check(s["heap"], s["hpos"]):
-        problems.append("heap order or index broken")
+    if not cal_check(s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"], s["qf"]):
+        problems.append("event calendar broken")
     rec = s["rec"]
     r = rec[:, :3] + rec[:, 3:6] * (t - rec[:, 6])[:, None]
     off = np.linalg.norm(_min_image(r - s["centre"], box), axis=1)

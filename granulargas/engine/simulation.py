@@ -19,8 +19,8 @@ import math
 import numpy as np
 
 from granulargas.engine import _loop
-from granulargas.engine._cells import OVERFLOW, build_all_lists
-from granulargas.engine._queue import allocate_heap, heap_build
+from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
+from granulargas.engine._calendar import allocate_calendar, cal_build
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import (
     ConfigError,
@@ -60,6 +60,13 @@ def _aligned_records(n):
     buf = np.zeros(n * 8 + 8)
     offset = (-buf.ctypes.data % 64) // 8
     return buf[offset : offset + n * 8].reshape(n, 8)
+
+
+def _aligned_int_rows(rows, width):
+    """Uninitialised (rows, width) int32 array starting on a 64-byte boundary."""
+    buf = np.empty(rows * width + 16, dtype=np.int32)
+    offset = (-buf.ctypes.data % 64) // 4
+    return buf[offset : offset + rows * width].reshape(rows, width)
 
 
 def morton_order(positions3, box3, ncell):
@@ -184,6 +191,8 @@ class Simulation:
         self._ncell[:d] = np.floor(bx / cut).astype(np.int64)
         self._built = False
         self._nb_width = self._initial_list_width(n, volume, cut)
+        mean = n / float(np.prod(self._ncell))
+        self._cell_width = 16 * max(1, math.ceil((mean + 5.0 * math.sqrt(mean) + 2) / 16))
 
     # ------------------------------------------------------------------ build
     def _initial_list_width(self, n, volume, cut):
@@ -217,39 +226,51 @@ class Simulation:
         s["pcount"] = np.zeros(n, dtype=np.int32)
         s["lastcoll"] = np.ascontiguousarray(self._last_collision[order])
         s["rapid"] = np.zeros(n, dtype=np.int32)
-        s["cell_head"] = np.full(int(np.prod(self._ncell)), -1, dtype=np.int32)
-        s["cell_next"] = np.empty(n, dtype=np.int32)
-        s["cell_prev"] = np.empty(n, dtype=np.int32)
+        ncells = int(np.prod(self._ncell))
+        s["cell_n"] = np.zeros(ncells, dtype=np.int32)
         s["cell_of"] = np.empty(n, dtype=np.int32)
+        s["slot_of"] = np.empty(n, dtype=np.int32)
         s["nbn"] = np.zeros(n, dtype=np.int32)
         pos = np.ascontiguousarray(rec[:, :3])
         while True:
             s["nbl"] = np.empty((n, self._nb_width), dtype=np.int32)
+            s["cell_ids"] = _aligned_int_rows(ncells, self._cell_width)
             st = build_all_lists(pos, s["centre"], rec, self.shell, self._box3, self._ncell,
-                                 s["cell_head"], s["cell_next"], s["cell_prev"], s["cell_of"],
+                                 s["cell_ids"], s["cell_n"], s["cell_of"], s["slot_of"],
                                  s["nbl"], s["nbn"])
-            if st != OVERFLOW:
+            if st == OVERFLOW:
+                self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
+            elif st == CELL_OVERFLOW:
+                self._cell_width += 16
+            else:
                 break
-            self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
         # compact the lists to what this state needs (+ a margin; they grow on demand)
         width = min(n - 1, int(s["nbn"].max()) + 6)
         if width < self._nb_width:
             s["nbl"] = np.ascontiguousarray(s["nbl"][:, :width])
             self._nb_width = width
         s["scratch"] = np.empty(self._nb_width, dtype=np.int32)
-        times = np.empty(n)
+        s["stencil"] = np.empty(27, dtype=np.int32)
+        s.update(allocate_calendar(n))
         _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
                           s["partner"], s["pcount"], self._box3, 0.5 * self.shell * (1.0 - 1e-9),
-                          times)
-        s["heap"] = allocate_heap(n)
-        s["hpos"] = np.empty(n, dtype=np.int32)
-        heap_build(s["heap"], s["hpos"], times)
+                          s["qt"])
+        cal_build(self._time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"],
+                  s["qf"])
         with np.errstate(over="ignore", under="ignore"):
             mv2 = float(np.sum(self._masses[:, None] * self._velocities**2))
         s["scal"] = np.array([self._time, self._dissipated, self._virial, self._kin_int, mv2])
         s["iscal"] = np.array([self._collisions, self._events, -1, -1, 0, 0], dtype=np.int64)
         self._s = s
         self._built = True
+
+    def _grow_cells(self):
+        s = self._s
+        old = s["cell_ids"]
+        self._cell_width += 16
+        new = _aligned_int_rows(old.shape[0], self._cell_width)
+        new[:, : old.shape[1]] = old
+        s["cell_ids"] = new
 
     def _grow_lists(self):
         s = self._s
@@ -300,14 +321,18 @@ class Simulation:
         kind, eps, tc, pref, inv_h, coeffs = self.rule.kernel_arguments()
         v2 = s["scal"][4] / float(np.sum(s["mass"]))
         scale = 2.0 * float(self._radii.min()) / math.sqrt(v2) if v2 > 0 else 1.0
-        fpar = np.array([eps, tc, pref, inv_h, self.shell, 1e-10 * scale])
+        fpar = np.array([eps, tc, pref, inv_h, self.shell, 1e-10 * scale, float(self._radii.max())])
         chunk = max(1_000_000, 2 * self.n)
+        # a fresh calendar per call keeps its window width matched to the event rate
+        cal_build(self.time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"],
+                  s["qf"])
         while True:
             status = _loop.advance(
                 s["rec"], s["img"], s["centre"], s["mass"], s["count"],
                 s["partner"], s["pcount"], s["lastcoll"], s["rapid"], s["nbl"], s["nbn"], s["scratch"],
-                s["cell_head"], s["cell_next"], s["cell_prev"], s["cell_of"], s["heap"],
-                s["hpos"], self._box3, self._ncell, kind, fpar, coeffs,
+                s["stencil"],
+                s["cell_ids"], s["cell_n"], s["cell_of"], s["slot_of"],
+                s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"], s["qf"], self._box3, self._ncell, kind, fpar, coeffs,
                 self.collapse_count, until, chunk, target, s["scal"], s["iscal"])
             if status == _loop.BUDGET:
                 if progress is not None:
@@ -315,6 +340,9 @@ class Simulation:
                 continue
             if status == OVERFLOW:
                 self._grow_lists()
+                continue
+            if status == CELL_OVERFLOW:
+                self._grow_cells()
                 continue
             if status in (_loop.DONE, _loop.MAX_COLLISIONS):
                 break

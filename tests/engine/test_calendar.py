@@ -1,0 +1,53 @@
+"""The event calendar against a naive reference (argmin over all event times)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from granulargas.engine._calendar import allocate_calendar, cal_build, cal_check, cal_peek, cal_update
+
+
+def _args(c):
+    return c["qt"], c["qlink"], c["qwhere"], c["small"], c["heads"], c["qi"], c["qf"]
+
+
+@pytest.mark.parametrize("n, spread", [(5, 1.0), (300, 1.0), (2000, 1e-3), (1000, 1e6)])
+def test_calendar_pops_in_time_order_like_a_naive_argmin(n, spread):
+    rng = np.random.default_rng(n)
+    c = allocate_calendar(n)
+    now = 10.0
+    c["qt"][:] = now + rng.exponential(spread, n)
+    c["qt"][rng.random(n) < 0.05] = math.inf  # particles at rest
+    cal_build(now, *_args(c))
+    assert cal_check(*_args(c))
+    ref = c["qt"].copy()
+    for step in range(20 * n):
+        i = cal_peek(*_args(c))
+        k = int(np.argmin(ref))
+        if ref[k] == math.inf:
+            assert i == -1
+            break
+        assert ref[i] == ref[k], f"step {step}: popped {ref[i]} but the earliest is {ref[k]}"
+        now = ref[i]
+        # the popped particle and a random other one get new times (later or equal to now;
+        # sometimes far beyond the ring, sometimes inf, sometimes exactly now)
+        for p in (i, int(rng.integers(n))):
+            u = rng.random()
+            t = math.inf if u < 0.02 else now if u < 0.05 else now + rng.exponential(spread) * (
+                1e4 if u > 0.97 else 1.0)
+            ref[p] = t
+            cal_update(p, t, *_args(c))
+        if step % 97 == 0:
+            assert cal_check(*_args(c))
+    assert cal_check(*_args(c))
+
+
+def test_calendar_empty_ring_jumps_to_overflow():
+    c = allocate_calendar(10)
+    c["qt"][:] = math.inf
+    c["qt"][3] = 1e12
+    cal_build(0.0, *_args(c))
+    assert cal_peek(*_args(c)) == 3
+    cal_update(3, math.inf, *_args(c))
+    assert cal_peek(*_args(c)) == -1
