@@ -75,6 +75,26 @@ def stream(i, t, rec, img, box):
     rec[i, 6] = t
 
 
+@jit(inline="always")
+def _prefetch_particle(i, rec, img, centre, mass, count, pcount, lastcoll, rapid, nbl, nbn,
+                       partner, qt, qlink, qwhere):
+    """Prefetch hints for every per-particle row an event of particle i touches."""
+    prefetch(rec, i)
+    prefetch(img, i)
+    prefetch(centre, i)
+    prefetch(mass, i)
+    prefetch(count, i)
+    prefetch(pcount, i)
+    prefetch(lastcoll, i)
+    prefetch(rapid, i)
+    prefetch(nbl, i)
+    prefetch(nbn, i)
+    prefetch(partner, i)
+    prefetch(qt, i)
+    prefetch(qlink, i)
+    prefetch(qwhere, i)
+
+
 @jit
 def predict(i, t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell):
     """Earliest event of particle i (streamed to t): collision or list expiry.
@@ -264,9 +284,17 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         if i1 >= 0:
             p1 = partner[i1]
             if p1 >= 0:
-                prefetch(rec, p1)
+                _prefetch_particle(p1, rec, img, centre, mass, count, pcount, lastcoll, rapid,
+                                   nbl, nbn, partner, qt, qlink, qwhere)
             for k in range(nbn[i1]):
                 prefetch(rec, nbl[i1, k])
+            prefetch(img, i1)
+            prefetch(mass, i1)
+            prefetch(lastcoll, i1)
+            prefetch(rapid, i1)
+            prefetch(count, i1)
+            prefetch(qlink, i1)
+            prefetch(qwhere, i1)
             size = qi[0]
             if size > 1:
                 c2 = 1
@@ -280,6 +308,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
                 prefetch(nbl, i2)
                 prefetch(nbn, i2)
                 prefetch(partner, i2)
+                prefetch(pcount, i2)
                 prefetch(centre, i2)
         if iscal[I_COLLISIONS] >= max_collisions:
             status = MAX_COLLISIONS
