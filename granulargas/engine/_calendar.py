@@ -10,9 +10,11 @@ costs O(log N) dependent cache misses per update at large N; a calendar
   4-ary min-heap ``small`` of (time, id) nodes (a few dozen events, in cache);
 * the next ``nb - 1`` windows are *buckets*: unsorted doubly linked lists
   (``qlink[i] = (next, prev)``, heads in ``heads``), in a ring (slot B mod nb);
-* events beyond the ring wait in an *overflow* list (``heads[nb]``), whose
-  smallest time ``ovf_min`` (a lower bound after removals) says when to
-  redistribute it.
+* events beyond the ring wait in an *overflow* list (``heads[nb]``), which is
+  redistributed every half turn of the ring (an overflow event lies at least
+  one full turn ahead when placed, so none falls due in between; the cost is
+  O(overflow) per ~N events). ``ovf_min`` (a lower bound after removals) lets
+  an empty ring jump straight to the earliest overflow event.
 
 ``where[i] >= 0`` is the ring slot (or ``nb`` for overflow) of particle i;
 ``where[i] < 0`` means it sits in the small heap at node ``-where[i] - 1``.
@@ -42,9 +44,9 @@ Q_W, Q_T0, Q_OVF = 0, 1, 2
 
 
 def ring_size(n):
-    """Number of ring slots for n particles (a power of two, ~4 mean delays)."""
+    """Number of ring slots for n particles (a power of two, ~8 mean delays)."""
     nb = 64
-    while nb < 4 * n // PER_WINDOW + 2:
+    while nb < 8 * n // PER_WINDOW + 2:
         nb *= 2
     return nb
 
@@ -234,7 +236,9 @@ def cal_peek(qt, qlink, where, small, heads, qi, qf):
             qi[Q_NRING] -= 1
             _small_push(j, qt[j], small, where, qi)
             j = nx
-        if (qf[Q_OVF] - qf[Q_T0]) / qf[Q_W] < cur + nb:
+        if cur % (nb // 2) == 0:
+            # every half turn of the ring: overflow events were beyond cur + nb when
+            # placed, so none is due before the next half turn
             _redistribute_overflow(qt, qlink, where, small, heads, qi, qf)
     return int(small[0, 1])
 
