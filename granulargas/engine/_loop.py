@@ -14,21 +14,25 @@ current time only when it takes part in an event. The data a prediction reads
 for a neighbour sit in one 64-byte record per particle,
 ``rec[i] = (x, y, z, vx, vy, vz, t_i, R_i)``, so that one cache line serves it.
 
-Prefetching: events hit particles in random memory order, so at N >~ 10^5 an
-event waits mostly on cache misses (the particle's record and list row, then
-one record per neighbour). After each event the loop issues prefetch hints
-(:mod:`granulargas.engine._prefetch`, no effect on results) for the records of
-the next event's partner and neighbours, and for the record and list row of
-the earliest child of the heap root (the likely event after that), so these
-misses overlap with the current work. Measured (3D elastic, packing 0.3,
-interleaved with the plain loop on a shared 2-core machine): N = 10^5, median
-+15 % collisions per second over 10 pairs (faster in 9); N = 10^6, +18 % (one
-pair); N = 10^4 neutral.
+Memory: beyond the 1 MB L2 cache of the machines we measure on, every random
+access costs ~100-160 ns, so at N >~ 10^4 an event waits mostly on cache
+misses, and the design counts cache lines: the event calendar
+(:mod:`granulargas.engine._calendar`) updates in O(1) lines instead of a heap's
+O(log N) dependent misses; a list rebuild reads cell rows and centres in
+independent passes (:mod:`granulargas.engine._cells`); and after each event
+the loop issues prefetch hints (:mod:`granulargas.engine._prefetch`, no effect
+on results) for every per-particle row of the next event's particle and its
+partner, the records of its neighbours, and the rows of the likely event after
+it (the earliest child of the small heap's root), so that these misses overlap
+with the current work. Measured gains (``scripts/bench_engine.py``, elastic 3D,
+packing 0.3, N = 10^5, interleaved A/B runs): calendar and cell passes
+together +30 %, the wider prefetch +11 %; at N = 10^6 the calendar's overflow
+handling decides everything (see its module docstring).
 
 Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 0 reached ``until``; 1 event budget of this chunk used (call again);
-2 ``max_collisions`` reached; 10 a neighbour list is full (enlarge, call
-again: nothing was lost); 20 inelastic collapse (a particle collided
+2 ``max_collisions`` reached; 10 a neighbour list is full, 11 a cell is full
+(enlarge, call again: nothing was lost); 20 inelastic collapse (a particle collided
 ``collapse_count`` times in a row less than ``collapse_dt`` after its previous
 collision); 21 impact beyond the restitution table; 30 watchdog (an event in
 the past or an endless run of zero-time events: round-off trouble).

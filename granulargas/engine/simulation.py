@@ -4,7 +4,7 @@
 under way, a compiled internal state in *memory order*: particles sorted along
 a Morton (Z-order) curve of the cell grid so that neighbours sit close in
 memory. The internal state (list centres, neighbour lists, cells, one event per
-particle, heap) is built from the public state alone at the start of the first
+particle, event calendar) is built from the public state alone at the start of the first
 ``run`` after construction or :meth:`Simulation.synchronise`, which is what
 makes a restart from a file written at a synchronised time bit-identical to
 the uninterrupted run. The driver never loops over particles; between compiled

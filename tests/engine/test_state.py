@@ -140,3 +140,22 @@ def test_run_backwards_rejected():
     sim.run(1.0)
     with pytest.raises(ValueError):
         sim.run(0.5)
+
+
+def test_cells_grow_when_full():
+    """Cells cut to their current fullest occupancy overflow when a list centre moves in,
+    grow, and the trajectory is bit-identical to an undisturbed run."""
+    ref = make_sim(n=300, packing=0.05, seed=13)
+    sim = make_sim(n=300, packing=0.05, seed=13)
+    sim._cell_width = 1  # overflow in the first build
+    sim._build()
+    s = sim._s
+    w = int(s["cell_n"].max())
+    assert sim._cell_width > 1
+    s["cell_ids"] = np.ascontiguousarray(s["cell_ids"][:, :w])
+    sim._cell_width = w
+    sim.run(20.0)
+    ref.run(20.0)
+    assert sim._cell_width > w
+    assert check(sim) == []
+    np.testing.assert_array_equal(sim.positions, ref.positions)
