@@ -179,6 +179,25 @@ def _collect(i, x, y, z, ri, rmax, centre, rec, shell, box, ncell, cell_ids, cel
 
 
 @jit(inline="always")
+def prefetch_cells(x, y, z, box, ncell, cell_ids, cell_n):
+    """Prefetch hints for the cell rows a list rebuild around (x, y, z) will read.
+
+    (x, y, z) may lie up to shell/2 outside the box; cell_coord clamps it.
+    """
+    cx = cell_coord(x, box[0], ncell[0])
+    cy = cell_coord(y, box[1], ncell[1])
+    cz = cell_coord(z, box[2], ncell[2])
+    zr = 1 if ncell[2] >= 3 else 0
+    for oz in range(-zr, zr + 1):
+        kz = _wrap(cz + oz, ncell[2])
+        for oy in range(-1, 2):
+            row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
+            prefetch(cell_n, _wrap(cx, ncell[0]) + row)
+            for ox in range(-1, 2):
+                prefetch(cell_ids, _wrap(cx + ox, ncell[0]) + row)
+
+
+@jit(inline="always")
 def _wrap(c, n):
     if c < 0:
         return c + n

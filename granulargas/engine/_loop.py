@@ -41,7 +41,7 @@ the past or an endless run of zero-time events: round-off trouble).
 import math
 
 from granulargas._numba import jit
-from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, rebuild_list
+from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, prefetch_cells, rebuild_list
 from granulargas.engine._collide import restitution
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image
 from granulargas.engine._prefetch import prefetch
@@ -193,6 +193,8 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         j = partner[i]
         if j >= 0 and count[j] == pcount[i]:
             # ---- pair collision: validate, execute, re-predict both
+            for k in range(nbn[j]):  # j's list row is in cache: start the misses of predict(j)
+                prefetch(rec, nbl[j, k])
             stream(i, te, rec, img, box)
             stream(j, te, rec, img, box)
             dx = min_image(rec[i, 0] - rec[j, 0], box[0])
@@ -290,6 +292,11 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             if p1 >= 0:
                 _prefetch_particle(p1, rec, img, centre, mass, count, pcount, lastcoll, rapid,
                                    nbl, nbn, partner, qt, qlink, qwhere)
+            else:
+                prefetch_cells(rec[i1, 0] + rec[i1, 3] * (qt[i1] - rec[i1, 6]),
+                               rec[i1, 1] + rec[i1, 4] * (qt[i1] - rec[i1, 6]),
+                               rec[i1, 2] + rec[i1, 5] * (qt[i1] - rec[i1, 6]),
+                               box, ncell, cell_ids, cell_n)
             for k in range(nbn[i1]):
                 prefetch(rec, nbl[i1, k])
             prefetch(img, i1)
