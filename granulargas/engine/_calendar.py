@@ -51,14 +51,20 @@ def ring_size(n):
     return nb
 
 
-def allocate_calendar(n):
-    """Arrays of an empty calendar for n particles (fill ``qt``, then :func:`cal_build`)."""
+def allocate_calendar(n, capacity=None):
+    """Arrays of an empty calendar for n particles (fill ``qt``, then :func:`cal_build`).
+
+    ``capacity`` of the small heap: default max(1024, n / 16), some 10^3 times
+    what a window holds; when a window would overflow it, the calendar halves
+    its width and places all events anew (O(N), self-correcting).
+    """
     nb = ring_size(n)
+    cap = max(1024, n // 16) if capacity is None else int(capacity)
     return dict(
         qt=np.full(n, np.inf),
         qlink=np.full((n, 2), -1, dtype=np.int32),
         qwhere=np.zeros(n, dtype=np.int32),
-        small=np.zeros((n, 2)),
+        small=np.zeros((min(n, cap), 2)),
         heads=np.full(nb + 1, -1, dtype=np.int32),
         qi=np.array([0, 0, nb, 0], dtype=np.int64),
         qf=np.array([1.0, 0.0, np.inf]),
@@ -116,10 +122,13 @@ def _sift_down(small, where, k, n):
 @jit(inline="always")
 def _small_push(i, t, small, where, qi):
     k = qi[Q_SIZE]
+    if k >= small.shape[0]:
+        return False
     qi[Q_SIZE] = k + 1
     small[k, 0] = t
     small[k, 1] = i
     _sift_up(small, where, k)
+    return True
 
 
 @jit(inline="always")
@@ -167,8 +176,7 @@ def _insert(i, t, qt, qlink, where, small, heads, qi, qf):
     x = (t - qf[Q_T0]) / qf[Q_W]
     cur = qi[Q_CUR]
     if x < cur + 1:  # B(t) <= B_cur (also for round-off below t0)
-        _small_push(i, t, small, where, qi)
-        return
+        return _small_push(i, t, small, where, qi)
     nb = qi[Q_NB]
     if x < cur + nb:
         _link(i, int(x) % nb, qlink, heads, where)
@@ -177,26 +185,67 @@ def _insert(i, t, qt, qlink, where, small, heads, qi, qf):
         _link(i, nb, qlink, heads, where)
         if t < qf[Q_OVF]:
             qf[Q_OVF] = t
+    return True
+
+
+@jit
+def _place_all(t0, w, qt, qlink, where, small, heads, qi, qf):
+    """Empty the calendar and insert every event ``qt`` (windows from t0, width w).
+
+    Returns False if the first window overflows the small heap.
+    """
+    qf[Q_W] = w
+    qf[Q_T0] = t0
+    qf[Q_OVF] = math.inf
+    qi[Q_SIZE] = 0
+    qi[Q_CUR] = 0
+    qi[Q_NRING] = 0
+    for b in range(qi[Q_NB] + 1):
+        heads[b] = -1
+    for i in range(qt.shape[0]):
+        if not _insert(i, qt[i], qt, qlink, where, small, heads, qi, qf):
+            return False
+    return True
+
+
+@jit
+def _narrow(qt, qlink, where, small, heads, qi, qf):
+    """A window overflowed the small heap: halve w and place all events again.
+
+    ``qt`` holds every event time, so nothing is lost whatever state the lists
+    were left in. Returns False if even a tiny w cannot help (more simultaneous
+    events than the small heap holds).
+    """
+    t0 = qf[Q_T0] + qi[Q_CUR] * qf[Q_W]
+    w = qf[Q_W]
+    for _ in range(200):
+        w *= 0.5
+        if _place_all(t0, w, qt, qlink, where, small, heads, qi, qf):
+            return True
+    return False
 
 
 @jit
 def cal_update(i, t, qt, qlink, where, small, heads, qi, qf):
-    """Set the event time of particle i to t."""
+    """Set the event time of particle i to t. Returns False on failure (see :func:`_narrow`)."""
     wi = where[i]
     if wi < 0:
         k = -wi - 1
         if small[k, 0] > t or (t - qf[Q_T0]) / qf[Q_W] >= qi[Q_CUR] + 1:
             _small_remove(k, small, where, qi)
-            _insert(i, t, qt, qlink, where, small, heads, qi, qf)
+            if not _insert(i, t, qt, qlink, where, small, heads, qi, qf):
+                return _narrow(qt, qlink, where, small, heads, qi, qf)
         else:  # stays in the window: adjust in place
             small[k, 0] = t
             qt[i] = t
             _sift_down(small, where, k, qi[Q_SIZE])
-        return
+        return True
     _unlink(i, qlink, heads, where)
     if wi < qi[Q_NB]:
         qi[Q_NRING] -= 1
-    _insert(i, t, qt, qlink, where, small, heads, qi, qf)
+    if not _insert(i, t, qt, qlink, where, small, heads, qi, qf):
+        return _narrow(qt, qlink, where, small, heads, qi, qf)
+    return True
 
 
 @jit
@@ -207,45 +256,57 @@ def _redistribute_overflow(qt, qlink, where, small, heads, qi, qf):
     qf[Q_OVF] = math.inf
     while j >= 0:
         nx = qlink[j, 0]
-        _insert(j, qt[j], qt, qlink, where, small, heads, qi, qf)
+        if not _insert(j, qt[j], qt, qlink, where, small, heads, qi, qf):
+            return False
         j = nx
+    return True
 
 
 @jit
 def cal_peek(qt, qlink, where, small, heads, qi, qf):
-    """Particle with the earliest event (moving the window forward as needed); -1 if none.
+    """Particle with the earliest event (moving the window forward as needed).
 
     Its time is ``qt[result]``; every other event is at the same time or later.
+    Returns -1 if there is no event (all times inf), -2 on failure (see
+    :func:`_narrow`).
     """
     nb = qi[Q_NB]
     while qi[Q_SIZE] == 0:
+        ok = True
         if qi[Q_NRING] == 0:
             if qf[Q_OVF] == math.inf:
                 return -1
             # nothing in the ring: jump to the window before the earliest overflow event
             qi[Q_CUR] = int((qf[Q_OVF] - qf[Q_T0]) / qf[Q_W]) - 1
-            _redistribute_overflow(qt, qlink, where, small, heads, qi, qf)
-            continue
-        cur = qi[Q_CUR] + 1
-        qi[Q_CUR] = cur
-        slot = cur % nb
-        j = heads[slot]
-        heads[slot] = -1
-        while j >= 0:
-            nx = qlink[j, 0]
-            qi[Q_NRING] -= 1
-            _small_push(j, qt[j], small, where, qi)
-            j = nx
-        if cur % (nb // 2) == 0:
-            # every half turn of the ring: overflow events were beyond cur + nb when
-            # placed, so none is due before the next half turn
-            _redistribute_overflow(qt, qlink, where, small, heads, qi, qf)
+            ok = _redistribute_overflow(qt, qlink, where, small, heads, qi, qf)
+        else:
+            cur = qi[Q_CUR] + 1
+            qi[Q_CUR] = cur
+            slot = cur % nb
+            j = heads[slot]
+            heads[slot] = -1
+            while j >= 0:
+                nx = qlink[j, 0]
+                qi[Q_NRING] -= 1
+                if not _small_push(j, qt[j], small, where, qi):
+                    ok = False
+                    break
+                j = nx
+            if ok and cur % (nb // 2) == 0:
+                # every half turn of the ring: overflow events were beyond cur + nb when
+                # placed, so none is due before the next half turn
+                ok = _redistribute_overflow(qt, qlink, where, small, heads, qi, qf)
+        if not ok and not _narrow(qt, qlink, where, small, heads, qi, qf):
+            return -2
     return int(small[0, 1])
 
 
 @jit
 def cal_build(now, qt, qlink, where, small, heads, qi, qf):
-    """Place every particle's event ``qt`` anew (window starts at ``now``; w from the mean delay)."""
+    """Place every particle's event ``qt`` anew (window starts at ``now``; w from the mean delay).
+
+    Returns False on failure (see :func:`_narrow`).
+    """
     n = qt.shape[0]
     total = 0.0
     finite = 0
@@ -253,22 +314,17 @@ def cal_build(now, qt, qlink, where, small, heads, qi, qf):
         if qt[i] < math.inf:
             total += qt[i] - now
             finite += 1
-    nb = qi[Q_NB]
     w = 1.0
     if finite > 0 and total > 0.0:
         w = PER_WINDOW * (total / finite) / finite
     if not w > 0.0:
         w = 1.0
-    qf[Q_W] = w
-    qf[Q_T0] = now
-    qf[Q_OVF] = math.inf
-    qi[Q_SIZE] = 0
+    if _place_all(now, w, qt, qlink, where, small, heads, qi, qf):
+        return True
     qi[Q_CUR] = 0
-    qi[Q_NRING] = 0
-    for b in range(nb + 1):
-        heads[b] = -1
-    for i in range(n):
-        _insert(i, qt[i], qt, qlink, where, small, heads, qi, qf)
+    qf[Q_T0] = now
+    qf[Q_W] = w
+    return _narrow(qt, qlink, where, small, heads, qi, qf)
 
 
 @jit

@@ -35,7 +35,8 @@ Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 (enlarge, call again: nothing was lost); 20 inelastic collapse (a particle collided
 ``collapse_count`` times in a row less than ``collapse_dt`` after its previous
 collision); 21 impact beyond the restitution table; 30 watchdog (an event in
-the past or an endless run of zero-time events: round-off trouble).
+the past or an endless run of zero-time events: round-off trouble); 31 more
+simultaneous events than the event calendar's window holds.
 """
 
 import math
@@ -53,6 +54,7 @@ MAX_COLLISIONS = 2
 COLLAPSE = 20
 TABLE_RANGE = 21
 WATCHDOG = 30
+CALENDAR = 31
 
 # indices into the float and int scalar arrays
 S_TIME, S_DISSIPATED, S_VIRIAL, S_KIN_INT, S_SUM_MV2 = 0, 1, 2, 3, 4
@@ -170,6 +172,8 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             break
         i = cal_peek(qt, qlink, qwhere, small, heads, qi, qf)
         if i < 0:
+            if i == -2:
+                status = CALENDAR
             break
         te = qt[i]
         if te > until or te == math.inf:
@@ -255,11 +259,14 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
                 lastcoll[j] = te
                 tj = predict(j, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                              half_shell)
-                cal_update(j, tj, qt, qlink, qwhere, small, heads, qi, qf)
+                if not cal_update(j, tj, qt, qlink, qwhere, small, heads, qi, qf):
+                    status = CALENDAR
+                    break
                 if rapid[i] >= collapse_count or rapid[j] >= collapse_count:
                     ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                                  half_shell)
-                    cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf)
+                    if not cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf):
+                        status = CALENDAR
                     iscal[I_EVENTS] += 1
                     iscal[I_ERR_I] = i
                     iscal[I_ERR_J] = j
@@ -281,12 +288,17 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             stream(i, te, rec, img, box)
             iscal[I_STALE] += 1
         ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
-        cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf)
+        if not cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf):
+            status = CALENDAR
+            break
         iscal[I_EVENTS] += 1
         # ---- prefetch hints (no effect on results): the next event's partner and
         # neighbour records, and the rows of the likely event after it (the earliest
         # child of the root), so that their cache misses overlap with work
         i1 = cal_peek(qt, qlink, qwhere, small, heads, qi, qf)
+        if i1 == -2:
+            status = CALENDAR
+            break
         if i1 >= 0:
             p1 = partner[i1]
             if p1 >= 0:

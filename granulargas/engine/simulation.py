@@ -255,8 +255,10 @@ class Simulation:
         _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
                           s["partner"], s["pcount"], self._box3, 0.5 * self.shell * (1.0 - 1e-9),
                           s["qt"])
-        cal_build(self._time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"],
-                  s["qf"])
+        if not cal_build(self._time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"],
+                         s["qi"], s["qf"]):
+            raise SimulationError(f"event calendar overflow at t = {self._time:.12g}: more "
+                                  f"simultaneous events than its window holds")
         with np.errstate(over="ignore", under="ignore"):
             mv2 = float(np.sum(self._masses[:, None] * self._velocities**2))
         s["scal"] = np.array([self._time, self._dissipated, self._virial, self._kin_int, mv2])
@@ -324,8 +326,9 @@ class Simulation:
         fpar = np.array([eps, tc, pref, inv_h, self.shell, 1e-10 * scale, float(self._radii.max())])
         chunk = max(1_000_000, 2 * self.n)
         # a fresh calendar per call keeps its window width matched to the event rate
-        cal_build(self.time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"],
-                  s["qf"])
+        if not cal_build(self.time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"],
+                         s["qi"], s["qf"]):
+            self._raise(_loop.CALENDAR)
         while True:
             status = _loop.advance(
                 s["rec"], s["img"], s["centre"], s["mass"], s["count"],
@@ -370,6 +373,9 @@ class Simulation:
         if status == _loop.WATCHDOG:
             raise SimulationError(f"event-queue watchdog {where}: an event in the past or an endless "
                                   f"run of zero-time events")
+        if status == _loop.CALENDAR:
+            raise SimulationError(f"event calendar overflow {where}: more simultaneous events than "
+                                  f"its window holds ({self._s['small'].shape[0]})")
         raise SimulationError(f"engine status {status} {where}")
 
     def synchronise(self) -> "Simulation":

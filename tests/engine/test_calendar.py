@@ -51,3 +51,38 @@ def test_calendar_empty_ring_jumps_to_overflow():
     assert cal_peek(*_args(c)) == 3
     cal_update(3, math.inf, *_args(c))
     assert cal_peek(*_args(c)) == -1
+
+
+@pytest.mark.parametrize("capacity", [2, 5])
+def test_calendar_with_a_tiny_window_heap_narrows_and_stays_exact(capacity):
+    """A small heap far too small for the windows forces the halve-and-replace path."""
+    n = 400
+    rng = np.random.default_rng(capacity)
+    c = allocate_calendar(n, capacity=capacity)
+    now = 0.0
+    c["qt"][:] = rng.exponential(1.0, n)
+    assert cal_build(now, *_args(c))
+    assert cal_check(*_args(c))
+    w0 = c["qf"][0]
+    ref = c["qt"].copy()
+    for step in range(4000):
+        i = cal_peek(*_args(c))
+        assert i >= 0
+        k = int(np.argmin(ref))
+        assert ref[i] == ref[k]
+        now = ref[i]
+        for p in (i, int(rng.integers(n))):
+            t = now + rng.exponential(1.0) * (1e-3 if rng.random() < 0.3 else 1.0)
+            ref[p] = t
+            assert cal_update(p, t, *_args(c))
+    assert cal_check(*_args(c))
+    assert c["qf"][0] < w0  # it did narrow
+
+
+def test_calendar_reports_more_simultaneous_events_than_it_holds():
+    c = allocate_calendar(50, capacity=4)
+    c["qt"][:] = 1.0  # 50 events at the same time
+    if cal_build(0.0, *_args(c)):  # placed in a bucket: the failure comes when it is due
+        assert cal_peek(*_args(c)) == -2
+    c["qt"][:] = 0.0  # due at once
+    assert not cal_build(0.0, *_args(c))
