@@ -16,6 +16,12 @@ costs O(log N) dependent cache misses per update at large N; a calendar
   O(overflow) per ~N events). ``ovf_min`` (a lower bound after removals) lets
   an empty ring jump straight to the earliest overflow event.
 
+The small heap holds max(1024, N/16) nodes, some 10^3 windows' worth; if a
+window would overflow it (a sudden burst of simultaneous events), the width
+is halved and all events are placed anew from ``qt``, which always holds every
+event time (O(N), rare, self-correcting); only more simultaneous events than
+the small heap holds stop the run (status 31).
+
 ``where[i] >= 0`` is the ring slot (or ``nb`` for overflow) of particle i;
 ``where[i] < 0`` means it sits in the small heap at node ``-where[i] - 1``.
 Updating an event unlinks it (O(1)) and inserts it by its time (O(1), or
