@@ -16,7 +16,7 @@ costs O(log N) dependent cache misses per update at large N; a calendar
   O(overflow) per ~N events). ``ovf_min`` (a lower bound after removals) lets
   an empty ring jump straight to the earliest overflow event.
 
-The small heap holds max(1024, N/16) nodes, some 10^3 windows' worth; if a
+The small heap holds max(1024, N/16) nodes, at least ~20 windows' worth; if a
 window would overflow it (a sudden burst of simultaneous events), the width
 is halved and all events are placed anew from ``qt``, which always holds every
 event time (O(N), rare, self-correcting); only more simultaneous events than
@@ -31,8 +31,8 @@ small heap is non-empty. B(t) is monotone in t even in floating point, so an
 event in a later window is never earlier than one in the current window:
 the order of events is exact. The width w is chosen at :func:`cal_build` so that a
 window holds about ``PER_WINDOW`` events, from the mean event delay; the
-calendar is rebuilt (O(N)) at the start of each compiled chunk, which keeps w
-matched to a cooling gas. Ties are broken by heap node order, deterministically.
+calendar is rebuilt (O(N)) at the start of each ``Simulation.run`` call, which
+keeps w matched to a cooling gas. Ties are broken by heap node order, deterministically.
 
 Scalars: ``qi = [small size, B_cur, nb, events in the ring]``,
 ``qf = [w, t0, ovf_min]``.

@@ -262,3 +262,21 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
             out[m] = i
             m += 1
     return m
+
+
+@jit
+def distinct(values, m, seen, out):
+    """Distinct entries of values[:m] into out (first-occurrence order); returns their number.
+
+    ``seen`` (bool, N) must be all False on entry and is all False again on return.
+    """
+    u = 0
+    for k in range(m):
+        v = values[k]
+        if not seen[v]:
+            seen[v] = True
+            out[u] = v
+            u += 1
+    for k in range(u):
+        seen[out[k]] = False
+    return u

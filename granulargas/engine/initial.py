@@ -149,6 +149,8 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         for _ in range(int(sweeps)):
             do_sweep(radii * lam)
     buf = np.empty(max(64, 40 * n), dtype=np.int64)
+    uniq = np.empty(n, dtype=np.int64)
+    seen = np.zeros(n, dtype=np.bool_)
     grow = 0.05
     while lam < 1.0:
         if grow < 1e-4:
@@ -168,7 +170,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
                 continue
             kick = rng.uniform(0.5, 1.5, size=len(idx))
             m = mc.push_some(idx, r3, rad, box3, ncell, head, nxt, prv, cof, kick, buf)
-            idx = np.unique(buf[:m])
+            idx = np.sort(uniq[: mc.distinct(buf, m, seen, uniq)])  # = np.unique(buf[:m])
         if len(idx):  # stuck: undo, grow more gently
             r3[:] = saved
             mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
