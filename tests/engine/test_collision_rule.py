@@ -24,16 +24,24 @@ def linear_table(h=0.01, n=2000, c=C_LIN):
 
 
 def _pair(direction, g, ri, rj, mi, mj, tangential, rule):
-    """Spheres 0.1 apart along ``direction`` approaching at normal speed g."""
+    """Spheres that touch with contact normal ``direction`` at normal speed g.
+
+    They are placed back along their relative velocity by a distance 0.1, so
+    the contact is the first one whatever the tangential speed (a pair placed
+    0.1 apart along the normal with a large tangential speed would miss, and
+    could then circle the periodic box for ever without meeting).
+    """
     n = np.asarray(direction, float)
     n /= np.linalg.norm(n)
     t = np.cross(n, [0.3, -0.7, 0.2]) if len(n) == 3 else np.array([-n[1], n[0]])
     t /= np.linalg.norm(t)
     centre = np.full(len(n), 4.0)
-    pi = centre + 0.5 * (ri + rj + 0.1) * n
-    pj = centre - 0.5 * (ri + rj + 0.1) * n
     vi = -0.5 * g * n + tangential * t
     vj = 0.5 * g * n
+    u = vi - vj
+    rij = (ri + rj) * n - u * (0.1 / np.linalg.norm(u))
+    pi = centre + 0.5 * rij
+    pj = centre - 0.5 * rij
     return two_spheres(pi, pj, vi, vj, box=9.0, radii=(ri, rj), masses=(mi, mj), rule=rule)
 
 
