@@ -109,16 +109,6 @@ def slot_remove(i, cell_ids, cell_n, cell_of, slot_of):
 
 
 @jit(inline="always")
-def _wrap_cell(c, n, length):
-    """Periodic cell coordinate and the shift (0 or +-L) that brings its contents next to c."""
-    if c < 0:
-        return c + n, -length
-    if c >= n:
-        return c - n, length
-    return c, 0.0
-
-
-@jit(inline="always")
 def _collect(i, x, y, z, ri, rmax, centre, rec, shell, box, ncell, cell_ids, cell_n, scratch,
              stencil):
     """Particles j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
@@ -188,14 +178,10 @@ def prefetch_cells(x, y, z, box, ncell, cell_ids, cell_n):
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
-    zr = 1 if ncell[2] >= 3 else 0
-    for oz in range(-zr, zr + 1):
-        kz = _wrap(cz + oz, ncell[2])
-        for oy in range(-1, 2):
-            row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
-            prefetch(cell_n, _wrap(cx, ncell[0]) + row)
-            for ox in range(-1, 2):
-                prefetch(cell_ids, _wrap(cx + ox, ncell[0]) + row)
+    for k in range(stencil_size(ncell)):
+        c = stencil_cell(cx, cy, cz, k, ncell)
+        prefetch(cell_ids, c)
+        prefetch(cell_n, c)
 
 
 @jit(inline="always")
