@@ -111,8 +111,14 @@ def collision_budget(config: RunConfig) -> int:
 
 
 def _even(interval: float, end: float) -> np.ndarray:
+    """Multiples of ``interval`` up to ``end``, and ``end`` itself (exactly, last).
+
+    A multiple within round-off of ``end`` (27.5 / 200 * 200 = 27.500000000000004)
+    is dropped: ``end`` closes the list, so no target lies past it.
+    """
     k = np.arange(1, int(math.floor(end / interval * (1 + 1e-12))) + 1)
-    return np.append(k * interval, end)
+    t = k * interval
+    return np.append(t[t < end * (1 - 1e-12)], end)
 
 
 def output_schedule(config: RunConfig) -> Schedule:

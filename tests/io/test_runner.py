@@ -27,6 +27,16 @@ def test_schedule_log_spaced_from_mean_free_time(small_3d):
     assert set(np.round(np.arange(1, 17) * 0.25, 12)) <= set(np.round(s.targets, 12))
 
 
+@pytest.mark.parametrize("end", [27.5, 4.0, 0.3, 1e-3 * 7, 123.456])
+def test_schedule_never_passes_the_end_time(small_3d, end):
+    """27.5 / 200 * 200 = 27.500000000000004: the last target must be end_time itself."""
+    text = small_3d.replace("end_time = 4.0", f"end_time = {end!r}").replace(
+        "observables_interval = 0.25", "").replace("{out}", "x.h5")
+    s = output_schedule(parse_config(text, "x.toml"))
+    assert s.targets[-1] == end and np.all(s.targets[:-1] < end)
+    assert np.all(np.diff(s.targets) > 0)
+
+
 def test_mean_free_time_is_enskog():
     # 3D, eta = 0.1: omega = 4 sqrt(pi) chi n sigma^2 sqrt(T/m), n = 6 eta / pi, chi = (1 - eta/2)/(1 - eta)^3
     c = parse_config('[system]\npacking_fraction = 0.1\n[collision]\nmodel = "elastic"\n[run]\nend_time = 1.0', "x")
