@@ -124,11 +124,11 @@ def predict(i, t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell
         s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), box[0]),
                             min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), box[1]),
                             min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), box[2]),
-                            vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7],
-                            best - t)
-        if t + s < best:
-            best = t + s
-            p = j
+                            vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
+        tc = t + s
+        better = tc < best
+        best = tc if better else best
+        p = j if better else p
     partner[i] = p
     pcount[i] = count[p] if p >= 0 else 0
     return best
