@@ -176,8 +176,8 @@ def _unlink(i, qlink, heads, where):
         qlink[nx, 1] = pv
 
 
-@jit(inline="always")
-def _insert(i, t, qt, qlink, where, small, heads, qi, qf):
+def _insert_impl(i, t, qt, qlink, where, small, heads, qi, qf):
+    """Place the event of particle i at time t; False if the small heap is full."""
     qt[i] = t
     x = (t - qf[Q_T0]) / qf[Q_W]
     cur = qi[Q_CUR]
@@ -192,6 +192,12 @@ def _insert(i, t, qt, qlink, where, small, heads, qi, qf):
         if t < qf[Q_OVF]:
             qf[Q_OVF] = t
     return True
+
+
+# the hot path inlines it; the cold paths (rebuilds, overflow) share one compiled copy,
+# which keeps the first compile short
+_insert = jit(inline="always")(_insert_impl)
+_insert_call = jit(_insert_impl)
 
 
 @jit
@@ -209,7 +215,7 @@ def _place_all(t0, w, qt, qlink, where, small, heads, qi, qf):
     for b in range(qi[Q_NB] + 1):
         heads[b] = -1
     for i in range(qt.shape[0]):
-        if not _insert(i, qt[i], qt, qlink, where, small, heads, qi, qf):
+        if not _insert_call(i, qt[i], qt, qlink, where, small, heads, qi, qf):
             return False
     return True
 
@@ -237,18 +243,17 @@ def cal_update(i, t, qt, qlink, where, small, heads, qi, qf):
     wi = where[i]
     if wi < 0:
         k = -wi - 1
-        if small[k, 0] > t or (t - qf[Q_T0]) / qf[Q_W] >= qi[Q_CUR] + 1:
-            _small_remove(k, small, where, qi)
-            if not _insert(i, t, qt, qlink, where, small, heads, qi, qf):
-                return _narrow(qt, qlink, where, small, heads, qi, qf)
-        else:  # stays in the window: adjust in place
+        if small[k, 0] <= t and (t - qf[Q_T0]) / qf[Q_W] < qi[Q_CUR] + 1:
+            # stays in the window, later: adjust in place
             small[k, 0] = t
             qt[i] = t
             _sift_down(small, where, k, qi[Q_SIZE])
-        return True
-    _unlink(i, qlink, heads, where)
-    if wi < qi[Q_NB]:
-        qi[Q_NRING] -= 1
+            return True
+        _small_remove(k, small, where, qi)
+    else:
+        _unlink(i, qlink, heads, where)
+        if wi < qi[Q_NB]:
+            qi[Q_NRING] -= 1
     if not _insert(i, t, qt, qlink, where, small, heads, qi, qf):
         return _narrow(qt, qlink, where, small, heads, qi, qf)
     return True
@@ -262,7 +267,7 @@ def _redistribute_overflow(qt, qlink, where, small, heads, qi, qf):
     qf[Q_OVF] = math.inf
     while j >= 0:
         nx = qlink[j, 0]
-        if not _insert(j, qt[j], qt, qlink, where, small, heads, qi, qf):
+        if not _insert_call(j, qt[j], qt, qlink, where, small, heads, qi, qf):
             return False
         j = nx
     return True

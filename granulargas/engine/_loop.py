@@ -41,6 +41,8 @@ simultaneous events than the event calendar's window holds.
 
 import math
 
+import numpy as np
+
 from granulargas._numba import jit
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, prefetch_cells, rebuild_list
 from granulargas.engine._collide import restitution
@@ -194,7 +196,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             zero_advance = 0
         scal[S_KIN_INT] += scal[S_SUM_MV2] * (te - time)
         time = te
-        j = partner[i]
+        j = np.int64(partner[i])  # one signature for the callees (partner is int32)
         if j >= 0 and count[j] == pcount[i]:
             # ---- pair collision: validate, execute, re-predict both
             for k in range(nbn[j]):  # j's list row is in cache: start the misses of predict(j)
