@@ -24,10 +24,11 @@ the loop issues prefetch hints (:mod:`granulargas.engine._prefetch`, no effect
 on results) for every per-particle row of the next event's particle and its
 partner, the records of its neighbours, and the rows of the likely event after
 it (the earliest child of the small heap's root), so that these misses overlap
-with the current work. Measured gains (``scripts/bench_engine.py``, elastic 3D,
-packing 0.3, N = 10^5, interleaved A/B runs): calendar and cell passes
-together +30 %, the wider prefetch +11 %; at N = 10^6 the calendar's overflow
-handling decides everything (see its module docstring).
+with the current work. Measured gains (elastic 3D, packing 0.3, N = 10^5,
+adjacent runs on one core): calendar and cell passes together +20 % (0.19 ->
+0.23 M collisions/s), the wider prefetch +11 % (medians of 6 alternated A/B
+runs); at N = 10^6 the calendar's overflow handling decides everything (see
+its module docstring).
 
 Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 0 reached ``until``; 1 event budget of this chunk used (call again);
