@@ -161,46 +161,6 @@ def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
 
 
 @jit
-def relax_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, disp,
-               out):
-    """Overlap-relaxation moves of the particles ``idx`` (see :func:`relax_sweep`).
-
-    Writes the particles still involved in overlaps after the moves (with
-    repetitions) into ``out`` and returns their number.
-    """
-    m = 0
-    for k in range(idx.shape[0]):
-        i = idx[k]
-        old = overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
-                            cell_next)
-        if old == 0.0:
-            continue
-        x = r[i, 0] + step * disp[k, 0]
-        y = r[i, 1] + step * disp[k, 1]
-        z = r[i, 2] + step * disp[k, 2]
-        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
-        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
-        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
-        if x < box[0] and y < box[1] and z < box[2]:
-            new = overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next)
-            if new < old:
-                c = cell_index(x, y, z, box, ncell)
-                if c != cell_of[i]:
-                    cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
-                    cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
-                r[i, 0] = x
-                r[i, 1] = y
-                r[i, 2] = z
-        m0 = m
-        m = _overlap_partners(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
-                              cell_next, out, m)
-        if m > m0 and m < out.shape[0]:
-            out[m] = i
-            m += 1
-    return m
-
-
-@jit
 def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, kick, out):
     """Push each particle of ``idx`` out of its overlaps (Gauss-Seidel descent).
 
