@@ -255,16 +255,21 @@ class Simulation:
         _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
                           s["partner"], s["pcount"], self._box3, 0.5 * self.shell * (1.0 - 1e-9),
                           s["qt"])
-        if not cal_build(self._time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"],
-                         s["qi"], s["qf"]):
-            raise SimulationError(f"event calendar overflow at t = {self._time:.12g}: more "
-                                  f"simultaneous events than its window holds")
+        self._place_events(s, self._time)
         with np.errstate(over="ignore", under="ignore"):
             mv2 = float(np.sum(self._masses[:, None] * self._velocities**2))
         s["scal"] = np.array([self._time, self._dissipated, self._virial, self._kin_int, mv2])
         s["iscal"] = np.array([self._collisions, self._events, -1, -1, 0, 0], dtype=np.int64)
         self._s = s
         self._built = True
+
+    def _place_events(self, s, now):
+        """(Re)build the event calendar from the event times ``s["qt"]`` at time ``now``."""
+        if not cal_build(now, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"],
+                         s["qf"]):
+            raise SimulationError(f"event calendar overflow at t = {now:.12g}: more simultaneous "
+                                  f"events than its window holds ({s['small'].shape[0]})")
+        self._calendar_time = now
 
     def _grow_cells(self):
         s = self._s
@@ -325,10 +330,9 @@ class Simulation:
         scale = 2.0 * float(self._radii.min()) / math.sqrt(v2) if v2 > 0 else 1.0
         fpar = np.array([eps, tc, pref, inv_h, self.shell, 1e-10 * scale, float(self._radii.max())])
         chunk = max(1_000_000, 2 * self.n)
-        # a fresh calendar per call keeps its window width matched to the event rate
-        if not cal_build(self.time, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"],
-                         s["qi"], s["qf"]):
-            self._raise(_loop.CALENDAR)
+        if self._calendar_time != self.time:
+            # a fresh calendar per call keeps its window width matched to the event rate
+            self._place_events(s, self.time)
         while True:
             status = _loop.advance(
                 s["rec"], s["img"], s["centre"], s["mass"], s["count"],
