@@ -7,9 +7,12 @@ Usage::
 """
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 from granulargas.engine.initial import random_state
+from granulargas.errors import UserError
 
 DEFAULT = ["1e6:0.1:3", "1e6:0.3:3", "1e6:0.45:3", "1e6:0.7:2"]
 
@@ -19,9 +22,14 @@ def main(argv=None):
     p.add_argument("--cases", nargs="+", default=DEFAULT, help="N:packing:dimension")
     p.add_argument("--seed", type=int, default=1)
     args = p.parse_args(argv)
+    cases = []
     for case in args.cases:
-        n, eta, d = case.split(":")
-        n, eta, d = int(float(n)), float(eta), int(d)
+        try:
+            n, eta, d = case.split(":")
+            cases.append((int(float(n)), float(eta), int(d)))
+        except ValueError:
+            p.error(f"--cases {case!r}: expected N:packing:dimension, e.g. 1e6:0.45:3")
+    for n, eta, d in cases:
         random_state(500, eta, d, seed=0)  # compile (or load) the kernels first
         t0 = time.perf_counter()
         random_state(n, eta, d, seed=args.seed)
@@ -29,4 +37,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except UserError as err:
+        sys.exit(f"{Path(__file__).name}: {err}")

@@ -12,12 +12,15 @@ Usage::
 
 import argparse
 import resource
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.engine.initial import random_state
+from granulargas.errors import UserError
 
 
 def _peak_gb():
@@ -48,4 +51,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    try:
+        main()
+    except UserError as err:
+        sys.exit(f"{Path(__file__).name}: {err}")
