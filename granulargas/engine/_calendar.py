@@ -8,33 +8,50 @@ costs O(log N) dependent cache misses per update at large N; a calendar
 * time is cut into windows of width w, numbered B(t) = floor((t - t0) / w);
   the events of the *current window* (all with B(t) <= B_cur) sit in a small
   4-ary min-heap ``small`` of (time, id) nodes (a few dozen events, in cache);
-* the next ``nb - 1`` windows are *buckets*: unsorted doubly linked lists
-  (``qlink[i] = (next, prev)``, heads in ``heads``), in a ring (slot B mod nb);
-* events beyond the ring wait in an *overflow* list (``heads[nb]``), which is
+* the next ``nb - 1`` windows are *buckets* in a ring (slot B mod nb);
+* events beyond the ring wait in an *overflow* bucket (slot ``nb``), which is
   redistributed every half turn of the ring (an overflow event lies at least
   one full turn ahead when placed, so none falls due in between; the cost is
   O(overflow) per ~N events). ``ovf_min`` (a lower bound after removals) lets
   an empty ring jump straight to the earliest overflow event.
 
+A bucket is an unsorted stack of *chunks*, rows of ``chunks`` (next chunk,
+then up to CHUNK - 1 particle ids), taken from a free list; ``buckets[b]`` =
+(newest chunk, ids in it). Placing an event appends its id (one store, into a
+line that recent appends to the same bucket keep in cache); moving an event
+does not touch the old bucket at all (*lazy deletion*): ``where[i]`` says where
+the event of i lives now, and an id met in bucket b counts only if
+``where[id] == b``. (A particle that left b and came back has two entries;
+the first moves it to the heap, which sets ``where``, so the second is
+skipped.) An entry can be stale only until its bucket is emptied, one turn
+at most, when its chunks return to the free list. Compared with doubly
+linked lists threaded through the particles, this avoids the three stores
+into other particles' rows per update and, when a window opens, the chain
+of dependent misses: its ids are read in sequence and their ``qt``/``where``
+rows are prefetched together.
+
 The small heap holds max(1024, N/16) nodes, at least ~20 windows' worth; if a
 window would overflow it (a sudden burst of simultaneous events), the width
 is halved and all events are placed anew from ``qt``, which always holds every
 event time (O(N), rare, self-correcting); only more simultaneous events than
-the small heap holds stop the run (status 31).
+the small heap holds stop the run (status 31). If the chunk pool runs dry
+(stale entries pile up), all events are placed anew at the same width, which
+keeps only live entries; the pool (N/(CHUNK-1) chunks for live entries, one
+partly filled chunk per bucket, and as many again for stale ones) always
+suffices for that.
 
 ``where[i] >= 0`` is the ring slot (or ``nb`` for overflow) of particle i;
 ``where[i] < 0`` means it sits in the small heap at node ``-where[i] - 1``.
-Updating an event unlinks it (O(1)) and inserts it by its time (O(1), or
-O(log m) in the small heap of m events). Taking the earliest event moves the
-window forward, emptying one bucket into the small heap per step, until the
-small heap is non-empty. B(t) is monotone in t even in floating point, so an
-event in a later window is never earlier than one in the current window:
-the order of events is exact. The width w is chosen at :func:`cal_build` so that a
-window holds about ``PER_WINDOW`` events, from the mean event delay; the
-calendar is rebuilt (O(N)) at the start of each ``Simulation.run`` call, which
-keeps w matched to a cooling gas. Ties are broken by heap node order, deterministically.
+Taking the earliest event moves the window forward, emptying one bucket into
+the small heap per step, until the small heap is non-empty. B(t) is monotone
+in t even in floating point, so an event in a later window is never earlier
+than one in the current window: the order of events is exact. The width w is
+chosen at :func:`cal_build` so that a window holds about ``PER_WINDOW``
+events, from the mean event delay; the calendar is rebuilt (O(N)) at the
+start of each ``Simulation.run`` call, which keeps w matched to a cooling
+gas. Ties are broken by heap node order, deterministically.
 
-Scalars: ``qi = [small size, B_cur, nb, events in the ring]``,
+Scalars: ``qi = [small size, B_cur, nb, live events in the ring, free chunk]``,
 ``qf = [w, t0, ovf_min]``.
 """
 
@@ -43,36 +60,50 @@ import math
 import numpy as np
 
 from granulargas._numba import jit
+from granulargas.engine._prefetch import prefetch
 
 PER_WINDOW = 48
-Q_SIZE, Q_CUR, Q_NB, Q_NRING = 0, 1, 2, 3
+CHUNK = 8  # int32 per chunk row: next chunk + 7 ids (32 bytes)
+Q_SIZE, Q_CUR, Q_NB, Q_NRING, Q_FREE = 0, 1, 2, 3, 4
 Q_W, Q_T0, Q_OVF = 0, 1, 2
 
 
 def ring_size(n):
-    """Number of ring slots for n particles (a power of two, ~8 mean delays)."""
+    """Number of ring slots for n particles (a power of two, ~4-8 mean delays)."""
     nb = 64
-    while nb < 8 * n // PER_WINDOW + 2:
+    while 2 * nb <= 8 * n // PER_WINDOW + 2:
         nb *= 2
     return nb
 
 
-def allocate_calendar(n, capacity=None):
+def pool_size(n, nb):
+    """Chunks for n live entries plus one partial chunk per bucket, and as many for stale entries."""
+    live = -(-n // (CHUNK - 1))
+    return 2 * live + nb + 1
+
+
+def allocate_calendar(n, capacity=None, pool=None):
     """Arrays of an empty calendar for n particles (fill ``qt``, then :func:`cal_build`).
 
     ``capacity`` of the small heap: default max(1024, n / 16), some 10^3 times
     what a window holds; when a window would overflow it, the calendar halves
-    its width and places all events anew (O(N), self-correcting).
+    its width and places all events anew (O(N), self-correcting). ``pool``:
+    number of chunks (default :func:`pool_size`; never below what n live
+    entries need, so that placing all events anew always succeeds).
     """
     nb = ring_size(n)
     cap = max(1024, n // 16) if capacity is None else int(capacity)
+    need = -(-n // (CHUNK - 1)) + nb + 1
+    chunks = pool_size(n, nb) if pool is None else max(int(pool), need)
+    buf = np.empty(chunks * CHUNK + 16, dtype=np.int32)
+    offset = (-buf.ctypes.data % 32) // 4
     return dict(
         qt=np.full(n, np.inf),
-        qlink=np.full((n, 2), -1, dtype=np.int32),
+        chunks=buf[offset : offset + chunks * CHUNK].reshape(chunks, CHUNK),
         qwhere=np.zeros(n, dtype=np.int32),
         small=np.zeros((min(n, cap), 2)),
-        heads=np.full(nb + 1, -1, dtype=np.int32),
-        qi=np.array([0, 0, nb, 0], dtype=np.int64),
+        buckets=np.zeros((nb + 1, 2), dtype=np.int32),
+        qi=np.array([0, 0, nb, 0, -1], dtype=np.int64),
         qf=np.array([1.0, 0.0, np.inf]),
     )
 
@@ -154,44 +185,53 @@ def _small_remove(k, small, where, qi):
 
 # -------------------------------------------------------------------- buckets
 @jit(inline="always")
-def _link(i, b, qlink, heads, where):
-    h = heads[b]
-    qlink[i, 0] = h
-    qlink[i, 1] = -1
-    if h >= 0:
-        qlink[h, 1] = i
-    heads[b] = i
+def _append(i, b, chunks, buckets, where, qi):
+    """Put id i into bucket b; False if the chunk pool is empty."""
+    c = buckets[b, 0]
+    f = buckets[b, 1]
+    if c < 0 or f == CHUNK - 1:
+        nc = qi[Q_FREE]
+        if nc < 0:
+            return False
+        qi[Q_FREE] = chunks[nc, 0]
+        chunks[nc, 0] = c
+        c = nc
+        f = 0
+        buckets[b, 0] = c
+    chunks[c, 1 + f] = i
+    buckets[b, 1] = f + 1
     where[i] = b
+    return True
 
 
 @jit(inline="always")
-def _unlink(i, qlink, heads, where):
-    nx = qlink[i, 0]
-    pv = qlink[i, 1]
-    if pv >= 0:
-        qlink[pv, 0] = nx
-    else:
-        heads[where[i]] = nx
-    if nx >= 0:
-        qlink[nx, 1] = pv
+def _release(c, chunks, qi):
+    chunks[c, 0] = qi[Q_FREE]
+    qi[Q_FREE] = c
 
 
-def _insert_impl(i, t, qt, qlink, where, small, heads, qi, qf):
-    """Place the event of particle i at time t; False if the small heap is full."""
+# insert status
+_OK, _HEAP_FULL, _POOL_EMPTY = 0, 1, 2
+
+
+def _insert_impl(i, t, qt, chunks, where, small, buckets, qi, qf):
+    """Place the event of particle i at time t; returns _OK, _HEAP_FULL or _POOL_EMPTY."""
     qt[i] = t
     x = (t - qf[Q_T0]) / qf[Q_W]
     cur = qi[Q_CUR]
     if x < cur + 1:  # B(t) <= B_cur (also for round-off below t0)
-        return _small_push(i, t, small, where, qi)
+        return _OK if _small_push(i, t, small, where, qi) else _HEAP_FULL
     nb = qi[Q_NB]
     if x < cur + nb:
-        _link(i, int(x) % nb, qlink, heads, where)
+        if not _append(i, int(x) & (nb - 1), chunks, buckets, where, qi):
+            return _POOL_EMPTY
         qi[Q_NRING] += 1
     else:
-        _link(i, nb, qlink, heads, where)
+        if not _append(i, nb, chunks, buckets, where, qi):
+            return _POOL_EMPTY
         if t < qf[Q_OVF]:
             qf[Q_OVF] = t
-    return True
+    return _OK
 
 
 # the hot path inlines it; the cold paths (rebuilds, overflow) share one compiled copy,
@@ -201,10 +241,11 @@ _insert_call = jit(_insert_impl)
 
 
 @jit
-def _place_all(t0, w, qt, qlink, where, small, heads, qi, qf):
+def _place_all(t0, w, qt, chunks, where, small, buckets, qi, qf):
     """Empty the calendar and insert every event ``qt`` (windows from t0, width w).
 
-    Returns False if the first window overflows the small heap.
+    Returns False if the first window overflows the small heap (the pool
+    always suffices for live entries alone).
     """
     qf[Q_W] = w
     qf[Q_T0] = t0
@@ -213,33 +254,41 @@ def _place_all(t0, w, qt, qlink, where, small, heads, qi, qf):
     qi[Q_CUR] = 0
     qi[Q_NRING] = 0
     for b in range(qi[Q_NB] + 1):
-        heads[b] = -1
+        buckets[b, 0] = -1
+        buckets[b, 1] = 0
+    m = chunks.shape[0]
+    for c in range(m):
+        chunks[c, 0] = c + 1 if c + 1 < m else -1
+    qi[Q_FREE] = 0
     for i in range(qt.shape[0]):
-        if not _insert_call(i, qt[i], qt, qlink, where, small, heads, qi, qf):
+        if _insert_call(i, qt[i], qt, chunks, where, small, buckets, qi, qf) != _OK:
             return False
     return True
 
 
 @jit
-def _narrow(qt, qlink, where, small, heads, qi, qf):
-    """A window overflowed the small heap: halve w and place all events again.
+def _replace(narrow, qt, chunks, where, small, buckets, qi, qf):
+    """Place all events anew from ``qt`` (which always holds every event time).
 
-    ``qt`` holds every event time, so nothing is lost whatever state the lists
-    were left in. Returns False if even a tiny w cannot help (more simultaneous
-    events than the small heap holds).
+    With ``narrow`` (a window overflowed the small heap) the width is halved
+    first, and again until the first window fits; otherwise (the chunk pool ran
+    dry) the width stays and only live entries are kept. Returns False if even a
+    tiny w cannot help (more simultaneous events than the small heap holds).
     """
     t0 = qf[Q_T0] + qi[Q_CUR] * qf[Q_W]
     w = qf[Q_W]
+    if not narrow and _place_all(t0, w, qt, chunks, where, small, buckets, qi, qf):
+        return True
     for _ in range(200):
         w *= 0.5
-        if _place_all(t0, w, qt, qlink, where, small, heads, qi, qf):
+        if _place_all(t0, w, qt, chunks, where, small, buckets, qi, qf):
             return True
     return False
 
 
 @jit
-def cal_update(i, t, qt, qlink, where, small, heads, qi, qf):
-    """Set the event time of particle i to t. Returns False on failure (see :func:`_narrow`)."""
+def cal_update(i, t, qt, chunks, where, small, buckets, qi, qf):
+    """Set the event time of particle i to t. Returns False on failure (see :func:`_replace`)."""
     wi = where[i]
     if wi < 0:
         k = -wi - 1
@@ -250,73 +299,103 @@ def cal_update(i, t, qt, qlink, where, small, heads, qi, qf):
             _sift_down(small, where, k, qi[Q_SIZE])
             return True
         _small_remove(k, small, where, qi)
-    else:
-        _unlink(i, qlink, heads, where)
-        if wi < qi[Q_NB]:
-            qi[Q_NRING] -= 1
-    if not _insert(i, t, qt, qlink, where, small, heads, qi, qf):
-        return _narrow(qt, qlink, where, small, heads, qi, qf)
+    elif wi < qi[Q_NB]:
+        qi[Q_NRING] -= 1  # its old entry goes stale (lazy deletion)
+    st = _insert(i, t, qt, chunks, where, small, buckets, qi, qf)
+    if st != _OK:
+        return _replace(st == _HEAP_FULL, qt, chunks, where, small, buckets, qi, qf)
     return True
 
 
 @jit
-def _redistribute_overflow(qt, qlink, where, small, heads, qi, qf):
+def _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf):
+    """Place the live overflow events anew; returns an insert status (_OK or the failure)."""
     nb = qi[Q_NB]
-    j = heads[nb]
-    heads[nb] = -1
+    c = buckets[nb, 0]
+    f = buckets[nb, 1]
+    buckets[nb, 0] = -1
+    buckets[nb, 1] = 0
     qf[Q_OVF] = math.inf
-    while j >= 0:
-        nx = qlink[j, 0]
-        if not _insert_call(j, qt[j], qt, qlink, where, small, heads, qi, qf):
-            return False
-        j = nx
+    while c >= 0:
+        nx = chunks[c, 0]
+        for q in range(1, f + 1):
+            j = chunks[c, q]
+            if where[j] == nb:
+                where[j] = -1 - qt.shape[0]  # in transit: a second entry of j is skipped
+                st = _insert_call(j, qt[j], qt, chunks, where, small, buckets, qi, qf)
+                if st != _OK:
+                    return st
+        _release(c, chunks, qi)
+        c = nx
+        f = CHUNK - 1
+    return _OK
+
+
+@jit(inline="always")
+def _open_bucket(slot, qt, chunks, where, small, buckets, qi):
+    """Move the live events of ring bucket ``slot`` into the small heap; False if it fills."""
+    c = buckets[slot, 0]
+    f = buckets[slot, 1]
+    buckets[slot, 0] = -1
+    buckets[slot, 1] = 0
+    while c >= 0:
+        nx = chunks[c, 0]
+        for q in range(1, f + 1):
+            j = chunks[c, q]
+            prefetch(qt, j)
+            prefetch(where, j)
+        if nx >= 0:
+            prefetch(chunks, nx)
+        for q in range(1, f + 1):
+            j = chunks[c, q]
+            if where[j] == slot:
+                qi[Q_NRING] -= 1
+                if not _small_push(j, qt[j], small, where, qi):
+                    return False
+        _release(c, chunks, qi)
+        c = nx
+        f = CHUNK - 1
     return True
 
 
 @jit
-def cal_peek(qt, qlink, where, small, heads, qi, qf):
+def cal_peek(qt, chunks, where, small, buckets, qi, qf):
     """Particle with the earliest event (moving the window forward as needed).
 
     Its time is ``qt[result]``; every other event is at the same time or later.
     Returns -1 if there is no event (all times inf), -2 on failure (see
-    :func:`_narrow`).
+    :func:`_replace`).
     """
     nb = qi[Q_NB]
     while qi[Q_SIZE] == 0:
-        ok = True
+        st = _OK
         if qi[Q_NRING] == 0:
             if qf[Q_OVF] == math.inf:
                 return -1
-            # nothing in the ring: jump to the window before the earliest overflow event
+            # nothing live in the ring: jump to the window before the earliest overflow
+            # event (stale entries left in the ring are skipped when their bucket opens)
             qi[Q_CUR] = int((qf[Q_OVF] - qf[Q_T0]) / qf[Q_W]) - 1
-            ok = _redistribute_overflow(qt, qlink, where, small, heads, qi, qf)
+            st = _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf)
         else:
             cur = qi[Q_CUR] + 1
             qi[Q_CUR] = cur
-            slot = cur % nb
-            j = heads[slot]
-            heads[slot] = -1
-            while j >= 0:
-                nx = qlink[j, 0]
-                qi[Q_NRING] -= 1
-                if not _small_push(j, qt[j], small, where, qi):
-                    ok = False
-                    break
-                j = nx
-            if ok and cur % (nb // 2) == 0:
+            if not _open_bucket(cur & (nb - 1), qt, chunks, where, small, buckets, qi):
+                st = _HEAP_FULL
+            elif cur & (nb // 2 - 1) == 0:
                 # every half turn of the ring: overflow events were beyond cur + nb when
                 # placed, so none is due before the next half turn
-                ok = _redistribute_overflow(qt, qlink, where, small, heads, qi, qf)
-        if not ok and not _narrow(qt, qlink, where, small, heads, qi, qf):
+                st = _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf)
+        if st != _OK and not _replace(st == _HEAP_FULL, qt, chunks, where, small, buckets, qi,
+                                      qf):
             return -2
     return int(small[0, 1])
 
 
 @jit
-def cal_build(now, qt, qlink, where, small, heads, qi, qf):
+def cal_build(now, qt, chunks, where, small, buckets, qi, qf):
     """Place every particle's event ``qt`` anew (window starts at ``now``; w from the mean delay).
 
-    Returns False on failure (see :func:`_narrow`).
+    Returns False on failure (see :func:`_replace`).
     """
     n = qt.shape[0]
     total = 0.0
@@ -330,17 +409,17 @@ def cal_build(now, qt, qlink, where, small, heads, qi, qf):
         w = PER_WINDOW * (total / finite) / finite
     if not w > 0.0:
         w = 1.0
-    if _place_all(now, w, qt, qlink, where, small, heads, qi, qf):
+    if _place_all(now, w, qt, chunks, where, small, buckets, qi, qf):
         return True
     qi[Q_CUR] = 0
     qf[Q_T0] = now
     qf[Q_W] = w
-    return _narrow(qt, qlink, where, small, heads, qi, qf)
+    return _replace(True, qt, chunks, where, small, buckets, qi, qf)
 
 
 @jit
-def cal_check(qt, qlink, where, small, heads, qi, qf):
-    """Invariant checker: True if every event sits where its time says."""
+def cal_check(qt, chunks, where, small, buckets, qi, qf):
+    """Invariant checker: True if every event sits where its time says and no chunk is lost."""
     n = qt.shape[0]
     nb = qi[Q_NB]
     size = qi[Q_SIZE]
@@ -353,22 +432,42 @@ def cal_check(qt, qlink, where, small, heads, qi, qf):
             return False
         if k > 0 and small[(k - 1) >> 2, 0] > small[k, 0]:
             return False
-    seen = 0
-    ring = 0
+    found = np.zeros(n, dtype=np.bool_)
+    used = 0
     for b in range(nb + 1):
-        j = heads[b]
-        prev = -1
-        while j >= 0:
-            x = (qt[j] - qf[Q_T0]) / qf[Q_W]
-            if where[j] != b or qlink[j, 1] != prev or x < cur + 1:
+        c = buckets[b, 0]
+        f = buckets[b, 1]
+        while c >= 0:
+            used += 1
+            for q in range(1, f + 1):
+                j = chunks[c, q]
+                if where[j] == b:
+                    found[j] = True
+            c = chunks[c, 0]
+            f = CHUNK - 1
+    free = 0
+    c = qi[Q_FREE]
+    while c >= 0 and free <= chunks.shape[0]:
+        free += 1
+        c = chunks[c, 0]
+    if used + free != chunks.shape[0]:
+        return False
+    ring = 0
+    for i in range(n):
+        b = where[i]
+        if b < 0:
+            if b < -size:
                 return False
-            if b < nb:
-                if x >= cur + nb or int(x) % nb != b:
-                    return False
-                ring += 1
-            elif qt[j] < qf[Q_OVF]:
+            continue
+        if b > nb or not found[i]:
+            return False
+        x = (qt[i] - qf[Q_T0]) / qf[Q_W]
+        if x < cur + 1:
+            return False
+        if b < nb:
+            if x >= cur + nb or (int(x) & (nb - 1)) != b:
                 return False
-            seen += 1
-            prev = j
-            j = qlink[j, 0]
-    return seen + size == n and ring == qi[Q_NRING]
+            ring += 1
+        elif qt[i] < qf[Q_OVF]:
+            return False
+    return ring == qi[Q_NRING]

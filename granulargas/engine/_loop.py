@@ -86,7 +86,7 @@ def stream(i, t, rec, img, box):
 
 @jit(inline="always")
 def _prefetch_particle(i, rec, img, centre, mass, count, pcount, lastcoll, rapid, nbl, nbn,
-                       partner, qt, qlink, qwhere):
+                       partner, qt, qwhere):
     """Prefetch hints for every per-particle row an event of particle i touches."""
     prefetch(rec, i)
     prefetch(img, i)
@@ -100,7 +100,6 @@ def _prefetch_particle(i, rec, img, centre, mass, count, pcount, lastcoll, rapid
     prefetch(nbn, i)
     prefetch(partner, i)
     prefetch(qt, i)
-    prefetch(qlink, i)
     prefetch(qwhere, i)
 
 
@@ -146,8 +145,8 @@ def predict_all(t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shel
 
 @jit
 def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
-            nbl, nbn, scratch, stencil, cell_ids, cell_n, cell_of, slot_of,
-            qt, qlink, qwhere, small, heads, qi, qf,
+            nbl, nbn, scratch, stencil, cell_ids, cell_n, cell_of,
+            qt, chunks, qwhere, small, buckets, qi, qf,
             box, ncell, kind, fpar, coeffs, collapse_count, until, max_events, max_collisions,
             scal, iscal):
     """Process events in time order until ``until`` (or a budget); see module doc.
@@ -173,7 +172,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         if iscal[I_EVENTS] >= events_end:
             status = BUDGET
             break
-        i = cal_peek(qt, qlink, qwhere, small, heads, qi, qf)
+        i = cal_peek(qt, chunks, qwhere, small, buckets, qi, qf)
         if i < 0:
             if i == -2:
                 status = CALENDAR
@@ -262,13 +261,13 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
                 lastcoll[j] = te
                 tj = predict(j, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                              half_shell)
-                if not cal_update(j, tj, qt, qlink, qwhere, small, heads, qi, qf):
+                if not cal_update(j, tj, qt, chunks, qwhere, small, buckets, qi, qf):
                     status = CALENDAR
                     break
                 if rapid[i] >= collapse_count or rapid[j] >= collapse_count:
                     ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box,
                                  half_shell)
-                    if not cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf):
+                    if not cal_update(i, ti, qt, chunks, qwhere, small, buckets, qi, qf):
                         status = CALENDAR
                     iscal[I_EVENTS] += 1
                     iscal[I_ERR_I] = i
@@ -279,7 +278,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             # ---- list expiry: new centre and list for i
             stream(i, te, rec, img, box)
             st = rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell_of,
-                              slot_of, nbl, nbn, scratch, stencil)
+                              nbl, nbn, scratch, stencil)
             if st != 0:
                 iscal[I_ERR_I] = i
                 iscal[I_ERR_J] = -1
@@ -291,14 +290,14 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             stream(i, te, rec, img, box)
             iscal[I_STALE] += 1
         ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
-        if not cal_update(i, ti, qt, qlink, qwhere, small, heads, qi, qf):
+        if not cal_update(i, ti, qt, chunks, qwhere, small, buckets, qi, qf):
             status = CALENDAR
             break
         iscal[I_EVENTS] += 1
         # ---- prefetch hints (no effect on results): the next event's partner and
         # neighbour records, and the rows of the likely event after it (the earliest
         # child of the root), so that their cache misses overlap with work
-        i1 = cal_peek(qt, qlink, qwhere, small, heads, qi, qf)
+        i1 = cal_peek(qt, chunks, qwhere, small, buckets, qi, qf)
         if i1 == -2:
             status = CALENDAR
             break
@@ -306,7 +305,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             p1 = partner[i1]
             if p1 >= 0:
                 _prefetch_particle(p1, rec, img, centre, mass, count, pcount, lastcoll, rapid,
-                                   nbl, nbn, partner, qt, qlink, qwhere)
+                                   nbl, nbn, partner, qt, qwhere)
             else:
                 prefetch_cells(rec[i1, 0] + rec[i1, 3] * (qt[i1] - rec[i1, 6]),
                                rec[i1, 1] + rec[i1, 4] * (qt[i1] - rec[i1, 6]),
@@ -319,7 +318,6 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             prefetch(lastcoll, i1)
             prefetch(rapid, i1)
             prefetch(count, i1)
-            prefetch(qlink, i1)
             prefetch(qwhere, i1)
             size = qi[0]
             if size > 1:

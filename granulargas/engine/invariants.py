@@ -27,7 +27,7 @@ def check(sim, overlap_tol: float = 1e-9) -> list[str]:
     box = sim._box3
     t = float(s["scal"][0])
     problems = []
-    if not cal_check(s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"], s["qf"]):
+    if not cal_check(s["qt"], s["chunks"], s["qwhere"], s["small"], s["buckets"], s["qi"], s["qf"]):
         problems.append("event calendar broken")
     rec = s["rec"]
     r = rec[:, :3] + rec[:, 3:6] * (t - rec[:, 6])[:, None]

@@ -229,14 +229,13 @@ class Simulation:
         ncells = int(np.prod(self._ncell))
         s["cell_n"] = np.zeros(ncells, dtype=np.int32)
         s["cell_of"] = np.empty(n, dtype=np.int32)
-        s["slot_of"] = np.empty(n, dtype=np.int32)
         s["nbn"] = np.zeros(n, dtype=np.int32)
         pos = np.ascontiguousarray(rec[:, :3])
         while True:
             s["nbl"] = np.empty((n, self._nb_width), dtype=np.int32)
             s["cell_ids"] = _aligned_int_rows(ncells, self._cell_width)
             st = build_all_lists(pos, s["centre"], rec, self.shell, self._box3, self._ncell,
-                                 s["cell_ids"], s["cell_n"], s["cell_of"], s["slot_of"],
+                                 s["cell_ids"], s["cell_n"], s["cell_of"],
                                  s["nbl"], s["nbn"])
             if st == OVERFLOW:
                 self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
@@ -265,7 +264,7 @@ class Simulation:
 
     def _place_events(self, s, now):
         """(Re)build the event calendar from the event times ``s["qt"]`` at time ``now``."""
-        if not cal_build(now, s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"],
+        if not cal_build(now, s["qt"], s["chunks"], s["qwhere"], s["small"], s["buckets"], s["qi"],
                          s["qf"]):
             raise SimulationError(f"event calendar overflow at t = {now:.12g}: more simultaneous "
                                   f"events than its window holds ({s['small'].shape[0]})")
@@ -338,8 +337,8 @@ class Simulation:
                 s["rec"], s["img"], s["centre"], s["mass"], s["count"],
                 s["partner"], s["pcount"], s["lastcoll"], s["rapid"], s["nbl"], s["nbn"], s["scratch"],
                 s["stencil"],
-                s["cell_ids"], s["cell_n"], s["cell_of"], s["slot_of"],
-                s["qt"], s["qlink"], s["qwhere"], s["small"], s["heads"], s["qi"], s["qf"], self._box3, self._ncell, kind, fpar, coeffs,
+                s["cell_ids"], s["cell_n"], s["cell_of"],
+                s["qt"], s["chunks"], s["qwhere"], s["small"], s["buckets"], s["qi"], s["qf"], self._box3, self._ncell, kind, fpar, coeffs,
                 self.collapse_count, until, chunk, target, s["scal"], s["iscal"])
             if status == _loop.BUDGET:
                 if progress is not None:

@@ -9,7 +9,7 @@ from granulargas.engine._calendar import allocate_calendar, cal_build, cal_check
 
 
 def _args(c):
-    return c["qt"], c["qlink"], c["qwhere"], c["small"], c["heads"], c["qi"], c["qf"]
+    return c["qt"], c["chunks"], c["qwhere"], c["small"], c["buckets"], c["qi"], c["qf"]
 
 
 @pytest.mark.parametrize("n, spread", [(5, 1.0), (300, 1.0), (2000, 1e-3), (1000, 1e6)])
