@@ -31,14 +31,15 @@ def check(sim, overlap_tol: float = 1e-9) -> list[str]:
         problems.append("event calendar broken")
     rec = s["rec"]
     r = rec[:, :3] + rec[:, 3:6] * (t - rec[:, 6])[:, None]
-    off = np.linalg.norm(_min_image(r - s["centre"], box), axis=1)
+    centre = s["centre"].astype(np.float64)
+    off = np.linalg.norm(_min_image(r - centre, box), axis=1)
     if np.any(off > 0.5 * sim.shell * (1 + 1e-6)):
         problems.append(f"particle beyond shell/2 of its list centre: max {off.max():.6g}")
     n = len(r)
     rad = rec[:, 7]
     lists = [set(s["nbl"][i, : s["nbn"][i]].tolist()) for i in range(n)]
     for i in range(n):
-        dc = np.linalg.norm(_min_image(s["centre"][i] - s["centre"], box), axis=1)
+        dc = np.linalg.norm(_min_image(centre[i] - centre, box), axis=1)
         want = set(np.flatnonzero(dc < rad[i] + rad + sim.shell).tolist()) - {i}
         if not want <= lists[i]:
             problems.append(f"list of {i} misses {sorted(want - lists[i])[:5]}")

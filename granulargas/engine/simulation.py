@@ -219,7 +219,7 @@ class Simulation:
         img = np.zeros((n, 3), dtype=np.int32)
         img[:, :d] = self._images[order]
         s["img"] = img
-        s["centre"] = np.empty((n, 3))
+        s["centre"] = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
         s["mass"] = np.ascontiguousarray(self._masses[order])
         s["count"] = np.zeros(n, dtype=np.int32)
         s["partner"] = np.full(n, -1, dtype=np.int32)

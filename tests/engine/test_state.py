@@ -159,3 +159,48 @@ def test_cells_grow_when_full():
     assert sim._cell_width > w
     assert check(sim) == []
     np.testing.assert_array_equal(sim.positions, ref.positions)
+
+
+def test_float32_list_centres_stay_safe_far_from_the_origin():
+    """List centres are stored as float32. Near x = 3e4 they are rounded by up to
+    1e-3 diameters, yet every list must be complete for the stored centres and no
+    pair may overlap (a rebuild that tested the unrounded position would miss
+    pairs near the cut-off here)."""
+    rng = np.random.default_rng(5)
+    g = np.stack(np.meshgrid(np.arange(38) * 1.3, np.arange(4) * 1.5, np.arange(4) * 1.5,
+                             indexing="ij"), axis=-1).reshape(-1, 3)
+    pos = g + np.array([30000.0 - 50.0, 0.2, 0.2])
+    vel = rng.normal(size=pos.shape)
+    vel -= vel.mean(axis=0)
+    n = len(pos)
+    sim = Simulation(pos, vel, np.full(n, 0.5), np.ones(n), np.array([30000.0, 6.0, 6.0]),
+                     CollisionRule.elastic())
+    for t in (2.0, 4.0, 6.0):
+        sim.run(t)
+        assert check(sim) == [], t
+    assert sim.collisions > 3000
+
+
+def test_rebuild_tests_the_rounded_centre():
+    """A pair whose stored (float32) centres are closer than R_i + R_j + shell must be
+    listed even when the unrounded position is just beyond: at x ~ 3e4 the centre
+    of i rounds down by 9e-4, which moves it from 2.0013 to 1.99998 from j."""
+    from granulargas.engine._cells import rebuild_list
+
+    box = np.array([30000.0, 6.0, 6.0])
+    pos = np.array([[29980.0, 3.0, 3.0], [29990.0, 3.0, 3.0]])
+    sim = Simulation(pos, np.zeros((2, 3)), np.full(2, 0.5), np.ones(2), box,
+                     CollisionRule.elastic(), shell=1.0)
+    sim._build()
+    s = sim._s
+    assert sim.shell == 1.0 and s["nbn"].tolist() == [0, 0]
+    i = int(np.flatnonzero(s["rec"][:, 0] == 29980.0)[0])
+    b = np.sqrt(4.0 - 1e-4 - 1.5**2)
+    s["rec"][i, :3] = [29991.5009, 3.0 + b, 3.0]
+    assert np.float32(29991.5009) == np.float32(29991.5)
+    st = rebuild_list(i, s["rec"], s["centre"], 0.5, sim.shell, sim._box3, sim._ncell,
+                      s["cell_ids"], s["cell_n"], s["cell_of"], s["nbl"], s["nbn"],
+                      s["scratch"], s["stencil"])
+    assert st == 0
+    assert s["nbn"].tolist() == [1, 1]
+    assert check(sim) == []
