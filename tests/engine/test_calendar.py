@@ -86,3 +86,50 @@ def test_calendar_reports_more_simultaneous_events_than_it_holds():
         assert cal_peek(*_args(c)) == -2
     c["qt"][:] = 0.0  # due at once
     assert not cal_build(0.0, *_args(c))
+
+
+def test_calendar_with_the_smallest_chunk_pool_compacts_and_stays_exact():
+    """The smallest pool (live entries only) runs dry on stale entries again and again;
+    each time all events are placed anew at the same width, in the same order."""
+    n = 500
+    rng = np.random.default_rng(7)
+    c = allocate_calendar(n, pool=1)
+    now = 0.0
+    c["qt"][:] = rng.exponential(1.0, n)
+    assert cal_build(now, *_args(c))
+    w0 = c["qf"][0]
+    ref = c["qt"].copy()
+    compactions = 0
+    for step in range(6000):
+        i = cal_peek(*_args(c))
+        assert ref[i] == ref[int(np.argmin(ref))]
+        now = ref[i]
+        # the popped particle and three others get new times: many entries go stale
+        for p in (i, *rng.integers(n, size=3).tolist()):
+            t = now + rng.exponential(1.0)
+            ref[p] = t
+            t0 = c["qf"][1]
+            assert cal_update(p, t, *_args(c))
+            compactions += c["qf"][1] != t0  # only placing all anew moves the origin
+        if step % 101 == 0:
+            assert cal_check(*_args(c))
+    assert compactions > 5
+    assert c["qf"][0] == w0  # compaction never narrows the window
+
+
+def test_calendar_skips_a_second_entry_of_a_particle_that_came_back():
+    """Lazy deletion: a particle moved out of a bucket and back has two entries there."""
+    c = allocate_calendar(50)
+    c["qt"][:] = np.linspace(1.0, 2.0, 50)
+    assert cal_build(0.0, *_args(c))
+    w = c["qf"][0]
+    t_far = 0.0 + 30.5 * w
+    cal_update(7, t_far, *_args(c))
+    cal_update(7, t_far + 40 * w, *_args(c))
+    cal_update(7, t_far, *_args(c))
+    assert cal_check(*_args(c))
+    popped = []
+    while (i := cal_peek(*_args(c))) >= 0:
+        popped.append(i)
+        cal_update(i, math.inf, *_args(c))
+    assert sorted(popped) == list(range(50))
