@@ -76,10 +76,11 @@ def ring_size(n):
     return nb
 
 
-def pool_size(n, nb):
-    """Chunks for n live entries plus one partial chunk per bucket, and as many for stale entries."""
+def pool_size(n, nb, stale=True):
+    """Chunks for n live entries plus one partial chunk per bucket (the least that placing
+    all events anew needs), and with ``stale`` as many again for stale entries."""
     live = -(-n // (CHUNK - 1))
-    return 2 * live + nb + 1
+    return live + nb + 1 + (live if stale else 0)
 
 
 def allocate_calendar(n, capacity=None, pool=None):
@@ -93,8 +94,7 @@ def allocate_calendar(n, capacity=None, pool=None):
     """
     nb = ring_size(n)
     cap = max(1024, n // 16) if capacity is None else int(capacity)
-    need = -(-n // (CHUNK - 1)) + nb + 1
-    chunks = pool_size(n, nb) if pool is None else max(int(pool), need)
+    chunks = pool_size(n, nb) if pool is None else max(int(pool), pool_size(n, nb, stale=False))
     buf = np.empty(chunks * CHUNK + 16, dtype=np.int32)
     offset = (-buf.ctypes.data % 32) // 4
     return dict(
@@ -321,7 +321,8 @@ def _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf):
         for q in range(1, f + 1):
             j = chunks[c, q]
             if where[j] == nb:
-                where[j] = -1 - qt.shape[0]  # in transit: a second entry of j is skipped
+                # a second entry of j (it left the overflow and came back) is placed
+                # again only if j went back to the overflow: one more entry there, no harm
                 st = _insert_call(j, qt[j], qt, chunks, where, small, buckets, qi, qf)
                 if st != _OK:
                     return st

@@ -8,8 +8,7 @@ Two particles not in each other's lists are therefore at least R_i + R_j apart
 at all times: they cannot touch. The argument holds for any point c_i within
 shell/2 of particle i, so rounding the centres costs nothing as long as every
 test (the full build, each rebuild, the expiry time) uses the same stored
-centres; it halves their memory (12 bytes per particle) and the lines a
-rebuild reads. When the list of i expires only i's list is rebuilt, from a
+centres; it halves their memory (12 bytes per particle). When the list of i expires only i's list is rebuilt, from a
 cell grid that holds the list centres (a row of slots per cell, one cache line
 for up to 16), and i is added to / removed from the lists of the neighbours
 that join or leave (Smallenburg, Eur. Phys. J. E 45, 22 (2022)). Cells are at
@@ -313,18 +312,21 @@ def build_all_lists(r, centre, rec, shell, box, ncell, cell_ids, cell_n, cell_of
         slot_insert(i, c, cell_ids, cell_n, cell_of)
     nbn[:] = 0
     for i in range(n):
-        cx = cell_coord(np.float64(centre[i, 0]), box[0], ncell[0])
-        cy = cell_coord(np.float64(centre[i, 1]), box[1], ncell[1])
-        cz = cell_coord(np.float64(centre[i, 2]), box[2], ncell[2])
+        # every test uses the stored (float32) centres, as every later rebuild does
+        xi = np.float64(centre[i, 0])
+        yi = np.float64(centre[i, 1])
+        zi = np.float64(centre[i, 2])
+        cx = cell_coord(xi, box[0], ncell[0])
+        cy = cell_coord(yi, box[1], ncell[1])
+        cz = cell_coord(zi, box[2], ncell[2])
         for k in range(stencil_size(ncell)):
             c = stencil_cell(cx, cy, cz, k, ncell)
             for q in range(cell_n[c]):
                 j = cell_ids[c, q]
                 if j > i:
-                    # the test uses the stored (float32) centres, as every later rebuild does
-                    dx = min_image(np.float64(centre[i, 0]) - centre[j, 0], box[0])
-                    dy = min_image(np.float64(centre[i, 1]) - centre[j, 1], box[1])
-                    dz = min_image(np.float64(centre[i, 2]) - centre[j, 2], box[2])
+                    dx = min_image(xi - centre[j, 0], box[0])
+                    dy = min_image(yi - centre[j, 1], box[1])
+                    dz = min_image(zi - centre[j, 2], box[2])
                     cut = rec[i, 7] + rec[j, 7] + shell
                     if dx * dx + dy * dy + dz * dz < cut * cut:
                         if nbn[i] >= m or nbn[j] >= m:

@@ -45,7 +45,7 @@ import math
 import numpy as np
 
 from granulargas._numba import jit
-from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, prefetch_cells, rebuild_list
+from granulargas.engine._cells import prefetch_cells, rebuild_list
 from granulargas.engine._collide import restitution
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image
 from granulargas.engine._prefetch import prefetch
