@@ -115,8 +115,11 @@ def test_viscoelastic_cooling_3d_large_several_seeds(tmp_path):
 
 @pytest.mark.slow
 def test_sonine_a2_of_the_hcs_matches_van_noije_ernst(tmp_path):
-    # eps = 0.9, 3D, packing 0.05, L = 0.5 L_c (N = 2182), 6 seeds; a2 from every
-    # snapshot after 2 tau0 (the Maxwellian start relaxes within a few collisions).
+    # eps = 0.9, 3D, packing 0.05, L = 0.5 L_c (N = 2182), 12 seeds; a2 averaged over
+    # the snapshots after 2 tau0 (the Maxwellian start relaxes within a few collisions).
+    # The error comes from the scatter of the seeds' means: successive snapshots are
+    # correlated (slow hydrodynamic modes), and seeds 1-36 scatter 1.5-1.8 times more
+    # than the snapshots' own scatter / sqrt(snapshots) says.
     from granulargas.analysis.run import sonine_history
     from granulargas.io.config import parse_config
     from granulargas.io.runner import run_config
@@ -126,14 +129,14 @@ def test_sonine_a2_of_the_hcs_matches_van_noije_ernst(tmp_path):
     N = int(n * (0.5 * th.instability_length(eps, n)) ** 3)
     tau0 = th.haff_tau0(eps, n)
     vals = []
-    for seed in range(1, 7):
+    for seed in range(1, 13):
         path = tmp_path / f"a2_{seed}.h5"
         text = CONFIG.format(dim=3, n=N, eta=eta, seed=seed, collision=f'model = "constant"\nrestitution = {eps}',
                              end=30 * tau0, dt=tau0, file=path).replace("snapshots = 6", f"snapshot_interval = {30 * tau0 / 39}")
         run_config(parse_config(text, source="test"), overwrite=True)
         t, a2, _ = sonine_history(path)
-        vals.append(a2[t > 2 * tau0])
-    v = np.concatenate(vals)
+        vals.append(a2[t > 2 * tau0].mean())
+    v = np.array(vals)
     se = v.std(ddof=1) / math.sqrt(v.size)
     expected = th.sonine_a2(eps, 3)  # -0.0146
     assert abs(v.mean() - expected) < 4 * se, (v.mean(), se)
