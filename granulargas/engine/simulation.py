@@ -249,7 +249,7 @@ class Simulation:
             s["nbl"] = np.ascontiguousarray(s["nbl"][:, :width])
             self._nb_width = width
         s["scratch"] = np.empty(self._nb_width, dtype=np.int32)
-        s["stencil"] = np.empty(27, dtype=np.int32)
+        s["stencil"] = np.empty(27, dtype=np.int64)
         s.update(allocate_calendar(n))
         _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
                           s["partner"], s["pcount"], self._box3, 0.5 * self.shell * (1.0 - 1e-9),
