@@ -180,20 +180,23 @@ def _reach(x, y, z, cut, box, ncell, stencil):
 
 
 @jit(inline="always")
-def _collect(i, x, y, z, ri, rmax, centre, rec, shell, box, ncell, cell_ids, cell_n, scratch,
+def _collect(i, x, y, z, ri, rmax, m, centre, rec, shell, box, ncell, cell_ids, cell_n, scratch,
              stencil):
     """Particles j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
 
-    Three passes, so that the cache misses of one pass overlap: (1) the cells
-    around (x, y, z) that the cut-off sphere reaches (:func:`_reach`) into
+    Passes, so that the cache misses of one pass overlap: (1) the cells around
+    (x, y, z) that the cut-off sphere reaches (:func:`_reach`) into
     ``stencil``, with a prefetch for each cell's row, (2) a prefetch for the
-    centre of every particle in them, (3) the distance tests. Each cell is
-    tested with the query point shifted by the cell's periodic offset, so the
-    inner loop needs no minimum image; the test uses R_i + R_max + shell first
-    and reads R_j only for the hits. Returns the number found, or -1 if
-    ``scratch`` would overflow.
+    centre of every particle in them, (3) the distance tests against
+    R_i + R_max + shell, branch-free (every candidate is written, the count
+    advances on a hit: a branch on data still in flight would serialise the
+    misses), each cell with the query point shifted by the cell's periodic
+    offset so that no minimum image is needed, (4) the hits compacted in
+    place, with the exact cut-off for partners smaller than R_max. Returns the
+    number found, or -1 if more than ``m`` are found or ``scratch`` is shorter
+    than the candidates (the caller enlarges both).
     """
-    m = scratch.shape[0]
+    cap = scratch.shape[0]
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
@@ -213,20 +216,31 @@ def _collect(i, x, y, z, ri, rmax, centre, rec, shell, box, ncell, cell_ids, cel
         qx = x - _shift(cx + code % 3 - 1, ncell[0], box[0])
         qy = y - _shift(cy + (code // 3) % 3 - 1, ncell[1], box[1])
         qz = z - _shift(cz + code // 9 - 1, ncell[2], box[2])
-        for q in range(cell_n[c]):
+        nq = cell_n[c]
+        if count + nq > cap:
+            return -1
+        for q in range(nq):
             j = cell_ids[c, q]
             dx = qx - centre[j, 0]
             dy = qy - centre[j, 1]
             dz = qz - centre[j, 2]
-            d2 = dx * dx + dy * dy + dz * dz
-            if d2 < cut_max2 and j != i:
-                cut = ri + rec[j, 7] + shell
-                if d2 < cut * cut:
-                    if count >= m:
-                        return -1
-                    scratch[count] = j
-                    count += 1
-    return count
+            scratch[count] = j
+            count += (dx * dx + dy * dy + dz * dz < cut_max2) & (j != i)
+    found = 0
+    for k in range(count):
+        j = scratch[k]
+        cut = ri + rec[j, 7] + shell
+        if cut < cut_max:
+            dx = min_image(x - centre[j, 0], box[0])
+            dy = min_image(y - centre[j, 1], box[1])
+            dz = min_image(z - centre[j, 2], box[2])
+            if dx * dx + dy * dy + dz * dz >= cut * cut:
+                continue
+        if found >= m:
+            return -1
+        scratch[found] = j
+        found += 1
+    return found
 
 
 @jit(inline="always")
@@ -297,7 +311,7 @@ def rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell
     if c != cell_of[i] and cell_n[c] >= cell_ids.shape[1]:
         return CELL_OVERFLOW
     m = nbl.shape[1]
-    count = _collect(i, x, y, z, rec[i, 7], rmax, centre, rec, shell, box, ncell, cell_ids,
+    count = _collect(i, x, y, z, rec[i, 7], rmax, m, centre, rec, shell, box, ncell, cell_ids,
                      cell_n, scratch, stencil)
     if count < 0 or count > m:
         return OVERFLOW

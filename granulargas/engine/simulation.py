@@ -248,7 +248,7 @@ class Simulation:
         if width < self._nb_width:
             s["nbl"] = np.ascontiguousarray(s["nbl"][:, :width])
             self._nb_width = width
-        s["scratch"] = np.empty(self._nb_width, dtype=np.int32)
+        s["scratch"] = self._new_scratch()
         s["stencil"] = np.empty(27, dtype=np.int64)
         s.update(allocate_calendar(n))
         _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
@@ -270,6 +270,10 @@ class Simulation:
                                   f"events than its window holds ({s['small'].shape[0]})")
         self._calendar_time = now
 
+    def _new_scratch(self):
+        """Work space of a list rebuild: every candidate of the 27 cells, at least a full list."""
+        return np.empty(max(self._nb_width, 27 * self._cell_width), dtype=np.int32)
+
     def _grow_cells(self):
         s = self._s
         old = s["cell_ids"]
@@ -277,6 +281,7 @@ class Simulation:
         new = _aligned_int_rows(old.shape[0], self._cell_width)
         new[:, : old.shape[1]] = old
         s["cell_ids"] = new
+        s["scratch"] = self._new_scratch()
 
     def _grow_lists(self):
         s = self._s
@@ -287,8 +292,8 @@ class Simulation:
         nbl = np.empty((n, new), dtype=np.int32)
         nbl[:, : self._nb_width] = s["nbl"]
         s["nbl"] = nbl
-        s["scratch"] = np.empty(new, dtype=np.int32)
         self._nb_width = new
+        s["scratch"] = self._new_scratch()
 
     # -------------------------------------------------------------------- run
     def run(self, until: float, max_collisions: int | None = None, progress=None) -> "Simulation":

@@ -107,8 +107,8 @@ def test_neighbour_lists_grow_when_full():
     s = sim._s
     w = int(s["nbn"].max())
     s["nbl"] = np.ascontiguousarray(s["nbl"][:, :w])
-    s["scratch"] = np.empty(w, dtype=np.int32)
     sim._nb_width = w
+    s["scratch"] = sim._new_scratch()
     sim.run(2.0)
     ref.run(2.0)
     assert sim._nb_width > w
