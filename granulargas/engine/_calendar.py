@@ -51,7 +51,8 @@ events, from the mean event delay; the calendar is rebuilt (O(N)) at the
 start of each ``Simulation.run`` call, which keeps w matched to a cooling
 gas. Ties are broken by heap node order, deterministically.
 
-Scalars: ``qi = [small size, B_cur, nb, live events in the ring, free chunk]``,
+Scalars: ``qi = [small size, B_cur, nb, live events in the ring, free chunk,
+look-ahead chunk]``,
 ``qf = [w, t0, ovf_min]``.
 """
 
@@ -64,7 +65,7 @@ from granulargas.engine._prefetch import prefetch
 
 PER_WINDOW = 48
 CHUNK = 8  # int32 per chunk row: next chunk + 7 ids (32 bytes)
-Q_SIZE, Q_CUR, Q_NB, Q_NRING, Q_FREE = 0, 1, 2, 3, 4
+Q_SIZE, Q_CUR, Q_NB, Q_NRING, Q_FREE, Q_LOOK = 0, 1, 2, 3, 4, 5
 Q_W, Q_T0, Q_OVF = 0, 1, 2
 
 
@@ -95,7 +96,7 @@ def allocate_calendar(n, capacity=None, pool=None):
     nb = ring_size(n)
     cap = max(1024, n // 16) if capacity is None else int(capacity)
     chunks = pool_size(n, nb) if pool is None else max(int(pool), pool_size(n, nb, stale=False))
-    buf = np.empty(chunks * CHUNK + 16, dtype=np.int32)
+    buf = np.zeros(chunks * CHUNK + 16, dtype=np.int32)
     offset = (-buf.ctypes.data % 32) // 4
     return dict(
         qt=np.full(n, np.inf),
@@ -103,7 +104,7 @@ def allocate_calendar(n, capacity=None, pool=None):
         qwhere=np.zeros(n, dtype=np.int32),
         small=np.zeros((min(n, cap), 2)),
         buckets=np.zeros((nb + 1, 2), dtype=np.int32),
-        qi=np.array([0, 0, nb, 0, -1], dtype=np.int64),
+        qi=np.array([0, 0, nb, 0, -1, -1], dtype=np.int64),
         qf=np.array([1.0, 0.0, np.inf]),
     )
 
@@ -260,6 +261,7 @@ def _place_all(t0, w, qt, chunks, where, small, buckets, qi, qf):
     for c in range(m):
         chunks[c, 0] = c + 1 if c + 1 < m else -1
     qi[Q_FREE] = 0
+    qi[Q_LOOK] = -1
     for i in range(qt.shape[0]):
         if _insert_call(i, qt[i], qt, chunks, where, small, buckets, qi, qf) != _OK:
             return False
@@ -359,6 +361,29 @@ def _open_bucket(slot, qt, chunks, where, small, buckets, qi):
     return True
 
 
+@jit(inline="always")
+def cal_look_ahead(qt, chunks, where, qi):
+    """Prefetch hints for one chunk of the next bucket (no effect on results).
+
+    Called once per event: while the current window's ~PER_WINDOW events are
+    processed, the next bucket's chain of chunks is walked one chunk at a time
+    (each chunk prefetched one call before it is read) and the ``qt``/``where``
+    rows of its ids are prefetched, so that opening that bucket finds them in
+    cache instead of waiting on one miss per chunk. Stale or unused slots only
+    prefetch lines in vain.
+    """
+    c = qi[Q_LOOK]
+    if c >= 0:
+        for q in range(1, CHUNK):
+            j = chunks[c, q]
+            prefetch(qt, j)
+            prefetch(where, j)
+        nx = chunks[c, 0]
+        if nx >= 0:
+            prefetch(chunks, nx)
+        qi[Q_LOOK] = nx
+
+
 @jit
 def cal_peek(qt, chunks, where, small, buckets, qi, qf):
     """Particle with the earliest event (moving the window forward as needed).
@@ -386,6 +411,12 @@ def cal_peek(qt, chunks, where, small, buckets, qi, qf):
                 # every half turn of the ring: overflow events were beyond cur + nb when
                 # placed, so none is due before the next half turn
                 st = _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf)
+            if st == _OK:
+                # the look-ahead (cal_look_ahead) walks the next bucket meanwhile
+                head = buckets[(cur + 1) & (nb - 1), 0]
+                qi[Q_LOOK] = head
+                if head >= 0:
+                    prefetch(chunks, head)
         if st != _OK and not _replace(st == _HEAP_FULL, qt, chunks, where, small, buckets, qi,
                                       qf):
             return -2

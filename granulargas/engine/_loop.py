@@ -51,7 +51,7 @@ from granulargas.engine._cells import prefetch_cells, rebuild_list
 from granulargas.engine._collide import restitution
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image
 from granulargas.engine._prefetch import prefetch
-from granulargas.engine._calendar import cal_peek, cal_update
+from granulargas.engine._calendar import cal_look_ahead, cal_peek, cal_update
 
 DONE = 0
 BUDGET = 1
@@ -303,6 +303,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
         if i1 == -2:
             status = CALENDAR
             break
+        cal_look_ahead(qt, chunks, qwhere, qi)
         if i1 >= 0:
             p1 = partner[i1]
             if p1 >= 0:
