@@ -424,11 +424,8 @@ def cal_peek(qt, chunks, where, small, buckets, qi, qf):
 
 
 @jit
-def cal_build(now, qt, chunks, where, small, buckets, qi, qf):
-    """Place every particle's event ``qt`` anew (window starts at ``now``; w from the mean delay).
-
-    Returns False on failure (see :func:`_replace`).
-    """
+def cal_width(now, qt):
+    """Window width for events ``qt`` at time ``now``: PER_WINDOW events per window on average."""
     n = qt.shape[0]
     total = 0.0
     finite = 0
@@ -441,6 +438,16 @@ def cal_build(now, qt, chunks, where, small, buckets, qi, qf):
         w = PER_WINDOW * (total / finite) / finite
     if not w > 0.0:
         w = 1.0
+    return w
+
+
+@jit
+def cal_build(now, qt, chunks, where, small, buckets, qi, qf):
+    """Place every particle's event ``qt`` anew (window starts at ``now``; w from the mean delay).
+
+    Returns False on failure (see :func:`_replace`).
+    """
+    w = cal_width(now, qt)
     if _place_all(now, w, qt, chunks, where, small, buckets, qi, qf):
         return True
     qi[Q_CUR] = 0

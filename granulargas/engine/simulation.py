@@ -20,7 +20,7 @@ import numpy as np
 
 from granulargas.engine import _loop
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
-from granulargas.engine._calendar import allocate_calendar, cal_build
+from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import (
     ConfigError,
@@ -335,8 +335,11 @@ class Simulation:
         fpar = np.array([eps, tc, pref, inv_h, self.shell, 1e-10 * scale, float(self._radii.max())])
         chunk = max(1_000_000, 2 * self.n)
         if self._calendar_time != self.time:
-            # a fresh calendar per call keeps its window width matched to the event rate
-            self._place_events(s, self.time)
+            # the window width must stay matched to the event rate (a cooling gas slows
+            # down): the events are placed anew when it is off by more than a factor 2
+            ratio = cal_width(self.time, s["qt"]) / float(s["qf"][0])
+            if not 0.5 <= ratio <= 2.0:
+                self._place_events(s, self.time)
         while True:
             status = _loop.advance(
                 s["rec"], s["img"], s["centre"], s["mass"], s["count"],
