@@ -89,9 +89,9 @@ def stream(i, t, rec, img, box):
 @jit(inline="always")
 def _prefetch_particle(i, rec, img, centre, mass, count, pcount, lastcoll, rapid, nbl, nbn,
                        partner, qt, qwhere):
-    """Prefetch hints for every per-particle row an event of particle i touches."""
+    """Prefetch hints for the per-particle rows an event of particle i touches (not
+    ``img``, which only a wrap through the box writes)."""
     prefetch(rec, i)
-    prefetch(img, i)
     prefetch(centre, i)
     prefetch(mass, i)
     prefetch(count, i)
@@ -179,7 +179,7 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             if i == -2:
                 status = CALENDAR
             break
-        te = qt[i]
+        te = small[0, 0]  # = qt[i]: the heap root's copy, in cache
         if te > until or te == math.inf:
             break
         if te <= time:
@@ -309,18 +309,17 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
             if p1 >= 0:
                 _prefetch_particle(p1, rec, img, centre, mass, count, pcount, lastcoll, rapid,
                                    nbl, nbn, partner, qt, qwhere)
+                prefetch(mass, i1)  # the rows only a collision of i1 touches
+                prefetch(lastcoll, i1)
+                prefetch(rapid, i1)
+                prefetch(count, i1)
             else:
-                prefetch_cells(rec[i1, 0] + rec[i1, 3] * (qt[i1] - rec[i1, 6]),
-                               rec[i1, 1] + rec[i1, 4] * (qt[i1] - rec[i1, 6]),
-                               rec[i1, 2] + rec[i1, 5] * (qt[i1] - rec[i1, 6]),
+                dt1 = small[0, 0] - rec[i1, 6]  # small[0, 0] = qt[i1]
+                prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
+                               rec[i1, 2] + rec[i1, 5] * dt1,
                                rec[i1, 7] + rmax + shell, box, ncell, cell_ids, cell_n, stencil)
             for k in range(nbn[i1]):
                 prefetch(rec, nbl[i1, k])
-            prefetch(img, i1)
-            prefetch(mass, i1)
-            prefetch(lastcoll, i1)
-            prefetch(rapid, i1)
-            prefetch(count, i1)
             prefetch(qwhere, i1)
             # the event after i1: the earliest child of the root, except the event of
             # i1's partner, which i1's collision re-predicts (often the partner's copy of
