@@ -318,6 +318,12 @@ def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
                 prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
                                rec[i1, 2] + rec[i1, 5] * dt1,
                                rec[i1, 7] + rmax + shell, box, ncell, cell_ids, cell_n, stencil)
+                # the rebuild rewrites the lists of neighbours that leave or join, mostly
+                # among the present ones, and moves i1's cell slot
+                for k in range(nbn[i1]):
+                    prefetch(nbl, nbl[i1, k])
+                    prefetch(nbn, nbl[i1, k])
+                prefetch(cell_of, i1)
             for k in range(nbn[i1]):
                 prefetch(rec, nbl[i1, k])
             prefetch(qwhere, i1)
