@@ -26,11 +26,12 @@ partner, the records of its neighbours, and the rows of the likely event after
 it (the earliest child of the small heap's root, passing over the event of the
 next particle's partner, which the next collision re-predicts: that guess is
 right for 98 % of events, against 80 % for the plain earliest child), so that
-these misses overlap with the current work. Measured gains (elastic 3D, packing 0.3, N = 10^5,
-adjacent runs on one core): calendar and cell passes together +20 % (0.19 ->
-0.23 M collisions/s), the wider prefetch +11 % (medians of 6 alternated A/B
-runs); at N = 10^6 the calendar's overflow handling decides everything (see
-its module docstring).
+these misses overlap with the current work; before a list expiry it also
+prefetches the cell rows around the particle and its neighbours' list rows.
+Where the time goes per part of the loop: ``python scripts/profile_loop.py 1e4
+1e6`` (cycle counters); what each change bought, alternated A/B runs:
+``python scripts/bench_ab.py OLD_TREE . --sizes 1e4 1e6`` (numbers in the
+README).
 
 Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 0 reached ``until``; 1 event budget of this chunk used (call again);
