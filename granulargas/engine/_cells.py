@@ -138,7 +138,7 @@ def _pick(o, lo2, hi2):
     return 0.0
 
 
-@jit(inline="always")
+@jit
 def _reach(x, y, z, cut, box, ncell, stencil):
     """Cells around (x, y, z) that a sphere of radius ``cut`` can reach, into ``stencil``.
 
@@ -243,7 +243,7 @@ def _collect(i, x, y, z, ri, rmax, m, centre, rec, shell, box, ncell, cell_ids, 
     return found
 
 
-@jit(inline="always")
+@jit
 def prefetch_cells(x, y, z, cut, box, ncell, cell_ids, cell_n, stencil):
     """Prefetch hints for the cell rows a list rebuild around (x, y, z) will read.
 
