@@ -313,7 +313,7 @@ def rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell
     m = nbl.shape[1]
     count = _collect(i, x, y, z, rec[i, 7], rmax, m, centre, rec, shell, box, ncell, cell_ids,
                      cell_n, scratch, stencil)
-    if count < 0 or count > m:
+    if count < 0:  # more than m found (or scratch too short)
         return OVERFLOW
     nold = nbn[i]
     for k in range(count):
