@@ -53,12 +53,12 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
     t_init = time.perf_counter() - t0
     if rule_name == "elastic":
         rule = CollisionRule.elastic()
-    elif rule_name.split(":")[0] == "viscoelastic":
+    elif rule_name.partition(":")[0] == "viscoelastic":
         from granulargas.contact import prefactor_from_damping, restitution_table
 
         # "viscoelastic" = damping 0.1; "viscoelastic:1e-4" a nearly elastic gas, whose
         # event sequence matches the elastic one, so that only the rule's own cost differs
-        damping = float(rule_name.split(":")[1]) if ":" in rule_name else 0.1
+        damping = float(rule_name.partition(":")[2] or 0.1)
         k = prefactor_from_damping(damping)
         # largest impact speed: twice the fastest particle (with margin); reference pair
         gmax = 2.5 * float(np.max(np.linalg.norm(st.velocities, axis=1)))
@@ -113,6 +113,18 @@ def jit_times():
     return first, statistics.median(cached)
 
 
+def _rule_valid(name):
+    """Whether ``name`` is a rule that :func:`run_case` understands."""
+    if name in ("elastic", "viscoelastic"):
+        return True
+    head, _, arg = name.partition(":")
+    try:
+        value = float(arg if head == "viscoelastic" else name)
+    except ValueError:
+        return False
+    return value > 0 if head == "viscoelastic" else 0 < value <= 1
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--quick", action="store_true", help="N = 1e4, 1e5 at packing 0.3 (3D elastic, "
@@ -120,13 +132,17 @@ def main(argv=None):
     p.add_argument("--sizes", type=float, nargs="+", default=None)
     p.add_argument("--packings", type=float, nargs="+", default=None)
     p.add_argument("--dims", type=int, nargs="+", default=None)
-    p.add_argument("--rules", nargs="+", default=None, help="elastic, viscoelastic (damping 0.1), viscoelastic:DAMPING or a "
-                   "constant eps")
+    p.add_argument("--rules", nargs="+", default=None,
+                   help="elastic, viscoelastic (damping 0.1), viscoelastic:DAMPING or a constant eps")
     p.add_argument("--repeats", type=int, default=None)
     p.add_argument("--no-jit", action="store_true", help="skip the JIT timing")
     p.add_argument("--json", default=None, help="also write the results to this JSON file")
     p.add_argument("--case", nargs=4, default=None, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
+    for rule in args.rules or []:
+        if not _rule_valid(rule):
+            p.error(f"--rules {rule}: allowed are elastic, viscoelastic, viscoelastic:DAMPING "
+                    f"(DAMPING > 0) and a constant eps in (0, 1]")
 
     if args.case:
         n, eta, dim, rule = args.case
