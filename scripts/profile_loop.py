@@ -7,7 +7,8 @@ update, the list rebuild, the stale-event path, the particle's own prediction
 and calendar update, the prefetch block and the peek at the next event. The
 patched copy is compiled (numba, ~15 s, not cached) and run on a random state
 after a warm-up of two collisions per particle; the table gives cycles per
-collision and per call of each part. The counters perturb the timing a little
+collision and per call of each part, and how often the prefetch block's guess
+of the event after next was right. The counters perturb the timing a little
 (the instrumented rate is printed beside the cycle totals); compare parts and
 sizes, not absolute rates with ``bench_engine.py``.
 
@@ -61,7 +62,7 @@ def patched_source(src):
     if k != 1:
         raise ValueError("the signature of advance(...) changed")
     after = [
-        ("    status = DONE\n", "    c0 = rdtsc()\n"),
+        ("    status = DONE\n", "    c0 = rdtsc()\n    guess = -1\n    pending = -1\n"),
         ("        j = np.int64(partner[i])  # one signature for the callees (partner is int32)\n",
          _tick(0, 8)),
         ("            iscal[I_EXPIRIES] += 1\n", _tick(4, 12)),
@@ -69,9 +70,15 @@ def patched_source(src):
         ("        ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, "
          "half_shell)\n", _tick(6, 8)),
         ("        iscal[I_EVENTS] += 1\n        # ---- prefetch hints", None),
-        ("        i1 = cal_peek(qt, chunks, qwhere, small, buckets, qi, qf)\n", _tick(9, 8)),
+        ("        i1 = cal_peek(qt, chunks, qwhere, small, buckets, qi, qf)\n",
+         _tick(9, 8) + "        pending = guess\n        guess = -1\n"),
+        # the guess of the event after next, made in the prefetch block, checked when
+        # that event comes (prof[20]: events, prof[21]: guessed right)
+        ("                i2 = int(small[c2, 1])\n", "                guess = i2\n"),
     ]
     before = [
+        ("        j = np.int64(partner[i])",
+         "        prof[20] += 1\n        if i == pending:\n            prof[21] += 1\n"),
         ("                tj = predict(j, te,", _tick(1, 16)),
         ("                if not cal_update(j, tj,", _tick(2, 16)),
         ("                if rapid[i] >= collapse_count or", _tick(3, 16)),
@@ -112,7 +119,7 @@ def profile(n, packing, seed=1):
     s = sim._s
     kind, eps, tc, pref, inv_h, coeffs = sim.rule.kernel_arguments()
     fpar = np.array([eps, tc, pref, inv_h, sim.shell, 1e-20, float(sim._radii.max())])
-    prof = np.zeros(20, np.int64)
+    prof = np.zeros(22, np.int64)
     names = list(inspect.signature(prof_loop.advance.py_func).parameters)
 
     def go(ncoll):
@@ -137,6 +144,8 @@ def profile(n, packing, seed=1):
         print(f"  {name:16s} {prof[k] / nc:7.0f} cycles/collision {100 * prof[k] / total:5.1f} %"
               f"  calls/collision {prof[10 + k] / nc:.2f}  cycles/call "
               f"{prof[k] / max(1, prof[10 + k]):.0f}")
+    print(f"  the event after next, guessed for the prefetch: right for "
+          f"{100 * prof[21] / max(1, prof[20]):.1f} % of events")
 
 
 def main(argv=None):

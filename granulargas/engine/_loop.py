@@ -25,7 +25,7 @@ on results) for every per-particle row of the next event's particle and its
 partner, the records of its neighbours, and the rows of the likely event after
 it (the earliest child of the small heap's root, passing over the event of the
 next particle's partner, which the next collision re-predicts: that guess is
-right for 98 % of events, against 80 % for the plain earliest child), so that
+right for 97-98 % of events, ``scripts/profile_loop.py``), so that
 these misses overlap with the current work; before a list expiry it also
 prefetches the cell rows around the particle and its neighbours' list rows.
 Where the time goes per part of the loop: ``python scripts/profile_loop.py 1e4
