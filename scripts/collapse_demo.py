@@ -34,10 +34,10 @@ import numpy as np
 from scipy.optimize import brentq
 
 from granulargas import theory
-from granulargas import validity as V
+from granulargas.run import validity as V
 from granulargas.contact import restitution_table
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 from granulargas.errors import InelasticCollapseError
 
 

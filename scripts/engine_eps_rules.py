@@ -19,7 +19,7 @@ isolation (loops over 1e6 beta drawn from the run's range).
 
 Cooling-curve error = largest relative deviation of T(t) from the reference
 (the 128-interval table of the same contact end) over the run:
-predicted by kinetic theory (:func:`granulargas.validity.viscoelastic_cooling`
+predicted by kinetic theory (:func:`granulargas.run.validity.viscoelastic_cooling`
 with the candidate eps) and measured with engine runs (mean over seeds of the
 per-seed ratio, same initial states; +- standard error).
 
@@ -43,7 +43,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from granulargas import theory
-from granulargas import validity as V
+from granulargas.run import validity as V
 from granulargas._numba import jit
 from granulargas.contact import restitution_table
 from granulargas.contact.lookup import table_lookup, table_lookup_many
@@ -51,7 +51,7 @@ from granulargas.contact.ode import solve_many
 from granulargas.contact.pade import A_PADE, C1
 from granulargas.contact.series import restitution_coefficients
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from granulargas.analysis.cooling import (
     sonine_coefficients,
 )
 from granulargas.errors import InputFileError
+from granulargas.io.h5md import iter_snapshots, load_snapshot, read_observables, read_parameters
 
 __all__ = [
     "RunInfo",
@@ -92,8 +93,6 @@ class RunInfo:
 
     @classmethod
     def from_file(cls, path) -> "RunInfo":
-        from granulargas.io.h5md import load_snapshot, read_parameters
-
         params = read_parameters(path)
         snap = load_snapshot(path, 0)
         coll = params.get("collision", {}) or {}
@@ -166,8 +165,6 @@ class CoolingHistory:
 
 def cooling_history(path, particles: int | None = None) -> CoolingHistory:
     """Temperature and collision count against time from ``observables/``."""
-    from granulargas.io.h5md import read_observables
-
     obs = read_observables(path)
     if "temperature" not in obs:
         raise InputFileError(f"{path}: no observables/temperature in the file")
@@ -178,8 +175,6 @@ def cooling_history(path, particles: int | None = None) -> CoolingHistory:
     T, coll, ke = np.asarray(T, float)[idx], np.asarray(coll)[idx], np.asarray(ke, float)[idx]
     ok = np.isfinite(T)
     if particles is None:
-        from granulargas.io.h5md import load_snapshot
-
         particles = load_snapshot(path, 0).radii.shape[0]
     cpp = collisions_per_particle(np.where(coll >= 0, coll, np.nan), particles)
     return CoolingHistory(t[ok], T[ok], coll[ok], cpp[ok], ke[ok])
@@ -195,8 +190,6 @@ def snapshot_series(path, func: Callable, every: int = 1, indices=None) -> Itera
     indices : sequence of int, optional
         Only these frame indices (overrides ``every``).
     """
-    from granulargas.io.h5md import iter_snapshots, load_snapshot
-
     if indices is not None:
         for k in indices:
             snap = load_snapshot(path, int(k))

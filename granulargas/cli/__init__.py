@@ -1,9 +1,12 @@
 """Command line: ``granulargas <command> ...`` (also ``python -m granulargas``).
 
-Each command lives in its own module exposing ``configure_parser(parser)`` and
-``run(args) -> int``; this file only wires them. Modules are imported lazily so
-that ``granulargas --help`` stays instant and one command's import cost (numba,
-scipy) is not paid by the others.
+Each command lives in its own module of this package (``granulargas.cli.run``,
+``.epsilon``, ``.analyze``, ``.advise``, ``.sweep``, ``.export``) exposing
+``configure_parser(parser)`` and ``run(args) -> int``; shared argument helpers
+are in :mod:`granulargas.cli._args`. This file only wires them. The command
+modules are imported lazily (:func:`build_parser` imports only the one named on
+the command line) so that ``granulargas --help`` stays instant and one command's
+import cost (numba, scipy) is not paid by the others.
 
 A :class:`granulargas.errors.UserError` becomes one line on stderr and its exit
 code; no traceback.
@@ -20,12 +23,12 @@ from granulargas.errors import UserError
 
 # name -> (module, one-line help)
 COMMANDS = {
-    "run": ("granulargas.io.run_command", "run a simulation from a TOML config, writing H5MD"),
-    "epsilon": ("granulargas.contact.cli", "coefficient of restitution and contact duration"),
-    "analyze": ("granulargas.analysis.cli", "report on a run's H5MD file (cooling, a2, plots)"),
-    "advise": ("granulargas.advise", "is a constant restitution good enough for this config?"),
-    "sweep": ("granulargas.sweep", "run a parameter sweep / ensemble from a sweep file"),
-    "export": ("granulargas.io.export", "export a run for LAMMPS or OVITO (GSD)"),
+    "run": ("granulargas.cli.run", "run a simulation from a TOML config, writing H5MD"),
+    "epsilon": ("granulargas.cli.epsilon", "coefficient of restitution and contact duration"),
+    "analyze": ("granulargas.cli.analyze", "report on a run's H5MD file (cooling, a2, plots)"),
+    "advise": ("granulargas.cli.advise", "is a constant restitution good enough for this config?"),
+    "sweep": ("granulargas.cli.sweep", "run a parameter sweep / ensemble from a sweep file"),
+    "export": ("granulargas.cli.export", "export a run for LAMMPS or OVITO (GSD)"),
 }
 
 

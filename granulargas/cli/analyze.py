@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from granulargas.analysis.run import analyze_cooling
 from granulargas.errors import InputFileError
 
 
@@ -81,8 +82,6 @@ def report(analysis, rows: int = 10) -> str:
 
 
 def run(args) -> int:
-    from granulargas.analysis.run import analyze_cooling
-
     try:
         a = analyze_cooling(args.file, t_range=tuple(args.fit_range) if args.fit_range else None,
                             with_sonine=not args.no_snapshots)
@@ -90,7 +89,7 @@ def run(args) -> int:
         raise InputFileError(f"{args.file}: cannot analyse ({exc})") from None
     print(report(a, rows=args.rows))
     if args.plot:
-        from granulargas.analysis.plots import plot_cooling
+        from granulargas.analysis.plots import plot_cooling  # matplotlib only when a plot is asked for
 
         plot_cooling(a, args.plot)
         print(f"  wrote {args.plot}")

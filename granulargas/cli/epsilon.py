@@ -19,6 +19,8 @@ import warnings
 
 import numpy as np
 
+from granulargas.contact import duration, material, restitution
+from granulargas.contact.series import MAX_RELIABLE_ORDER, SeriesDivergenceWarning, radius_of_convergence
 from granulargas.errors import UserError
 
 
@@ -42,8 +44,6 @@ def configure_parser(parser):
 
 
 def _material(args):
-    from granulargas.contact import material
-
     needed = {"--young": args.young, "--poisson": args.poisson, "--dissipation-time": args.dissipation_time,
               "--radius": args.radius, "--speed": args.speed}
     missing = [k for k, v in needed.items() if v is None]
@@ -84,9 +84,6 @@ def _material(args):
 
 
 def _rows(beta, end, order):
-    from granulargas.contact import duration, restitution
-    from granulargas.contact.series import MAX_RELIABLE_ORDER, SeriesDivergenceWarning, radius_of_convergence
-
     rows = [("ode", restitution(beta, end=end), duration(beta, end=end))]
     rows.append(("table", restitution(beta, method="table", end=end), duration(beta, method="table", end=end)))
     radius = radius_of_convergence(end)
@@ -114,9 +111,7 @@ def run(args) -> int:
         if any(not (b >= 0 and math.isfinite(b)) for b in args.beta):
             raise UserError(f"--beta {args.beta}: must be finite and >= 0")
         betas, speeds, units = np.asarray(args.beta, dtype=float), None, None
-        from granulargas.contact.material import validity_problems
-
-        for problem in validity_problems(beta=betas):
+        for problem in material.validity_problems(beta=betas):
             print(f"warning: {problem}")
     else:
         betas, speeds, units = _material(args)

@@ -9,9 +9,12 @@ terminal and prints a short summary.
 from __future__ import annotations
 
 import signal
-import tomllib
 
-from granulargas.errors import ConfigError
+from granulargas.cli._args import add_override_argument, overrides_from
+from granulargas.io.config import load_config
+from granulargas.run.advise import summary_line
+from granulargas.run.runner import run_config
+from granulargas.run.validity import raise_if_invalid
 
 
 def configure_parser(parser):
@@ -20,23 +23,8 @@ def configure_parser(parser):
     parser.add_argument("--restart", metavar="FILE",
                         help="continue from the last snapshot of FILE (same as [initial] from = FILE)")
     parser.add_argument("--output", "-o", metavar="FILE", help="output file (overrides [output] file)")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                        help="override a config value, e.g. --set collision.restitution=0.8 (repeatable)")
+    add_override_argument(parser, "collision.restitution=0.8")
     parser.add_argument("--quiet", "-q", action="store_true", help="no progress bar (the summary is still printed)")
-
-
-def parse_override(text: str):
-    """``section.key=value`` -> (key, value); the value is read as TOML, else as a string."""
-    key, sep, raw = text.partition("=")
-    key = key.strip()
-    if not sep or not key:
-        raise ConfigError(f"--set {text}: expected section.key=value")
-    raw = raw.strip()
-    try:
-        value = tomllib.loads(f"v = {raw}")["v"]
-    except tomllib.TOMLDecodeError:
-        value = raw
-    return key, value
 
 
 def _terminate(signum, frame):
@@ -44,12 +32,7 @@ def _terminate(signum, frame):
 
 
 def run(args) -> int:
-    from granulargas.advise import summary_line
-    from granulargas.io.config import load_config
-    from granulargas.io.runner import run_config
-    from granulargas.validity import raise_if_invalid
-
-    overrides = dict(parse_override(t) for t in args.overrides)
+    overrides = overrides_from(args)
     if args.restart:
         overrides["initial.from"] = args.restart
     if args.output:

@@ -292,7 +292,7 @@ def head_on_input(contact: DemContact, speed: float, timestep: float, steps: int
     coeffs = "\n".join(contact.pair_coeff(i, j, mi * mj / (mi + mj))
                         for i, j, mi, mj in ((1, 1, m1, m1), (1, 2, m1, m2), (2, 2, m2, m2)))
     return f"""\
-# head-on collision of two viscoelastic spheres (granulargas.io.lammps.head_on_input)
+# head-on collision of two viscoelastic spheres (granulargas.dem.lammps.head_on_input)
 units lj
 atom_style sphere
 atom_modify map array

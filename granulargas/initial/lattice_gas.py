@@ -63,38 +63,19 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from granulargas.engine import _montecarlo as mc
+from granulargas import theory
 from granulargas.errors import ConfigError
-
-
-@dataclass
-class InitialState:
-    """Arrays for :class:`granulargas.engine.Simulation` (particle-id order)."""
-
-    positions: np.ndarray  # (N, d)
-    velocities: np.ndarray  # (N, d)
-    radii: np.ndarray  # (N,)
-    masses: np.ndarray  # (N,)
-    box: np.ndarray  # (d,)
-
-    def as_kwargs(self) -> dict:
-        return dict(positions=self.positions, velocities=self.velocities, radii=self.radii,
-                    masses=self.masses, box=self.box)
-
-
-def particle_volume(radii, dimension):
-    """Volume (3D) or area (2D) of each particle."""
-    radii = np.asarray(radii, dtype=np.float64)
-    return 4.0 / 3.0 * math.pi * radii**3 if dimension == 3 else math.pi * radii**2
+from granulargas.initial import _montecarlo as mc
+from granulargas.initial.state import InitialState
 
 
 def box_for_packing(radii, packing, dimension, aspect=None):
     """Box sides (d,) giving packing fraction ``packing`` (aspect: relative side lengths)."""
-    volume = float(np.sum(particle_volume(radii, dimension))) / packing
+    diameters = 2.0 * np.asarray(radii, dtype=np.float64)
+    volume = float(np.sum(theory.particle_volume(diameters, dimension))) / packing
     aspect = np.ones(dimension) if aspect is None else np.asarray(aspect, dtype=np.float64)
     return aspect * (volume / float(np.prod(aspect))) ** (1.0 / dimension)
 
@@ -191,7 +172,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     radii = np.asarray(radii, dtype=np.float64)
     box = np.asarray(box, dtype=np.float64)
     n, d = len(radii), len(box)
-    eta = float(np.sum(particle_volume(radii, d))) / float(np.prod(box))
+    eta = float(np.sum(theory.particle_volume(2.0 * radii, d))) / float(np.prod(box))
     # M sites for N particles: S(k) = 1 - N/M = S0 at long wavelengths (docstring)
     m_sites = max(n, round(n / max(_MIN_OCCUPANCY, 1.0 - fluid_s0(eta, d))))
     sites, dist, z_order = _lattice(m_sites, box)
@@ -289,8 +270,8 @@ def maxwell_velocities(masses, dimension, temperature=1.0, seed=0, rng=None):
 
 
 def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, masses=None,
-                 aspect=None, sweeps=None) -> InitialState:
-    """A random homogeneous initial state.
+                 aspect=None, sweeps=None, rng=None) -> InitialState:
+    """A random homogeneous initial state: box, positions, velocities (in this order from one generator).
 
     Parameters
     ----------
@@ -310,6 +291,9 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
         Relative box side lengths (default cubic/square).
     sweeps : int, optional
         Monte Carlo sweeps (see :func:`random_positions`).
+    rng : numpy.random.Generator, optional
+        Generator to draw from instead of ``default_rng(seed)`` (a config run draws
+        its polydisperse radii from it first).
     """
     if dimension not in (2, 3):
         raise ConfigError(f"dimension = {dimension}: allowed values are 2 and 3")
@@ -318,7 +302,7 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
         raise ConfigError(f"number of particles = {n}: need at least 2")
     if not 0.0 < packing < (0.74 if dimension == 3 else 0.9):
         raise ConfigError(f"packing fraction = {packing}: allowed range is (0, {0.74 if dimension == 3 else 0.9})")
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(seed) if rng is None else rng
     radii = np.array(np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)))
     if np.any(radii <= 0):
         raise ConfigError("radii: must be > 0")

@@ -1,12 +1,6 @@
-"""Export a run for LAMMPS (same physics, time-stepped DEM) or OVITO (GSD).
+"""GSD trajectories (HOOMD schema) of our H5MD files, for OVITO.
 
-``granulargas export lammps CONFIG [-o DIR]`` writes a LAMMPS data file and
-input script that start from the same initial state as ``granulargas run
-CONFIG`` (same seed, same particles) with the same contact law
-(:mod:`granulargas.io.lammps`: hertz/material + damping viscoelastic, a
-stiffness whose contact time is a stated fraction of the mean free time).
-
-``granulargas export gsd FILE.h5 [-o FILE.gsd]`` converts every snapshot of
+:func:`export_gsd` (``granulargas export gsd FILE.h5 [-o FILE.gsd]``) converts every snapshot of
 an H5MD file to a GSD trajectory (HOOMD schema, read natively by OVITO, 2D
 included): positions (shifted to the box centred on 0), velocities, image
 flags, diameters, masses, species as types, the box, and per frame the
@@ -20,14 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
-from granulargas.errors import ConfigError, InputFileError, UserError
+from granulargas.errors import InputFileError, UserError
+from granulargas.io.h5md import iter_snapshots, snapshot_count
 
 #: Time of each frame in the GSD file (OVITO shows log/ entries as global attributes).
 GSD_TIME_KEY = "granulargas/time"
 
 
 def _import_gsd():
-    try:
+    try:  # optional dependency (the 'export' extra): imported only when a GSD file is written
         import gsd.hoomd
     except ImportError:
         raise UserError("the gsd package is needed for GSD export: pip install 'granulargas[export]'") from None
@@ -61,8 +56,6 @@ def export_gsd(h5_path, gsd_path=None, *, overwrite: bool = False) -> tuple[Path
     kept, so x_unwrapped - L/2 = position + image L. In 2D, Lz = 0 and z = 0
     (``configuration/dimensions`` = 2).
     """
-    from granulargas.io.h5md import iter_snapshots, snapshot_count
-
     hoomd = _import_gsd()
     h5_path = Path(h5_path)
     gsd_path = Path(gsd_path) if gsd_path is not None else h5_path.with_suffix(".gsd")
@@ -121,107 +114,3 @@ def _gsd_frame(hoomd, snap, static):
     frame.particles.mass = masses
     frame.log[GSD_TIME_KEY] = np.array([snap.time], dtype=np.float64)
     return frame
-
-
-# --------------------------------------------------------------------------- LAMMPS
-
-
-def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_per_contact: int = 50,
-                  end_time: float | None = None, poisson_ratio: float | None = None, name: str = "granulargas"):
-    """Write LAMMPS data + input for a run config (same initial state as ``granulargas run``).
-
-    Parameters
-    ----------
-    config : RunConfig
-        A viscoelastic (or elastic) config.
-    directory : path
-        Output directory for ``data.<name>``, ``in.<name>``, ``granulargas_lammps.json``.
-    contact_fraction, steps_per_contact :
-        See :func:`granulargas.io.lammps.write_lammps_gas`.
-    end_time : float, optional
-        Simulated time (default: the config's ``run.end_time``).
-    poisson_ratio : float, optional
-        Default: the config's material value, else 0.3 (only Y / (1 - nu^2) matters).
-
-    Returns
-    -------
-    granulargas.io.lammps.LammpsExport
-    """
-    from granulargas.io import lammps, setup
-    from granulargas.io.runner import DEFAULT_OBSERVABLE_SAMPLES
-
-    c = config.collision
-    if c.model == "constant":
-        raise ConfigError(
-            f"{config.source}: collision.model = \"constant\": LAMMPS export needs the viscoelastic "
-            "(or elastic) contact law"
-        )
-    end_time = config.run.end_time if end_time is None else end_time
-    if end_time is None:
-        raise ConfigError(f"{config.source}: run.end_time is not set: LAMMPS runs for a fixed time (use --end-time)")
-    if c.model == "elastic":
-        prefactor, end = 0.0, "overlap"
-    else:
-        prefactor, end = setup.reduced_prefactor(config), c.contact_end
-    if poisson_ratio is None:
-        poisson_ratio = c.material.poisson_ratio if c.material is not None else lammps.DEFAULT_POISSON
-    state = setup.restart_state(config) if config.initial.from_file else setup.fresh_state(config)
-    if config.initial.from_file:
-        end_time = end_time - state.time
-        if end_time <= 0:
-            raise ConfigError(f"{config.source}: run.end_time = {end_time + state.time}: restart file is already at "
-                              f"t = {state.time}")
-    interval = config.output.observables_interval or end_time / DEFAULT_OBSERVABLE_SAMPLES
-    return lammps.write_lammps_gas(
-        directory, state.positions, state.velocities, state.radii, state.masses, state.box, prefactor,
-        end=end, end_time=end_time, thermo_interval=interval, contact_fraction=contact_fraction,
-        steps_per_contact=steps_per_contact, poisson_ratio=poisson_ratio, name=name, source=config.source,
-        time_origin=state.time,
-    )
-
-
-# --------------------------------------------------------------------------- CLI
-
-
-def configure_parser(parser):
-    sub = parser.add_subparsers(dest="format", metavar="FORMAT", required=True)
-    p = sub.add_parser("lammps", help="LAMMPS data + input with the same initial state and contact law",
-                       description="Write a LAMMPS (pair_style granular) run equivalent to a config.")
-    p.add_argument("config", help="TOML run configuration")
-    p.add_argument("-o", "--output", metavar="DIR", default=None,
-                   help="output directory (default: lammps_<config name>)")
-    p.add_argument("--contact-fraction", type=float, default=0.01, metavar="F",
-                   help="contact time / mean free time, sets the stiffness (default 0.01)")
-    p.add_argument("--steps-per-contact", type=int, default=50, metavar="N",
-                   help="timestep = contact time / N (default 50)")
-    p.add_argument("--end-time", type=float, default=None, metavar="T",
-                   help="simulated time (default: run.end_time of the config)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a config value, as in granulargas run (repeatable)")
-    g = sub.add_parser("gsd", help="GSD trajectory of an H5MD file (opens in OVITO)",
-                       description="Convert every snapshot of an H5MD file to GSD (HOOMD schema).")
-    g.add_argument("file", help="H5MD file written by granulargas run")
-    g.add_argument("-o", "--output", metavar="FILE.gsd", default=None, help="output (default: FILE with .gsd)")
-    g.add_argument("--overwrite", action="store_true", help="replace an existing output file")
-
-
-def run(args) -> int:
-    if args.format == "gsd":
-        path, frames = export_gsd(args.file, args.output, overwrite=args.overwrite)
-        print(f"wrote {path} ({frames} frames)")
-        return 0
-    from granulargas.io.config import load_config
-    from granulargas.io.run_command import parse_override
-
-    overrides = dict(parse_override(t) for t in args.overrides)
-    config = load_config(args.config, overrides)
-    directory = Path(args.output) if args.output else Path(f"lammps_{Path(args.config).stem}")
-    ex = export_lammps(config, directory, contact_fraction=args.contact_fraction,
-                       steps_per_contact=args.steps_per_contact, end_time=args.end_time)
-    print(f"wrote {ex.input_file} and {ex.data_file}")
-    print(f"  Y = {ex.contact.young_modulus:.6g}, A = {ex.contact.dissipation_time:.6g}, end = {ex.contact.end}"
-          f"{' (limit_damping)' if ex.contact.end == 'force' else ''}")
-    print(f"  contact time {ex.contact_time:.4g} = {ex.contact_fraction:g} x mean free time {ex.mean_free_time:.4g};"
-          f" timestep {ex.timestep:.4g}, {ex.steps} steps")
-    print(f"  run: cd {directory} && lmp -in {ex.input_file.name}")
-    return 0

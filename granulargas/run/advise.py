@@ -4,7 +4,7 @@ A viscoelastic gas sees a whole range of eps: fast impacts at the start of a
 cooling run are more inelastic than slow ones at the end (eps -> 1 as g -> 0).
 From the config alone (T0, damping or material, density, run length) the
 advice predicts, with kinetic theory and no simulation
-(:mod:`granulargas.validity` explains each step):
+(:mod:`granulargas.run.validity` explains each step):
 
 1. the temperature range of the run, from the viscoelastic cooling law solved
    with the exact eps(beta) (a quadrature in ln T);
@@ -40,10 +40,9 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from granulargas import theory
-from granulargas import validity as V
+from granulargas.run import validity as V
 
-__all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error",
-           "best_constant", "configure_parser", "run"]
+__all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant"]
 
 #: default tolerance on the relative error of T(t)
 DEFAULT_TOLERANCE = 0.02
@@ -60,7 +59,7 @@ class Advice:
     t_end, T_end : float
         Predicted run end time and final temperature.
     spread : dict or None
-        :func:`granulargas.validity.restitution_spread` over the run.
+        :func:`granulargas.run.validity.restitution_spread` over the run.
     eps_best : float or None
         Best constant eps (viscoelastic config) or the config's eps.
     error : float or None
@@ -219,31 +218,3 @@ def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
         return (f"advice       constant eps = {adv.eps_best:g} ~ damping {adv.damping_equivalent:.3g}; a viscoelastic "
                 f"gas would differ by up to {100 * adv.error:.2g} % in T(t) over this run")
     return None
-
-
-# ---------------------------------------------------------------- command line
-
-
-def configure_parser(parser):
-    parser.add_argument("config", help="TOML run configuration")
-    parser.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCE,
-                        help=f"allowed relative error of T(t) (default {DEFAULT_TOLERANCE:g})")
-    parser.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                        help="override a config value, e.g. --set collision.damping=0.05 (repeatable)")
-
-
-def run(args) -> int:
-    from granulargas.errors import ConfigError
-    from granulargas.io.config import load_config
-    from granulargas.io.run_command import parse_override
-
-    if not (0.0 < args.tolerance < 1.0):
-        raise ConfigError(f"--tolerance = {args.tolerance:g}: must be in (0, 1)")
-    config = load_config(args.config, dict(parse_override(t) for t in args.overrides))
-    adv = advise(config, args.tolerance)
-    print("\n".join(adv.lines()))
-    rv = V.check_run(config)
-    extra = [ln for ln in rv.lines()[1:] if not ln.startswith("validity     beta")]
-    if extra:
-        print("\n".join(extra))
-    return 0

@@ -1,4 +1,4 @@
-"""Config -> collision rule, restitution table and initial state.
+"""Config -> collision rule, restitution table and initial state (what a run starts from).
 
 Units are converted here, once (ARCHITECTURE.md "Units"):
 
@@ -29,32 +29,19 @@ from pathlib import Path
 import numpy as np
 
 from granulargas import __version__
+from granulargas.contact import material, restitution_table
+from granulargas.engine import CollisionRule
+from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
+from granulargas.initial import InitialState, box_for_packing, random_state
 from granulargas.io.config import RunConfig
-
-
-@dataclass
-class InitialState:
-    """Public engine state to start from (original particle order)."""
-
-    positions: np.ndarray
-    velocities: np.ndarray
-    radii: np.ndarray
-    masses: np.ndarray
-    box: np.ndarray
-    species: np.ndarray
-    images: np.ndarray | None = None
-    time: float = 0.0
-    collisions: int = 0
-    events: int = 0
-    dissipated_energy: float = 0.0
-    last_collision: np.ndarray | None = None
-    source: str | None = None
+from granulargas.io.h5md import load_snapshot, open_run, snapshot_count
+from granulargas.theory import particle_volume
 
 
 @dataclass
 class Setup:
-    """Everything :func:`granulargas.io.runner.run_config` needs."""
+    """Everything :func:`granulargas.run.runner.run_config` needs."""
 
     rule: object
     rule_name: str
@@ -68,55 +55,44 @@ class Setup:
 # ------------------------------------------------------------------- particles
 
 
-def particle_volume(diameter, dimension: int):
-    """Volume (3D, pi d^3/6) or area (2D, pi d^2/4) of particles of the given diameters."""
-    d = np.asarray(diameter, dtype=np.float64)
-    return math.pi * d**3 / 6.0 if dimension == 3 else math.pi * d**2 / 4.0
-
-
 def make_particles(config: RunConfig, rng: np.random.Generator):
-    """Radii, masses, species and the cubic box of the config's packing fraction."""
+    """Radii and masses of the config's particles (polydisperse radii drawn from ``rng``)."""
     s, p = config.system, config.particles
-    n, dim = s.particles, s.dimension
+    n = s.particles
     if p.polydisperse:
         diam = rng.uniform(p.diameter_min, p.diameter_max, n)
     else:
         diam = np.full(n, p.diameter)
     radii = np.ascontiguousarray(0.5 * diam)
-    vol = particle_volume(diam, dim)
-    masses = np.full(n, p.mass) if p.mass is not None else p.density * vol
-    edge = (vol.sum() / s.packing_fraction) ** (1.0 / dim)
-    box = np.full(dim, edge)
-    return radii, np.ascontiguousarray(masses, dtype=np.float64), np.zeros(n, np.int32), box
+    masses = np.full(n, p.mass) if p.mass is not None else p.density * particle_volume(diam, s.dimension)
+    return radii, np.ascontiguousarray(masses, dtype=np.float64)
 
 
 def fresh_state(config: RunConfig) -> InitialState:
     """Random non-overlapping positions and Maxwell-Boltzmann velocities with zero
     total momentum and temperature exactly ``initial.temperature``; all drawn from
-    ``numpy.random.default_rng(system.seed)`` (radii, then positions, then velocities)."""
-    from granulargas.engine import initial
-
+    ``numpy.random.default_rng(system.seed)`` (radii, then positions, then velocities)
+    by :func:`granulargas.initial.random_state`."""
     s = config.system
     rng = np.random.default_rng(s.seed)
-    radii, masses, species, box = make_particles(config, rng)
-    # the engine's cell grid needs >= 3.05 largest diameters per side
-    if box.min() < 3.05 * 2.0 * radii.max():
+    radii, masses = make_particles(config, rng)
+    box = box_for_packing(radii, s.packing_fraction, s.dimension)
+    dmax = 2.0 * float(radii.max())
+    if float(box.min()) < MIN_BOX_DIAMETERS * dmax:  # the engine's cell grid (engine.simulation)
         raise ConfigError(
-            f"{config.source}: system.particles = {s.particles}: box edge {box.min():.3g} is below 3.05 largest "
-            "diameters; use more particles or a higher packing_fraction"
+            f"{config.source}: system.particles = {s.particles}: box edge {box.min():.3g} is below "
+            f"{MIN_BOX_DIAMETERS:g} largest diameters (= {MIN_BOX_DIAMETERS * dmax:.4g}); use more particles "
+            "or a higher packing_fraction"
         )
     try:
-        positions = initial.random_positions(radii, box, rng=rng)
+        return random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
+                            radii=radii, masses=masses, rng=rng)
     except ConfigError as exc:
         raise ConfigError(f"{config.source}: system.packing_fraction = {s.packing_fraction:g}: {exc}") from None
-    velocities = initial.maxwell_velocities(masses, s.dimension, config.initial.temperature, rng=rng)
-    return InitialState(positions, np.ascontiguousarray(velocities), radii, masses, box, species)
 
 
 def restart_state(config: RunConfig) -> InitialState:
     """The last snapshot of one of our files, with its time and counters."""
-    from granulargas.io.h5md import load_snapshot, open_run, snapshot_count
-
     path = Path(config.initial.from_file)
     where = f'{config.source}: initial.from = "{path}"'
     try:
@@ -165,8 +141,6 @@ def restart_state(config: RunConfig) -> InitialState:
 
 def reduced_prefactor(config: RunConfig) -> float:
     """The viscoelastic pair prefactor k in reduced units (see module docstring)."""
-    from granulargas.contact import material
-
     c = config.collision
     if c.material is None:
         return float(material.prefactor_from_damping(c.damping, radius=0.5, mass=1.0))
@@ -205,8 +179,6 @@ def validity_warnings(config: RunConfig, prefactor: float, state: InitialState) 
     """One-line warnings when the run's expected beta range (or, on the material
     route, its impact speeds) leaves the viscoelastic model's range
     (:func:`granulargas.contact.material.validity_problems`)."""
-    from granulargas.contact.material import sound_speed, validity_problems
-
     _, high = expected_beta(prefactor, state)
     speed = sound = None
     mat = config.collision.material
@@ -214,15 +186,13 @@ def validity_warnings(config: RunConfig, prefactor: float, state: InitialState) 
         m, d = state.masses, state.velocities.shape[1]
         temp = float((m[:, None] * state.velocities**2).sum()) / (d * len(m))
         speed = 3.0 * math.sqrt(2.0 * temp / float(m.min())) * mat.speed_unit  # m/s
-        sound = sound_speed(mat.young_modulus, mat.density)
-    return [f"warning: {config.source}: {p}" for p in validity_problems(beta=high, impact_speed=speed,
+        sound = material.sound_speed(mat.young_modulus, mat.density)
+    return [f"warning: {config.source}: {p}" for p in material.validity_problems(beta=high, impact_speed=speed,
                                                                           speed_of_sound=sound)]
 
 
 def make_rule(config: RunConfig, state: InitialState):
     """(rule, name, prefactor, table, warnings, parameters) for the config."""
-    from granulargas.engine import CollisionRule
-
     c = config.collision
     params = {"model": c.model}
     if c.model == "elastic":
@@ -230,8 +200,6 @@ def make_rule(config: RunConfig, state: InitialState):
     if c.model == "constant":
         params.update(restitution=c.restitution, tc_time=c.tc_time)
         return CollisionRule.constant(c.restitution, tc_time=c.tc_time), "constant", None, None, [], params
-    from granulargas.contact import restitution_table
-
     k = reduced_prefactor(config)
     bmax = beta_bound(k, state)
     table = restitution_table(max(bmax, 1e-6), end=c.contact_end)
@@ -245,9 +213,15 @@ def make_rule(config: RunConfig, state: InitialState):
     return CollisionRule.viscoelastic(prefactor=k, table=table), "viscoelastic", k, table, warns, params
 
 
+def initial_state(config: RunConfig) -> InitialState:
+    """The state a run of ``config`` starts from: the restart file's last snapshot
+    (``initial.from``) or a fresh random state."""
+    return restart_state(config) if config.initial.from_file else fresh_state(config)
+
+
 def prepare(config: RunConfig) -> Setup:
     """Build rule, table and initial state; raise before any file is written."""
-    state = restart_state(config) if config.initial.from_file else fresh_state(config)
+    state = initial_state(config)
     rule, name, k, table, warns, rule_params = make_rule(config, state)
     s = config.system
     vol = particle_volume(2.0 * state.radii, s.dimension).sum()

@@ -1,4 +1,4 @@
-"""Parameter sweeps and ensembles: ``granulargas sweep SWEEP.toml``.
+"""Parameter sweeps and ensembles: the sweep file, its runs, the executor.
 
 A sweep file names a base config and the parameters to vary::
 
@@ -33,18 +33,21 @@ failed run is reported with its parameters and does not stop the others.
 
 from __future__ import annotations
 
-import argparse
 import itertools
+import multiprocessing
 import os
-import sys
 import time
 import tomllib
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import h5py
+
 from granulargas.errors import ConfigError, InputFileError
+from granulargas.io.config import load_config
 from granulargas.io.sweep_index import INDEX_NAME, read_index, write_index
+from granulargas.run.runner import run_config
 
 _TOP_KEYS = {"base", "output_dir", "mode", "set", "vary", "name"}
 
@@ -117,7 +120,7 @@ def _expand_values(path: Path, key: str, spec) -> list:
     raise ConfigError(f"{where} = {spec!r}: expected a list, a value, or range/linspace/logspace")
 
 
-def _format_value(value) -> str:
+def format_value(value) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
     return str(value)
@@ -173,9 +176,6 @@ def run_one(base: str, overrides: dict) -> dict:
     """Run one sweep member in a worker; never raises (errors come back as data)."""
     start = time.perf_counter()
     try:
-        from granulargas.io.config import load_config
-        from granulargas.io.runner import run_config
-
         config = load_config(base, overrides=overrides)
         summary = run_config(config, overwrite=True, quiet=True)
         return {
@@ -197,8 +197,6 @@ def _write_index(sweep: Sweep, entries: dict) -> None:
 
 def _file_is_readable(file: str) -> bool:
     try:
-        import h5py
-
         with h5py.File(file, "r") as fh:
             return "h5md" in fh
     except Exception:
@@ -238,7 +236,7 @@ def run_sweep(sweep: Sweep, executor: Executor, *, log=print) -> list[dict]:
             result = {"status": "failed", "error": f"{type(exc).__name__}: {exc}"}
         entries[spec.name] = {**entries[spec.name], **result}
         _write_index(sweep, entries)
-        params = ", ".join(f"{k}={_format_value(v)}" for k, v in spec.parameters.items())
+        params = ", ".join(f"{k}={format_value(v)}" for k, v in spec.parameters.items())
         if result["status"] == "done":
             log(f"done {spec.name} ({params}): {result['collisions']} collisions in {result['wall_time']:.1f} s")
         else:
@@ -252,7 +250,7 @@ def make_executor(workers: int | None = None, scheduler: str | None = None):
     Returns ``(executor, close)``; call ``close()`` when done.
     """
     if scheduler:
-        try:
+        try:  # optional dependency (the 'dask' extra), imported only when asked for
             from dask.distributed import Client
         except ImportError:
             raise InputFileError(
@@ -263,39 +261,6 @@ def make_executor(workers: int | None = None, scheduler: str | None = None):
         except OSError as exc:
             raise InputFileError(f"--scheduler {scheduler}: cannot connect ({exc})") from None
         return client.get_executor(pure=False), client.close
-    import multiprocessing
-
     workers = workers or max(1, os.cpu_count() or 1)
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
     return pool, pool.shutdown
-
-
-def configure_parser(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("sweep_file", metavar="SWEEP.toml", help="sweep file (see `granulargas.sweep`)")
-    parser.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
-    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                        help="run on a Dask cluster, e.g. tcp://host:8786 (needs the 'dask' extra)")
-    parser.add_argument("--dry-run", action="store_true", help="list the runs and exit")
-
-
-def run(args) -> int:
-    sweep = load_sweep(args.sweep_file)
-    if args.workers is not None and args.workers < 1:
-        raise ConfigError(f"--workers = {args.workers}: must be at least 1")
-    print(f"sweep {sweep.path}: {len(sweep.runs)} runs of {sweep.base} -> {sweep.output_dir}")
-    if args.dry_run:
-        for spec in sweep.runs:
-            params = ", ".join(f"{k}={_format_value(v)}" for k, v in spec.parameters.items())
-            print(f"  {spec.name}: {params}")
-        return 0
-    executor, close = make_executor(args.workers, args.scheduler)
-    try:
-        entries = run_sweep(sweep, executor)
-    finally:
-        close()
-    failed = [e for e in entries if e["status"] != "done"]
-    print(f"{len(entries) - len(failed)} of {len(entries)} runs done; index: {sweep.index_path}")
-    if failed:
-        print(f"{len(failed)} runs failed; rerun the same command to retry them", file=sys.stderr)
-        return 1
-    return 0

@@ -39,7 +39,7 @@ collisions are in truth three-body contacts. Such a contact changes the energy
 dissipated in the collisions involved by an amount of their own order, so the
 relative error of the cooling rate is of order ``f``. We warn when ``f`` exceeds
 2 %, i.e. ``t_c / t_free > TC_RATIO_WARN = 0.01``: the same 2 % that
-:mod:`granulargas.advise` takes as the default tolerance of T(t). The duration
+:mod:`granulargas.run.advise` takes as the default tolerance of T(t). The duration
 ``t_c = tau_c(beta) rho^(-2/5) g^(-1/5)`` (seed eq. 2 rescaled) needs the
 stiffness rho, known only on the material route; the ``damping`` route fixes
 beta alone (hard spheres: ``t_c -> 0``), and the ratio is then reported as not
@@ -84,7 +84,10 @@ import numpy as np
 from numpy.polynomial.legendre import leggauss
 
 from granulargas import theory
+from granulargas.contact import restitution_table
+from granulargas.contact.material import rho_from_material
 from granulargas.errors import ConfigError
+from granulargas.run.prepare import reduced_prefactor
 
 __all__ = [
     "TC_RATIO_WARN",
@@ -205,8 +208,6 @@ def gas_from_config(config) -> Gas:
     mass = p.mass if p.mass is not None else p.density * vol
     k = b = None
     if c.model == "viscoelastic":
-        from granulargas.io.setup import reduced_prefactor
-
         k = float(reduced_prefactor(config))
         b = float(theory.pair_damping(k, sigma, mass))
     return Gas(
@@ -229,8 +230,6 @@ def impact_speed_quantile(q, temperature, mass=1.0):
 
 def _eps(beta, end):
     """Exact eps(beta) through the engine's table (2e-10)."""
-    from granulargas.contact import restitution_table
-
     b = np.asarray(beta, dtype=float)
     table = restitution_table(max(float(np.max(b)) * 1.001, 1e-6), end=end)
     return table.restitution(b)
@@ -406,9 +405,6 @@ def contact_time_ratio(config_or_gas, temperature: float | None = None) -> float
         return gas.tc_time * omega
     if gas.model != "viscoelastic" or gas.material is None:
         return None
-    from granulargas.contact import restitution_table
-    from granulargas.contact.material import rho_from_material
-
     m = gas.material
     diameter_si = m.diameter * gas.sigma
     mass_si = m.density * math.pi * diameter_si**3 / 6.0

@@ -49,6 +49,7 @@ from scipy.special import gamma as _gamma
 __all__ = [
     "C1",
     "C2",
+    "particle_volume",
     "packing_fraction",
     "number_density",
     "contact_value",
@@ -82,19 +83,34 @@ def _check_dim(dim):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
 
 
-def packing_fraction(n, dim=3, sigma=1.0):
-    """Packing (area/volume) fraction of spheres or disks.
+def particle_volume(diameter, dim=3):
+    """Volume of spheres (3D, ``pi sigma^3 / 6``) or area of disks (2D, ``pi sigma^2 / 4``).
 
-    ``eta = pi n sigma^3 / 6`` (3D), ``pi n sigma^2 / 4`` (2D).
+    Parameters
+    ----------
+    diameter : float or array
+        Diameter(s) sigma (not radii).
+    dim : {2, 3}
+
+    Returns
+    -------
+    float or array, same shape as ``diameter``
     """
     _check_dim(dim)
-    return np.pi * n * sigma**3 / 6.0 if dim == 3 else np.pi * n * sigma**2 / 4.0
+    d = np.asarray(diameter, dtype=np.float64)
+    out = np.pi * d**3 / 6.0 if dim == 3 else np.pi * d**2 / 4.0
+    return out[()] if out.ndim == 0 else out
+
+
+def packing_fraction(n, dim=3, sigma=1.0):
+    """Packing (area/volume) fraction ``eta = n v(sigma)`` of spheres or disks
+    (:func:`particle_volume`: ``pi n sigma^3 / 6`` in 3D, ``pi n sigma^2 / 4`` in 2D)."""
+    return n * particle_volume(sigma, dim)
 
 
 def number_density(eta, dim=3, sigma=1.0):
-    """Inverse of :func:`packing_fraction`: number density for packing fraction ``eta``."""
-    _check_dim(dim)
-    return 6.0 * eta / (np.pi * sigma**3) if dim == 3 else 4.0 * eta / (np.pi * sigma**2)
+    """Inverse of :func:`packing_fraction`: number density ``eta / v(sigma)`` for packing fraction ``eta``."""
+    return eta / particle_volume(sigma, dim)
 
 
 def contact_value(eta, dim=3):

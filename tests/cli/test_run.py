@@ -73,7 +73,7 @@ BAD = {
     "negative damping": (_replace('model = "constant"\nrestitution = 0.9', 'model = "viscoelastic"\ndamping = -0.1'),
                          "collision.damping = -0.1: must be a number >= 0"),
     "unknown model": (_replace('model = "constant"', 'model = "hertz"'), 'collision.model = "hertz": must be one of'),
-    "too few particles": (_replace("particles = 200", "particles = 4"), "below 3.05 largest diameters"),
+    "too few particles": (_replace("particles = 200", "particles = 4"), "below 3.15 largest diameters"),
 }
 
 

@@ -14,9 +14,9 @@ import pytest
 from granulargas.cli import main
 from granulargas.errors import UserError
 from granulargas.io.config import parse_config
-from granulargas.io.export import export_lammps
-from granulargas.io.lammps import HERTZ_DURATION, enskog_mean_free_time, find_lmp, read_thermo, run_lammps
-from granulargas.io.setup import fresh_state, reduced_prefactor
+from granulargas.dem.export import export_lammps
+from granulargas.dem.lammps import HERTZ_DURATION, enskog_mean_free_time, find_lmp, read_thermo, run_lammps
+from granulargas.run.prepare import fresh_state, reduced_prefactor
 
 needs_lmp = pytest.mark.skipif(find_lmp() is None, reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
 
@@ -126,7 +126,7 @@ def test_overlap_end_has_no_limit_damping(tmp_path):
 
 
 def test_unequal_masses_get_one_eta_per_type_pair(tmp_path):
-    from granulargas.io.lammps import write_lammps_gas
+    from granulargas.dem.lammps import write_lammps_gas
 
     rng = np.random.default_rng(0)
     n, L = 40, 12.0
@@ -192,7 +192,7 @@ def test_lammps_cools_like_granulargas(tmp_path, dimension, end_time):
     1.5 error in the damping mapping moves T(t_end) by 10-20 %; the tolerance is 4 %.
     """
     from granulargas.io.h5md import read_observables
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     text = config_text(dimension, particles=1000).replace("damping = 0.2", "damping = 0.1")
     text = text.replace("end_time = 0.5", f"end_time = {end_time}")
@@ -212,7 +212,7 @@ def test_lammps_cools_like_granulargas(tmp_path, dimension, end_time):
 def test_export_from_a_restart_file(tmp_path):
     """initial.from: LAMMPS starts from the file's last snapshot and runs the remaining time."""
     from granulargas.io.h5md import load_snapshot
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     h5 = tmp_path / "first.h5"
     run_config(parse_config(config_text() + f'\n[output]\nfile = "{h5}"\nsnapshots = 2\n'), quiet=True)

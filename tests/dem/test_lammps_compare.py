@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from granulargas.io.lammps import find_lmp
+from granulargas.dem.lammps import find_lmp
 
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "compare_lammps.py"
 

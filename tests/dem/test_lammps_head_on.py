@@ -1,7 +1,7 @@
 """Two spheres head-on in LAMMPS vs the viscoelastic contact ODE (seed eq. 2).
 
 LAMMPS ``pair_style granular`` (hertz/material + damping viscoelastic, mapped
-by :class:`granulargas.io.lammps.DemContact`) is an independent integrator of
+by :class:`granulargas.dem.lammps.DemContact`) is an independent integrator of
 the same contact law: with ``limit_damping`` it must converge to the ``force``
 end of contact, without it to the ``overlap`` end, at first order in the
 timestep. The reference eps(beta) is an independent ODE solve written here
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from granulargas.io.lammps import DemContact, find_lmp, head_on_restitution
+from granulargas.dem.lammps import DemContact, find_lmp, head_on_restitution
 
 needs_lmp = pytest.mark.skipif(find_lmp() is None, reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
 

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from granulargas.io.lammps import (
+from granulargas.dem.lammps import (
     HERTZ_DURATION,
     DemContact,
     enskog_mean_free_time,

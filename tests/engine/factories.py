@@ -2,7 +2,7 @@
 
 import numpy as np
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 
 
 def make_sim(n=24, packing=0.2, dimension=3, seed=0, rule=None, radii=0.5, **kw):

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from granulargas.engine.initial import particle_volume, random_state
 from granulargas.errors import ConfigError
+from granulargas.initial import random_state
+from granulargas.theory import particle_volume
 
 
 def _min_ratio(pos, radii, box):
@@ -20,7 +21,7 @@ def test_dense_placement_without_overlap(d, eta):
     st = random_state(500, eta, d, seed=1)
     assert _min_ratio(st.positions, st.radii, st.box) >= 1.0
     assert np.all(st.positions >= 0) and np.all(st.positions < st.box)
-    assert np.sum(particle_volume(st.radii, d)) / np.prod(st.box) == pytest.approx(eta, rel=1e-12)
+    assert np.sum(particle_volume(2 * st.radii, d)) / np.prod(st.box) == pytest.approx(eta, rel=1e-12)
 
 
 @pytest.mark.parametrize("d, eta", [(3, 0.4), (2, 0.65)])

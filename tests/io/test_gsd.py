@@ -7,7 +7,7 @@ import pytest
 
 from granulargas.cli import main
 from granulargas.errors import InputFileError, UserError
-from granulargas.io.export import GSD_TIME_KEY, export_gsd
+from granulargas.io.gsd import GSD_TIME_KEY, export_gsd
 from granulargas.io.h5md import H5MDWriter, iter_snapshots
 
 # gsd is in the `test` extra: a missing gsd fails here rather than skipping the export tests

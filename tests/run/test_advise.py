@@ -7,12 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from granulargas import advise as A
+from granulargas.run import advise as A
 from granulargas import theory
 from granulargas.cli import main
 from granulargas.io.config import parse_config
 
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 
 
 def config(collision, run="end_time = 100.0"):

@@ -13,7 +13,7 @@ import pytest
 
 from granulargas.io.config import load_config, parse_config
 from granulargas.io.h5md import iter_snapshots, load_snapshot, read_observables, read_parameters, snapshot_count
-from granulargas.io.runner import mean_free_time, output_schedule, run_config
+from granulargas.run.runner import mean_free_time, output_schedule, run_config
 
 
 def test_schedule_log_spaced_from_mean_free_time(small_3d):
@@ -174,7 +174,7 @@ def test_two_dimensional_polydisperse_run(small_3d, write_config):
 def test_material_route_converts_to_reduced_prefactor(small_3d, write_config):
     """k = k_SI (sigma u / M^2)^(1/5), checked against beta computed directly in SI units."""
     from granulargas.contact.material import beta_from_material
-    from granulargas.io.setup import reduced_prefactor
+    from granulargas.run.prepare import reduced_prefactor
 
     mat = dict(young_modulus=1e7, poisson_ratio=0.4, dissipation_time=1e-5, diameter=0.01, density=1100.0,
                speed_unit=2.0)
@@ -222,7 +222,7 @@ def test_killed_run_leaves_valid_file(small_3d, write_config, tmp_path):
 
 
 def test_validity_warning_is_one_line(write_config):
-    from granulargas.io.setup import expected_beta, fresh_state
+    from granulargas.run.prepare import expected_beta, fresh_state
 
     cfg = load_config(write_config(), {"collision.damping": 2.0, "run.end_time": 0.5})
     typical, high = expected_beta(2.0, fresh_state(cfg))  # k = damping for reference particles

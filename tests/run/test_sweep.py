@@ -9,7 +9,7 @@ import pytest
 
 from granulargas.cli import main
 from granulargas.errors import ConfigError
-from granulargas.sweep import load_sweep, make_executor, read_index, run_sweep
+from granulargas.run.sweep import load_sweep, make_executor, read_index, run_sweep
 
 BASE = """\
 [system]

@@ -8,7 +8,7 @@ import pytest
 from scipy.special import gamma
 
 from granulargas import theory
-from granulargas import validity as V
+from granulargas.run import validity as V
 from granulargas.errors import ConfigError
 from granulargas.io.config import parse_config
 
