@@ -218,7 +218,7 @@ def main(argv=None):
         n, seeds, t_end, sizes, orders = 300, 2, 10.0, [4, 128], {"overlap": [1, 2], "force": [4]}
     timing = dict(n=500, collisions=20_000, repeats=1) if args.quick else {}
     wall0 = time.perf_counter()
-    # rigorous beta bound of the runs (io.setup): g_n <= 2 sqrt(2 E / m), R_eff <= 1/2, m_eff >= 1/2
+    # rigorous beta bound of the runs (run.prepare): g_n <= 2 sqrt(2 E / m), R_eff <= 1/2, m_eff >= 1/2
     g_max = 2.0 * math.sqrt(2.0 * 1.5 * n * 1.05)
     beta_max = b * (2 * 0.5 / 1.0) ** 0.2 * g_max**0.2
     times = np.linspace(0, t_end, 41)[1:]

@@ -12,7 +12,7 @@ Units (reduced): lengths in the reference particle diameter, masses in the
 reference particle mass, energies in the initial temperature T0 (k_B = 1), so
 time in sigma sqrt(m/T0). The material route (``[collision.material]``) gives
 the reference particle's SI diameter and density and the SI velocity unit
-``speed_unit`` (= sqrt(T0/m) for temperature 1); :mod:`granulargas.io.setup`
+``speed_unit`` (= sqrt(T0/m) for temperature 1); :mod:`granulargas.run.prepare`
 converts it once to the reduced pair prefactor k (ARCHITECTURE.md).
 """
 
