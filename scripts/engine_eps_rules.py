@@ -268,7 +268,7 @@ def main(argv=None):
     # engine: compile once (not timed), then references
     engine_runs(max(n, 300), b, ref["overlap"], 1, 0.5, np.array([0.5]))
     gas = V.Gas(dimension=3, packing_fraction=0.1, density=theory.number_density(0.1, 3), sigma=1.0, mass=1.0,
-                temperature=1.0, model="viscoelastic", prefactor=b, damping=b)
+                temperature=1.0, model="viscoelastic", prefactor=b)
     T_ref, cost_ref, pred_ref = {}, {}, {}
     for end in ("overlap", "force"):
         T_ref[end], _ = engine_runs(n, b, ref[end], seeds, t_end, times)

@@ -22,6 +22,7 @@ import numpy as np
 from granulargas.contact import duration, material, restitution
 from granulargas.contact.series import MAX_RELIABLE_ORDER, SeriesDivergenceWarning, radius_of_convergence
 from granulargas.errors import UserError
+from granulargas.theory import particle_volume
 
 
 def configure_parser(parser):
@@ -67,8 +68,8 @@ def _material(args):
         m1 = args.mass
         m2 = args.mass2 or m1
     else:
-        m1 = args.density * 4 / 3 * math.pi * r1 ** 3
-        m2 = args.density * 4 / 3 * math.pi * r2 ** 3
+        m1 = args.density * float(particle_volume(2.0 * r1, 3))
+        m2 = args.density * float(particle_volume(2.0 * r2, 3))
     r_eff, m_eff = material.effective(r1, r2), material.effective(m1, m2)
     g = np.asarray(args.speed, dtype=float)
     beta = material.beta_from_material(args.young, args.poisson, args.dissipation_time, r_eff, m_eff, g)

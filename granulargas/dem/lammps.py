@@ -46,6 +46,8 @@ from pathlib import Path
 
 import numpy as np
 
+from granulargas import theory
+from granulargas.contact import material
 from granulargas.errors import InputFileError, UserError
 
 #: Elastic Hertz contact duration in units rho^{-2/5} g^{-1/5}:
@@ -99,20 +101,24 @@ class DemContact:
         return self.young_modulus / (1.0 - self.poisson_ratio**2)
 
     def rho(self, radius_eff: float, mass_eff: float) -> float:
-        """Seed's rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2))."""
-        return 2.0 * self.reduced_modulus * math.sqrt(radius_eff) / (3.0 * mass_eff)
+        """Schwager & Pöschel's rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2))
+        (:func:`granulargas.contact.material.rho_from_material`)."""
+        return float(material.rho_from_material(self.young_modulus, self.poisson_ratio, radius_eff, mass_eff))
 
     def eta_n0(self, mass_eff: float) -> float:
         """LAMMPS damping coefficient eta_n0 = 3 A rho / (2 sqrt(R_eff)) = A Y / ((1-nu^2) m_eff)."""
         return self.dissipation_time * self.reduced_modulus / mass_eff
 
     def beta(self, speed: float, radius_eff: float, mass_eff: float) -> float:
-        """Dimensionless damping (3/2) A rho^{2/5} g^{1/5} of a collision at normal speed g."""
-        return 1.5 * self.dissipation_time * self.rho(radius_eff, mass_eff) ** 0.4 * speed**0.2
+        """Dimensionless damping (3/2) A rho^{2/5} g^{1/5} of a collision at normal speed g
+        (:func:`granulargas.contact.material.beta_from_material`)."""
+        return float(material.beta_from_material(self.young_modulus, self.poisson_ratio, self.dissipation_time,
+                                                 radius_eff, mass_eff, speed))
 
     def prefactor(self) -> float:
-        """Our pair prefactor k = (3/2) A (2 Y / (3 (1 - nu^2)))^{2/5}."""
-        return 1.5 * self.dissipation_time * (2.0 * self.reduced_modulus / 3.0) ** 0.4
+        """Our pair prefactor k = (3/2) A (2 Y / (3 (1 - nu^2)))^{2/5}
+        (:func:`granulargas.contact.material.prefactor_from_material`)."""
+        return float(material.prefactor_from_material(self.young_modulus, self.poisson_ratio, self.dissipation_time))
 
     def hertz_contact_time(self, speed: float, radius_eff: float, mass_eff: float) -> float:
         """Elastic Hertz duration HERTZ_DURATION rho^{-2/5} g^{-1/5} (time units)."""
@@ -130,9 +136,9 @@ class DemContact:
     @classmethod
     def from_prefactor(cls, prefactor: float, young_modulus: float, poisson_ratio: float = DEFAULT_POISSON,
                        end: str = "overlap") -> "DemContact":
-        """The contact with our pair prefactor k at stiffness Y: A = (2/3) k / (2 Y / (3 (1-nu^2)))^{2/5}."""
-        reduced = young_modulus / (1.0 - poisson_ratio**2)
-        dissipation_time = (2.0 / 3.0) * prefactor / (2.0 * reduced / 3.0) ** 0.4
+        """The contact with our pair prefactor k at stiffness Y: A = (2/3) k / (2 Y / (3 (1-nu^2)))^{2/5}
+        (:func:`granulargas.contact.material.dissipation_time_from_prefactor`)."""
+        dissipation_time = material.dissipation_time_from_prefactor(prefactor, young_modulus, poisson_ratio)
         return cls(young_modulus, poisson_ratio, dissipation_time, end)
 
     @classmethod
@@ -157,23 +163,12 @@ def stiffness_for_contact_time(contact_time: float, speed: float, radius_eff: fl
 
 def enskog_mean_free_time(dimension: int, packing_fraction: float, diameter: float = 1.0,
                           mass: float = 1.0, temperature: float = 1.0) -> float:
-    """1 / collision frequency per particle of an elastic Enskog gas (physics.md section 2).
-
-    3D: omega = 4 sqrt(pi) chi n sigma^2 sqrt(T/m), Carnahan-Starling chi;
-    2D: omega = 2 sqrt(pi) chi n sigma sqrt(T/m), Henderson chi.
-    """
-    eta = packing_fraction
-    if dimension == 3:
-        n = 6.0 * eta / (math.pi * diameter**3)
-        chi = (1.0 - eta / 2.0) / (1.0 - eta) ** 3
-        omega = 4.0 * math.sqrt(math.pi) * chi * n * diameter**2 * math.sqrt(temperature / mass)
-    elif dimension == 2:
-        n = 4.0 * eta / (math.pi * diameter**2)
-        chi = (1.0 - 7.0 * eta / 16.0) / (1.0 - eta) ** 2
-        omega = 2.0 * math.sqrt(math.pi) * chi * n * diameter * math.sqrt(temperature / mass)
-    else:
+    """1 / collision frequency per particle of an elastic Enskog gas
+    (:func:`granulargas.theory.collision_frequency`)."""
+    if dimension not in (2, 3):
         raise ValueError(f"dimension must be 2 or 3, not {dimension}")
-    return 1.0 / omega
+    n = theory.number_density(packing_fraction, dimension, diameter)
+    return 1.0 / float(theory.collision_frequency(n, temperature, dimension, diameter, mass))
 
 
 # --------------------------------------------------------------------------- running lmp
@@ -462,10 +457,7 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     sigma = float(np.mean(2.0 * radii))
     mass = float(np.mean(masses))
     volume = float(np.prod(box))
-    if d == 3:
-        packing = float(np.sum(4.0 / 3.0 * math.pi * radii**3)) / volume
-    else:
-        packing = float(np.sum(math.pi * radii**2)) / volume
+    packing = float(np.sum(theory.particle_volume(2.0 * radii, d))) / volume
     peculiar = velocities - np.sum(masses[:, None] * velocities, axis=0) / np.sum(masses)
     temperature = float(np.sum(masses[:, None] * peculiar**2)) / (d * n)
     if not temperature > 0.0:
@@ -549,7 +541,7 @@ def _write_data_file(path, positions, velocities, radii, masses, types, ntypes, 
     diam = 2.0 * radii
     # density such that LAMMPS's 3D rule rho pi d^3 / 6 gives the mass; the
     # input also sets the mass per type, which holds in 2D too
-    density = masses / (math.pi / 6.0 * diam**3)
+    density = masses / theory.particle_volume(diam, 3)
     pos3 = np.zeros((n, 3))
     vel3 = np.zeros((n, 3))
     pos3[:, :d] = positions

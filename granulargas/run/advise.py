@@ -16,12 +16,14 @@ advice predicts, with kinetic theory and no simulation
    relative deviation ``max_t |T_const(t) / T_visco(t) - 1|``;
 4. the verdict: a constant eps will do if that deviation is within the
    tolerance (default 2 %, ``--tolerance``);
-5. whether the box is longer than the shear-instability length of the best
-   constant eps (clusters: a constant-eps gas keeps them, a viscoelastic one
-   dissolves them as it cools; the homogeneous prediction then fails for both).
+5. whether the box is longer than the shear-instability length of the gas at
+   T0 (:meth:`granulargas.theory.gas.Gas.instability_length`; a viscoelastic
+   gas's grows as it cools, so clusters seeded early dissolve later; the
+   homogeneous prediction then fails for both rules).
 
-For a constant-eps config the advice reports the damping whose viscoelastic gas
-cools at the same initial rate and how far its T(t) would drift from Haff's law
+For a constant-eps config the advice reports the config ``damping`` (beta at
+g = 1 for two reference particles) whose viscoelastic gas cools at the same
+initial rate and how far its T(t) would drift from Haff's law
 over the run, plus the inelastic-collapse risk.
 
 The prediction assumes a homogeneous gas with a Maxwellian velocity
@@ -40,7 +42,9 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from granulargas import theory
+from granulargas.contact.material import damping_from_prefactor
 from granulargas.run import validity as V
+from granulargas.run.prepare import mean_particle
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant"]
 
@@ -66,9 +70,11 @@ class Advice:
         Predicted largest relative error of T(t) of the constant eps vs the
         viscoelastic law over the run.
     damping_equivalent : float or None
-        Constant config: the pair damping b with the same initial cooling rate.
+        Constant config: the config ``damping`` (reference particles) whose viscoelastic
+        gas has the same initial cooling rate.
     constant_ok : bool or None
     box, instability_length : float
+        Box edge and the shear-instability length at T0.
     notes : list of str
     """
 
@@ -137,27 +143,23 @@ def best_constant(gas: V.Gas, curve: V.CoolingCurve, t_end: float):
 
 
 def _box(config) -> float:
-    s, p = config.system, config.particles
-    d = s.dimension
-    vol = math.pi * p.diameter**3 / 6.0 if d == 3 else math.pi * p.diameter**2 / 4.0
-    return (s.particles * vol / s.packing_fraction) ** (1.0 / d)
+    """Box edge of the config's gas (particles of the mean diameter)."""
+    s = config.system
+    sigma, _ = mean_particle(config)
+    return (s.particles * float(theory.particle_volume(sigma, s.dimension)) / s.packing_fraction) ** (1.0 / s.dimension)
 
 
-def _instability(gas: V.Gas, eps: float) -> float:
-    if eps is None or eps >= 1.0:
-        return math.inf
-    return float(theory.instability_length(eps, gas.density, gas.dimension, gas.sigma))
-
-
-def _equivalent_damping(gas: V.Gas, eps: float) -> float:
-    """Damping b whose viscoelastic gas has (1 - eps^2)_eff(T0) = 1 - eps^2."""
+def _equivalent_prefactor(gas: V.Gas, eps: float) -> float:
+    """Prefactor k whose viscoelastic gas has (1 - eps^2)_eff(T0) = 1 - eps^2."""
     target = 1.0 - eps**2
 
-    def f(log_b):
-        g = replace(gas, model="viscoelastic", damping=math.exp(log_b))
+    def f(log_k):
+        g = replace(gas, model="viscoelastic", prefactor=math.exp(log_k))
         return V.effective_inelasticity(g, gas.temperature) - target
 
-    return math.exp(brentq(f, math.log(1e-8), math.log(20.0), xtol=1e-10))
+    # bracket in the pair constant b of the gas's particles: b = k (R_eff / m_eff^2)^(1/5)
+    scale = replace(gas, model="viscoelastic", prefactor=1.0).pair_constant
+    return math.exp(brentq(f, math.log(1e-8 / scale), math.log(20.0 / scale), xtol=1e-10))
 
 
 def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
@@ -166,14 +168,14 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     t_end, T_end = V.run_temperature_range(gas)
     adv = Advice(gas.model, tolerance, t_end, T_end / gas.temperature, box=_box(config))
     notes = []
-    if gas.model == "viscoelastic" and gas.damping > 0:
+    if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = V.viscoelastic_cooling(gas)
         t_end, T_end = V.run_temperature_range(gas, curve)
         adv.t_end, adv.T_end = t_end, T_end / gas.temperature
         adv.spread = V.restitution_spread(gas, gas.temperature, T_end)
         adv.eps_best, adv.error = best_constant(gas, curve, t_end)
         adv.constant_ok = adv.error <= tolerance
-        adv.instability_length = _instability(gas, adv.eps_best)
+        adv.instability_length = gas.instability_length()
         if adv.constant_ok:
             notes.append(f'use [collision] model = "constant", restitution = {adv.eps_best:.4f} '
                          "(cost per collision is nearly the same; the gain is a closed-form reference, Haff's law)")
@@ -183,15 +185,15 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         notes.append("damping = 0: the collisions are elastic; use model = \"elastic\"")
     elif gas.model == "constant" and gas.restitution < 1.0:
         eps = gas.restitution
-        b = _equivalent_damping(gas, eps)
-        ve = replace(gas, model="viscoelastic", damping=b)
+        k = _equivalent_prefactor(gas, eps)
+        ve = replace(gas, model="viscoelastic", prefactor=k)
         curve = V.viscoelastic_cooling(ve)
         t_ve, _ = V.run_temperature_range(replace(ve, end_time=t_end, collisions_per_particle=None), curve)
-        adv.damping_equivalent = b
+        adv.damping_equivalent = damping_from_prefactor(k)
         adv.eps_best = eps
         adv.error = constant_error(ve, eps, curve, t_end)
         adv.constant_ok = adv.error <= tolerance
-        adv.instability_length = _instability(gas, eps)
+        adv.instability_length = gas.instability_length()
         if gas.tc_time is None and (eps <= 0.7 or (gas.dimension == 2 and gas.packing_fraction >= 0.3)):
             notes.append(f"eps = {eps:g} without tc_time: dense or strongly inelastic regions can collapse "
                          "(InelasticCollapseError); set [collision] tc_time (TC model) or use the viscoelastic "

@@ -55,6 +55,16 @@ class Setup:
 # ------------------------------------------------------------------- particles
 
 
+def mean_particle(config: RunConfig) -> tuple[float, float]:
+    """(sigma, m): the config's mean diameter and the mass of a particle of that diameter
+    (``particles.mass``, or ``particles.density`` times its volume); what kinetic theory
+    of identical particles uses for the config."""
+    s, p = config.system, config.particles
+    sigma = p.diameter
+    mass = p.mass if p.mass is not None else p.density * float(particle_volume(sigma, s.dimension))
+    return sigma, mass
+
+
 def make_particles(config: RunConfig, rng: np.random.Generator):
     """Radii and masses of the config's particles (polydisperse radii drawn from ``rng``)."""
     s, p = config.system, config.particles
@@ -146,8 +156,13 @@ def reduced_prefactor(config: RunConfig) -> float:
         return float(material.prefactor_from_damping(c.damping, radius=0.5, mass=1.0))
     m = c.material
     k_si = float(material.prefactor_from_material(m.young_modulus, m.poisson_ratio, m.dissipation_time))
-    mass_si = m.density * math.pi * m.diameter**3 / 6.0
-    return k_si * (m.diameter * m.speed_unit / mass_si**2) ** 0.2
+    return k_si * (m.diameter * m.speed_unit / reference_mass_si(m) ** 2) ** 0.2
+
+
+def reference_mass_si(material) -> float:
+    """SI mass (kg) of the reference sphere of ``[collision.material]``: density x pi diameter^3 / 6
+    (the reduced mass unit of the material route)."""
+    return material.density * float(particle_volume(material.diameter, 3))
 
 
 def beta_bound(prefactor: float, state: InitialState) -> float:
@@ -156,7 +171,9 @@ def beta_bound(prefactor: float, state: InitialState) -> float:
     energy = 0.5 * float((m[:, None] * state.velocities**2).sum())
     m_min = float(m.min())
     g_max = 2.0 * math.sqrt(2.0 * energy / m_min)
-    return prefactor * (2.0 * float(state.radii.max()) / m_min**2) ** 0.2 * g_max**0.2
+    r_max = float(state.radii.max())
+    # R_eff <= R_max / 2 and m_eff >= m_min / 2: the pair constant of two (R_max, m_min) particles bounds all
+    return float(material.pair_constant(prefactor, r_max, r_max, m_min, m_min)) * g_max**0.2
 
 
 def expected_beta(prefactor: float, state: InitialState) -> tuple[float, float]:
@@ -168,10 +185,12 @@ def expected_beta(prefactor: float, state: InitialState) -> tuple[float, float]:
     m, r = state.masses, state.radii
     d = state.velocities.shape[1]
     temp = float((m[:, None] * state.velocities**2).sum()) / (d * len(m))
-    r_eff, m_eff = 0.5 * float(np.mean(r)), 0.5 * float(np.mean(m))
-    typical = prefactor * (r_eff * math.sqrt(math.pi * temp / (2.0 * m_eff)) / m_eff**2) ** 0.2
-    m_small = 0.5 * float(m.min())
-    high = prefactor * (0.5 * float(r.max()) * 3.0 * math.sqrt(temp / m_small) / m_small**2) ** 0.2
+    r_mean, m_mean = float(np.mean(r)), float(np.mean(m))
+    g_typical = math.sqrt(math.pi * temp / m_mean)  # sqrt(pi T / (2 m_eff)), m_eff = m / 2
+    typical = float(material.pair_constant(prefactor, r_mean, r_mean, m_mean, m_mean)) * g_typical**0.2
+    r_max, m_min = float(r.max()), float(m.min())
+    g_fast = 3.0 * math.sqrt(2.0 * temp / m_min)  # 3 sqrt(T / m_eff), m_eff = m_min / 2
+    high = float(material.pair_constant(prefactor, r_max, r_max, m_min, m_min)) * g_fast**0.2
     return typical, min(high, beta_bound(prefactor, state))
 
 
@@ -241,7 +260,7 @@ def prepare(config: RunConfig) -> Setup:
     }
     if config.collision.material is not None:
         m = config.collision.material
-        parameters["units_si"] = {"length_m": m.diameter, "mass_kg": m.density * math.pi * m.diameter**3 / 6.0,
+        parameters["units_si"] = {"length_m": m.diameter, "mass_kg": reference_mass_si(m),
                                   "speed_m_per_s": m.speed_unit, "time_s": m.diameter / m.speed_unit}
     if state.source:
         parameters["restart"] = {"file": state.source, "time": state.time, "step": state.events,

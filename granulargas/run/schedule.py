@@ -13,7 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from granulargas import theory
 from granulargas.io.config import RunConfig
+from granulargas.run.prepare import mean_particle
 
 #: default number of evenly spaced observables samples (plus every snapshot time)
 DEFAULT_OBSERVABLE_SAMPLES = 200
@@ -32,25 +34,12 @@ class Schedule:
 
 def mean_free_time(config: RunConfig) -> float:
     """Enskog estimate of the mean time between collisions of a particle at the
-    initial temperature (physics.md sec. 2), with the mean diameter and mass."""
-    s, p = config.system, config.particles
-    d, eta = s.dimension, s.packing_fraction
-    sigma = p.diameter
-    if p.mass is not None:
-        mass = p.mass
-    else:
-        vol = math.pi * sigma**3 / 6 if d == 3 else math.pi * sigma**2 / 4
-        mass = p.density * vol
-    v = math.sqrt(config.initial.temperature / mass)
-    if d == 3:
-        n = 6 * eta / (math.pi * sigma**3)
-        chi = (1 - eta / 2) / (1 - eta) ** 3
-        omega = 4 * math.sqrt(math.pi) * chi * n * sigma**2 * v
-    else:
-        n = 4 * eta / (math.pi * sigma**2)
-        chi = (1 - 7 * eta / 16) / (1 - eta) ** 2
-        omega = 2 * math.sqrt(math.pi) * chi * n * sigma * v
-    return 1.0 / omega
+    initial temperature (:func:`granulargas.theory.collision_frequency`), with the
+    mean diameter and its mass (:func:`granulargas.run.prepare.mean_particle`)."""
+    d = config.system.dimension
+    sigma, mass = mean_particle(config)
+    n = theory.number_density(config.system.packing_fraction, d, sigma)
+    return 1.0 / float(theory.collision_frequency(n, config.initial.temperature, d, sigma, mass))
 
 
 def collision_budget(config: RunConfig) -> int:

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from granulargas.run import advise as A
+from granulargas.run import validity as V
 from granulargas import theory
 from granulargas.cli import main
 from granulargas.io.config import parse_config
@@ -84,3 +85,46 @@ def test_cli(capsys):
     assert main(["advise", str(CONFIGS / "quickstart.toml"), "--tolerance", "2"]) == 2
     assert "tolerance" in capsys.readouterr().err
     assert main(["advise", str(CONFIGS / "quickstart.toml"), "--set", "collision.damping=-1"]) == 2
+
+
+def test_equivalent_damping_is_the_config_damping_for_any_particles():
+    """The reported damping means the config's ``damping`` (two reference particles), also
+    when the gas's particles are not the reference ones: pasting it into a viscoelastic
+    config gives the constant config's 1 - eps^2 as the initial effective inelasticity."""
+    particles = "[particles]\ndiameter = 1.5\nmass = 2.0\n"
+
+    def cfg(collision):
+        return parse_config(f"[system]\ndimension = 3\nparticles = 2000\npacking_fraction = 0.1\n{particles}"
+                            f"[collision]\n{collision}\n[run]\nend_time = 100.0\n", source="test.toml")
+
+    adv = A.advise(cfg('model = "constant"\nrestitution = 0.9'))
+    gas = V.gas_from_config(cfg(f'model = "viscoelastic"\ndamping = {adv.damping_equivalent!r}'))
+    assert V.effective_inelasticity(gas, gas.temperature) == pytest.approx(1 - 0.81, rel=1e-8)
+    # ... while the pair constant b of these particles differs from the damping
+    assert gas.pair_constant == pytest.approx(adv.damping_equivalent * (0.375 / 1.0) ** 0.2, rel=1e-12)
+
+
+def test_advise_and_analyze_report_one_instability_length(tmp_path):
+    """`advise` (from the config) and `analyze` (from the run's file) give the same L_c."""
+    from granulargas.analysis.run import RunInfo
+    from granulargas.run.runner import run_config
+
+    for collision in ('model = "viscoelastic"\ndamping = 0.1', 'model = "constant"\nrestitution = 0.9'):
+        cfg = parse_config(f"[system]\ndimension = 3\nparticles = 300\npacking_fraction = 0.1\n"
+                           f"[collision]\n{collision}\n[run]\nend_time = 0.2\n"
+                           f"[output]\nfile = \"{tmp_path / 'r.h5'}\"\n", source="test.toml")
+        advised = A.advise(cfg).instability_length
+        run_config(cfg, overwrite=True)
+        analysed = RunInfo.from_file(tmp_path / "r.h5").prediction(1.0).instability_length
+        assert math.isfinite(advised) and analysed == pytest.approx(advised, rel=1e-9)
+
+
+def test_viscoelastic_instability_length_at_small_damping():
+    """Exact-eps L_c at T0 against the closed form with the leading-order (1 - eps^2)_eff."""
+    b, n = 0.002, theory.number_density(0.1, 3)
+    gas = V.gas_from_config(config(f'model = "viscoelastic"\ndamping = {b}'))
+    q = float(theory.effective_inelasticity(b, 1.0, order=2))
+    assert gas.instability_length() == pytest.approx(theory.instability_length(math.sqrt(1 - q), n, 3, a2=0.0),
+                                                     rel=1e-4)
+    # it grows as the gas cools: (1 - eps^2)_eff ~ T^(1/10), so L_c ~ T^(-1/20)
+    assert gas.instability_length(1e-3) / gas.instability_length() == pytest.approx(1e-3 ** -0.05, rel=2e-3)
