@@ -48,3 +48,14 @@ def test_an_upward_import_breaks_the_layers(tmp_path, module, upward):
     out = lint(tmp_path)
     assert out.returncode != 0
     assert "BROKEN" in out.stdout and upward.split()[1].split(".")[1] in out.stdout
+
+
+def test_no_import_circle_between_modules():
+    """No module reaches itself through imports (strongly connected components of size 1)."""
+    import grimp
+
+    graph = grimp.build_graph("granulargas", cache_dir=None)
+    edges = {m: {x for x in graph.find_modules_directly_imported_by(m) if x.startswith("granulargas")}
+             for m in graph.modules if m.startswith("granulargas")}
+    circles = [(m, x) for m in edges for x in edges[m] if x == m or graph.chain_exists(importer=x, imported=m)]
+    assert not circles
