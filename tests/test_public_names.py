@@ -40,6 +40,9 @@ def test_every_command_module_has_parser_and_run(name):
     ("granulargas.advise", "granulargas.run.advise", ["advise", "summary_line"]),
     ("granulargas.validity", "granulargas.run.validity", ["check_run", "raise_if_invalid"]),
     ("granulargas.sweep", "granulargas.run.sweep", ["load_sweep", "run_sweep"]),
+    ("granulargas.io.run_command", "granulargas.cli.run", ["configure_parser", "run"]),
+    ("granulargas.analysis.cli", "granulargas.cli.analyze", ["report", "run"]),
+    ("granulargas.contact.cli", "granulargas.cli.epsilon", ["configure_parser", "run"]),
 ])
 def test_moved_modules_keep_their_old_name(old, new, names):
     sys.modules.pop(old, None)
@@ -54,11 +57,24 @@ def test_moved_modules_keep_their_old_name(old, new, names):
 def test_export_names_keep_working():
     sys.modules.pop("granulargas.io.export", None)
     with pytest.warns(DeprecationWarning):
-        export = importlib.import_module("granulargas.io.export")
-    from granulargas.dem.export import export_lammps
-    from granulargas.io.gsd import export_gsd
+        from granulargas.io.export import GSD_TIME_KEY, export_gsd, export_lammps
+    from granulargas.dem import export
+    from granulargas.io import gsd
 
-    assert export.export_lammps is export_lammps and export.export_gsd is export_gsd
+    assert export_lammps is export.export_lammps and export_gsd is gsd.export_gsd
+    assert GSD_TIME_KEY == gsd.GSD_TIME_KEY
+
+
+def test_old_paths_hold_no_file():
+    """The old names are resolved by granulargas._moved, so no old file shadows a moved module."""
+    from pathlib import Path
+
+    from granulargas._moved import MOVED
+
+    root = Path(granulargas.__file__).parent.parent
+    for old in MOVED:
+        path = root / Path(*old.split("."))
+        assert not path.with_suffix(".py").exists() and not path.is_dir(), old
 
 
 def test_config_and_readers_stay_in_io():

@@ -11,7 +11,7 @@ from pathlib import Path
 from granulargas.cli._args import add_override_argument, overrides_from
 from granulargas.dem.export import export_lammps
 from granulargas.io.config import load_config
-from granulargas.io.gsd import export_gsd
+from granulargas.io.gsd import GSD_TIME_KEY, export_gsd  # noqa: F401  (GSD_TIME_KEY: the old io.export name)
 
 def configure_parser(parser):
     sub = parser.add_subparsers(dest="format", metavar="FORMAT", required=True)
