@@ -8,9 +8,10 @@ exceptions and keep their traceback.
 
 
 class UserError(Exception):
-    """An error caused by input; printed as one line by the CLI."""
+    """An error caused by input; printed as one line by the CLI (``<prefix>: <message>``)."""
 
     exit_code = 2
+    prefix = "error"
 
 
 class ConfigError(UserError):

@@ -26,7 +26,7 @@ def plot_cooling(analysis, path):
     """
     plt = _plt()
     h, p = analysis.history, analysis.prediction
-    t = h.time - analysis.t_offset
+    t = h.time  # absolute, as in the file (a continued run starts at analysis.t_start)
     tau = p.tau0 if np.isfinite(p.tau0) else 1.0
     fig, axes = plt.subplots(3, 1, figsize=(6.4, 8.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.3]})
     x = t / tau
@@ -37,7 +37,7 @@ def plot_cooling(analysis, path):
     ax.loglog(xs, p.temperature(xs * tau) / p.T0, "k-", lw=1, label=f"theory ({p.law}, $\\tau_0$={p.tau0:.4g})")
     if analysis.fit_free is not None:
         f = analysis.fit_free
-        ax.loglog(xs, f(xs * tau) / p.T0, "r--", lw=1, label=f"fit: $\\tau_0$={f.tau0:.4g}, exponent {-f.exponent:.3f}")
+        ax.loglog(xs, f(xs * tau - analysis.t_start) / p.T0, "r--", lw=1, label=f"fit: $\\tau_0$={f.tau0:.4g}, exponent {-f.exponent:.3f}")
     ax.set_ylabel("$T/T_0$")
     ax.legend(fontsize=8)
     ax.set_title(f"{analysis.info.path}: {analysis.info.model}, d={analysis.info.dimension}, "

@@ -13,6 +13,7 @@ mass are used and :attr:`RunInfo.monodisperse` is False.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Callable, Iterator
@@ -59,16 +60,18 @@ class Prediction:
     mean_free_path: float
     instability_length: float
     tau0_second_order: float = math.nan  # viscoelastic: 1/((3/5) zeta(T0)) with the beta^2 term
+    t_start: float = 0.0  # the (absolute) time at which the temperature is T0
 
     def temperature(self, t):
-        t = np.asarray(t, dtype=float)
+        """T at absolute time t: T0 (1 + (t - t_start)/tau0)^(-exponent)."""
+        t = np.asarray(t, dtype=float) - self.t_start
         if self.law == "elastic":
             return np.full_like(t, self.T0)
         return self.T0 * (1.0 + t / self.tau0) ** (-self.exponent)
 
     def collisions(self, t):
-        """Collisions per particle by time t."""
-        t = np.asarray(t, dtype=float)
+        """Collisions per particle from t_start to absolute time t."""
+        t = np.asarray(t, dtype=float) - self.t_start
         if self.law == "haff":
             return theory.haff_collisions(t, self.tau0, self.omega0)
         if self.law == "viscoelastic":
@@ -134,8 +137,11 @@ class RunInfo:
                    sigma=self.diameter, mass=self.mass, temperature=float(T0), model=model,
                    restitution=self.restitution, prefactor=self.prefactor, end=self.contact_end)
 
-    def prediction(self, T0: float) -> Prediction:
-        """Kinetic theory for this run starting at temperature ``T0`` (at t = 0)."""
+    def prediction(self, T0: float, t_start: float = 0.0) -> Prediction:
+        """Kinetic theory for this run, at temperature ``T0`` at the absolute time ``t_start``."""
+        return dataclasses.replace(self._prediction(T0), t_start=float(t_start))
+
+    def _prediction(self, T0: float) -> Prediction:
         d, n, s, m = self.dimension, self.number_density, self.diameter, self.mass
         omega0 = float(theory.collision_frequency(n, T0, d, s, m))
         ell = float(theory.mean_free_path(n, d, s))
@@ -232,8 +238,8 @@ class CoolingAnalysis:
     prediction: Prediction
     fit: CoolingFit | None  # exponent fixed to the theory's
     fit_free: CoolingFit | None  # exponent fitted
-    sonine: tuple  # (time, a2, a3)
-    t_offset: float  # time of the first sample (restarts), subtracted from every time
+    sonine: tuple  # (time, a2, a3), absolute times
+    t_start: float  # absolute time of the first sample (later than 0 for a continued run)
 
     @property
     def tau0_deviation(self) -> float:
@@ -247,13 +253,15 @@ def analyze_cooling(path, t_range=None, with_sonine: bool = True, sonine_every: 
     """Fit the cooling law of a run and compare it with kinetic theory.
 
     The fixed-exponent fit (2 for constant restitution, 5/3 viscoelastic) gives
-    tau0; the free fit gives the exponent. Times are measured from the first
-    observable sample (restarted runs start later than 0).
+    tau0; the free fit gives the exponent. Every time is absolute, as in the file:
+    a run continued from another file (``--restart``) starts at the time it was
+    continued from, and theory and fits start there (``t_start``, the time of the
+    first observables sample, with T0 the temperature then).
 
     Parameters
     ----------
     t_range : (t_min, t_max), optional
-        Fit window, in the shifted time.
+        Fit window (absolute times).
     with_sonine : bool
         Also compute a2, a3 from the snapshots (reads every frame once).
     """
@@ -262,12 +270,12 @@ def analyze_cooling(path, t_range=None, with_sonine: bool = True, sonine_every: 
     if hist.time.size == 0:
         raise InputFileError(f"{path}: no temperature samples")
     t0 = float(hist.time[0])
-    t = hist.time - t0
-    pred = info.prediction(float(hist.temperature[0]))
+    t = hist.time - t0  # the cooling laws are written in the time since T was T0
+    pred = info.prediction(float(hist.temperature[0]), t_start=t0)
+    shifted = None if t_range is None else (t_range[0] - t0, t_range[1] - t0)
     fit = fit_free = None
     if pred.law != "elastic" and t.size >= 4:
-        fit = fit_cooling_law(t, hist.temperature, exponent=pred.exponent, t_range=t_range, tau0_guess=pred.tau0)
-        fit_free = fit_cooling_law(t, hist.temperature, exponent=None, t_range=t_range, tau0_guess=pred.tau0)
+        fit = fit_cooling_law(t, hist.temperature, exponent=pred.exponent, t_range=shifted, tau0_guess=pred.tau0)
+        fit_free = fit_cooling_law(t, hist.temperature, exponent=None, t_range=shifted, tau0_guess=pred.tau0)
     son = sonine_history(path, sonine_every) if with_sonine else (np.empty(0),) * 3
-    son = (son[0] - t0, son[1], son[2])
     return CoolingAnalysis(info, hist, pred, fit, fit_free, son, t0)

@@ -8,8 +8,8 @@ modules are imported lazily (:func:`build_parser` imports only the one named on
 the command line) so that ``granulargas --help`` stays instant and one command's
 import cost (numba, scipy) is not paid by the others.
 
-A :class:`granulargas.errors.UserError` becomes one line on stderr and its exit
-code; no traceback.
+A :class:`granulargas.errors.UserError` becomes one line on stderr (``error: ...``,
+``interrupted: ...`` for a run stopped by a signal) and its exit code; no traceback.
 """
 
 from __future__ import annotations
@@ -63,11 +63,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args._run(args) or 0)
     except UserError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"{exc.prefix}: {exc}", file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # a signal when there was no state to keep
+        signum = getattr(exc, "signum", 2)
+        name = {2: "SIGINT", 15: "SIGTERM"}.get(signum, f"signal {signum}")
+        print(f"interrupted: {name}", file=sys.stderr)
+        return 128 + signum
 
 
 if __name__ == "__main__":

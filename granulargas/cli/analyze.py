@@ -11,13 +11,14 @@ import numpy as np
 
 from granulargas.analysis.run import analyze_cooling
 from granulargas.errors import InputFileError
+from granulargas.io.paths import existing_directory
 
 
 def configure_parser(parser):
     parser.add_argument("file", help="H5MD file written by 'granulargas run'")
     parser.add_argument("--plot", metavar="PNG", help="write the cooling figure (T/T0, ratio to theory, a2) here")
     parser.add_argument("--fit-range", nargs=2, type=float, metavar=("TMIN", "TMAX"),
-                        help="fit window in time since the first sample (default: all samples)")
+                        help="fit window in (absolute) time (default: all samples)")
     parser.add_argument("--no-snapshots", action="store_true", help="skip a2/a3 (do not read the snapshots)")
     parser.add_argument("--rows", type=int, default=10, help="rows of the T(t) table (default 10)")
 
@@ -47,7 +48,7 @@ def report(analysis, rows: int = 10) -> str:
         side = "below" if L < p.instability_length else "ABOVE"
         lines.append(f"  box length {L:.4g} is {side} L_c ({p.instability_length:.4g})"
                      + ("" if L < p.instability_length else ": expect shear modes and clusters, not the homogeneous law"))
-    t = h.time - a.t_offset
+    t = h.time  # absolute times (a continued run starts later than 0)
     if t.size > 1:
         targets = np.geomspace(t[1], t[-1], max(rows - 1, 1))
         idx = np.unique(np.concatenate([[0], np.searchsorted(t, targets).clip(0, t.size - 1)]))
@@ -82,6 +83,8 @@ def report(analysis, rows: int = 10) -> str:
 
 
 def run(args) -> int:
+    if args.plot:  # before any work: a typo in the directory is refused, never created
+        existing_directory(args.plot, f"--plot {args.plot}")
     try:
         a = analyze_cooling(args.file, t_range=tuple(args.fit_range) if args.fit_range else None,
                             with_sonine=not args.no_snapshots)

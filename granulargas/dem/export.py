@@ -10,8 +10,11 @@ stiffness whose contact time is a stated fraction of the mean free time).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from granulargas.dem import lammps
 from granulargas.errors import ConfigError
+from granulargas.io.paths import existing_directory
 from granulargas.run.prepare import initial_state, reduced_prefactor
 from granulargas.run.schedule import DEFAULT_OBSERVABLE_SAMPLES
 
@@ -52,6 +55,8 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
         prefactor, end = reduced_prefactor(config), c.contact_end
     if poisson_ratio is None:
         poisson_ratio = c.material.poisson_ratio if c.material is not None else lammps.DEFAULT_POISSON
+    if not Path(directory).is_dir():  # the export makes DIR itself, never its parents
+        existing_directory(directory, f"--output {directory}")
     state = initial_state(config)
     if config.initial.from_file:
         end_time = end_time - state.time

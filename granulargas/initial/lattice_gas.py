@@ -80,6 +80,9 @@ def box_for_packing(radii, packing, dimension, aspect=None):
     return aspect * (volume / float(np.prod(aspect))) ** (1.0 / dimension)
 
 
+#: packing fractions up to which random placement works for every seed (module docstring)
+RANDOM_PLACEMENT_MAX = {3: 0.54, 2: 0.76}
+
 # lowest occupancy N/M of the lattice: M <= 8 N (memory at very low packing)
 _MIN_OCCUPANCY = 1.0 / 8.0
 

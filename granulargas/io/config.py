@@ -1,12 +1,46 @@
-"""TOML run configuration -> frozen dataclasses, with validation.
+"""TOML run configuration -> frozen dataclasses, validated by one declarative schema.
 
 A config file has the sections ``[system]``, ``[particles]``, ``[initial]``,
 ``[collision]`` (with the optional sub-table ``[collision.material]``), ``[run]``
 and ``[output]``; :func:`load_config` reads it with :mod:`tomllib`, applies
-optional dotted-key overrides, and returns a :class:`RunConfig`. Every value is
-checked once, here: unknown keys, wrong types and out-of-range values raise
-:class:`granulargas.errors.ConfigError` with one line naming the file, the key,
-the value and what is allowed.
+optional dotted-key overrides, and returns a :class:`RunConfig`.
+
+The schema
+----------
+Every key is described once, in :data:`SCHEMA`: a :class:`Key` gives its section,
+name, type, default, allowed range (and why the range is what it is), unit and
+meaning. Rules that involve several keys are :data:`RULES` (:class:`Rule`: a
+sentence for the documentation and a check). The validator (:func:`build_config`)
+is driven by the two:
+
+1. the document's structure: unknown sections and keys are refused, with the
+   nearest valid name suggested (:mod:`difflib`);
+2. each key of :data:`SCHEMA` in order: type, then range (a key that is absent
+   takes its default);
+3. each rule of :data:`RULES` in order;
+4. the values are assembled into the dataclasses (field ``Key.field`` of the
+   section's dataclass).
+
+Every failure raises :class:`granulargas.errors.ConfigError` with one line naming
+the file (or ``override``), the key, the value and what is allowed, and the reason
+of the bound when the value has the right type. :func:`config_schema` and
+:func:`config_rules` are what the documentation's configuration reference is
+generated from, so the reference cannot drift from the validator.
+
+Adding a key: one :class:`Key` entry in :data:`SCHEMA` (and a field of that name in
+the section's dataclass); a rule across keys, one entry in :data:`RULES`
+(ARCHITECTURE.md, "Adding a config key").
+
+Bounds that follow from float64 and from the engine (reduced units, below): masses
+and temperatures lie in [1e-100, 1e100] so that thermal speeds sqrt(T/m) lie in
+[1e-100, 1e100] and their squares far inside float64 (the engine refuses speeds
+outside (1e-150, 1e150)); diameters lie in [1e-50, 1e50] so that volumes
+(diameter^3) and squared distances stay finite; times lie below 1e100 so that
+time x speed stays finite; particle ids are int32 in the engine. Bounds that need
+the machine or the whole run (memory, disk, the float64 clock over the run, the
+restitution table's range) are checked when a run starts, before anything is
+allocated or written (:mod:`granulargas.run.resources`,
+:mod:`granulargas.run.validity`); the reference states them too.
 
 Units (reduced): lengths in the reference particle diameter, masses in the
 reference particle mass, energies in the initial temperature T0 (k_B = 1), so
@@ -18,11 +52,12 @@ converts it once to the reduced pair prefactor k (ARCHITECTURE.md).
 
 from __future__ import annotations
 
+import difflib
 import math
 import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from granulargas.errors import ConfigError
 
@@ -31,6 +66,21 @@ MAX_PACKING = {3: math.pi / (3.0 * math.sqrt(2.0)), 2: math.pi / (2.0 * math.sqr
 MODELS = ("elastic", "constant", "viscoelastic")
 CONTACT_ENDS = ("overlap", "force")
 DEFAULT_SNAPSHOTS = 20
+
+#: largest particle count: the engine indexes particles (neighbour lists, cells) with int32
+MAX_PARTICLES = 2**31 - 1
+#: masses and temperatures (reduced): thermal speeds sqrt(T/m) within [1e-100, 1e100]
+SCALE_RANGE = (1e-100, 1e100)
+#: diameters (reduced): volumes diameter^3 and squared distances within float64
+LENGTH_RANGE = (1e-50, 1e50)
+#: longest time (reduced): time x speed (<= 1e100) stays finite
+TIME_MAX = 1e100
+#: largest pair collision count of a run, C = collisions_per_particle x N / 2: exact in float64
+MAX_COLLISIONS = 2**53
+#: the restitution table covers beta <= 40 (granulargas.contact.table.TABLE_BETA_MAX)
+TABLE_BETA_MAX = 40.0
+#: SI material constants: within 1e+-100 so that the reduced prefactor stays finite
+SI_RANGE = (1e-100, 1e100)
 
 
 @dataclass(frozen=True)
@@ -70,7 +120,8 @@ class InitialConfig:
 
 @dataclass(frozen=True)
 class MaterialConfig:
-    """``[collision.material]`` (SI): the viscoelastic contact of seed eq. (2).
+    """``[collision.material]`` (SI): the viscoelastic contact of Schwager & Pöschel
+    (1997), eq. (2).
 
     young_modulus (Pa), poisson_ratio, dissipation_time A (s), diameter (m) and
     density (kg/m^3) of the reference particle, speed_unit (m/s): the reduced
@@ -151,85 +202,276 @@ class RunConfig:
         return dump_toml(self)
 
 
-# --------------------------------------------------------------------------- parsing
+# --------------------------------------------------------------------------- the schema
 
 
-class _Reader:
-    """Pulls typed, range-checked values out of one TOML table."""
-
-    def __init__(self, source: str, section: str, table: Any, overridden: set[str]):
-        self.source = source
-        self.section = section
-        self.overridden = overridden
-        if not isinstance(table, dict):
-            self.fail_key(None, table, "a table")
-        self.table = dict(table)
-
-    def where(self, key: str | None) -> str:
-        dotted = f"{self.section}.{key}" if key else self.section
-        origin = "override" if dotted in self.overridden else self.source
-        return f"{origin}: {dotted}"
-
-    def fail(self, key: str | None, value: Any, allowed: str):
-        raise ConfigError(f"{self.where(key)} = {_show(value)}: {allowed}")
-
-    def fail_key(self, key, value, allowed):
-        self.fail(key, value, f"must be {allowed}")
-
-    def pop(self, key, default=None):
-        return self.table.pop(key, default)
-
-    def integer(self, key, default, *, minimum=None, allowed=None):
-        if key not in self.table:
-            return default
-        v = self.table.pop(key)
-        if isinstance(v, float) and v.is_integer() and abs(v) < 2**53:
-            v = int(v)
-        if isinstance(v, bool) or not isinstance(v, int):
-            self.fail_key(key, v, "an integer")
-        if allowed is not None and v not in allowed:
-            self.fail_key(key, v, " or ".join(str(a) for a in allowed))
-        if minimum is not None and v < minimum:
-            self.fail_key(key, v, f"an integer >= {minimum}")
-        return v
-
-    def number(self, key, default, *, low=None, high=None, low_open=True, high_open=False, what=None):
-        if key not in self.table:
-            return default
-        v = self.table.pop(key)
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            self.fail_key(key, v, "a number")
-        v = float(v)
-        bad = not math.isfinite(v)
-        if low is not None:
-            bad |= v <= low if low_open else v < low
-        if high is not None:
-            bad |= v >= high if high_open else v > high
-        if bad:
-            self.fail_key(key, v, what or _interval(low, high, low_open, high_open))
-        return v
-
-    def string(self, key, default, *, allowed=None):
-        if key not in self.table:
-            return default
-        v = self.table.pop(key)
-        if not isinstance(v, str):
-            self.fail_key(key, v, "a string")
-        if allowed is not None and v not in allowed:
-            self.fail_key(key, v, "one of " + ", ".join(f'"{a}"' for a in allowed))
-        return v
-
-    def done(self):
-        for key, value in self.table.items():
-            self.fail(key, value, "unknown key")
+class DefaultText(str):
+    """A default the validator computes, described in words (not a TOML value)."""
 
 
-def _interval(low, high, low_open, high_open):
+@dataclass(frozen=True)
+class Key:
+    """One config key: what it is, what it may be, and why.
+
+    Attributes
+    ----------
+    section : str
+        ``"system"``, ..., ``"collision.material"`` (sub-tables dotted).
+    key : str
+        The TOML key; a key of an inline table is dotted (``"diameter.min"``).
+    type : str
+        ``"integer"``, ``"number"``, ``"string"``, ``"table"`` or ``"number or table"``.
+    meaning : str
+        One or two sentences (Markdown code spans allowed).
+    default : TOML value or None
+        The value an absent key takes (None: no value; see ``default_text``).
+    default_text : str or None
+        A default the validator computes (e.g. ``"runs/<config name>.h5"``).
+    unit : str
+        Unit of a number ("" for dimensionless or not a number).
+    low, high : float or None
+        Numeric range; ``low_open``/``high_open`` exclude the bound itself.
+    high_by_dimension : dict or None
+        An upper bound that depends on ``system.dimension`` (overrides ``high``).
+    choices : tuple or None
+        Allowed values (strings, or integers).
+    reason : str
+        Why the range is what it is (float64, memory, the engine, physics).
+    run_check : str
+        Bounds checked when a run starts (machine or whole-run bounds), in words.
+    field : str or None
+        The dataclass field (default: ``key``).
+    required_in_table : bool
+        A key of a sub-table that must be given whenever the table is.
+    """
+
+    section: str
+    key: str
+    type: str
+    meaning: str
+    default: Any = None
+    default_text: str | None = None
+    unit: str = ""
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    high_by_dimension: dict | None = None
+    choices: tuple | None = None
+    reason: str = ""
+    run_check: str = ""
+    field: str | None = None
+    required_in_table: bool = False
+
+    @property
+    def dotted(self) -> str:
+        return f"{self.section}.{self.key}"
+
+    @property
+    def attribute(self) -> str:
+        return self.field or self.key
+
+    @property
+    def shown_default(self):
+        """The default as the reference shows it: a TOML value, a :class:`DefaultText` or None."""
+        return DefaultText(self.default_text) if self.default_text is not None else self.default
+
+    def range_text(self, dimension: int | None = None) -> str:
+        """What the validator accepts, as one phrase (the error messages use it)."""
+        if self.choices is not None:
+            if all(isinstance(c, str) for c in self.choices):
+                return "one of " + ", ".join(f'"{c}"' for c in self.choices)
+            return " or ".join(str(c) for c in self.choices)
+        if self.type in ("string", "table"):
+            return "a non-empty string" if self.type == "string" else "a table"
+        high = self.high
+        if self.high_by_dimension is not None and dimension is not None:
+            high = self.high_by_dimension[dimension]
+        kind = "an integer" if self.type == "integer" else "a number"
+        return _range_phrase(kind, self.low, high, self.low_open, self.high_open)
+
+    @property
+    def allowed(self) -> str:
+        """Everything the validator and the run-start checks accept, for the reference."""
+        if self.high_by_dimension is not None:
+            text = "; ".join(f"{d}D: {self.range_text(d)}" for d in sorted(self.high_by_dimension, reverse=True))
+        else:
+            text = self.range_text()
+        if self.key == "diameter" and self.section == "particles":
+            text += ", or a table { min, max } (below)"
+        if self.required_in_table:
+            text += "; required in the table"
+        if self.reason:
+            text += f" ({self.reason})"
+        if self.run_check:
+            text += f"; when the run starts: {self.run_check}"
+        return text
+
+
+def _num(x: float) -> str:
+    if isinstance(x, int) or (isinstance(x, float) and x.is_integer() and abs(x) < 1e16):
+        return str(int(x))
+    return f"{x:.4g}".replace("e+", "e")
+
+
+def _range_phrase(kind, low, high, low_open, high_open) -> str:
+    if low is None and high is None:
+        return kind
     if high is None:
-        return f"a number {'>' if low_open else '>='} {low:g}"
+        return f"{kind} {'>' if low_open else '>='} {_num(low)}"
     if low is None:
-        return f"a number {'<' if high_open else '<='} {high:g}"
-    return f"in {'(' if low_open else '['}{low:g}, {high:g}{')' if high_open else ']'}"
+        return f"{kind} {'<' if high_open else '<='} {_num(high)}"
+    where = f"{'(' if low_open else '['}{_num(low)}, {_num(high)}{')' if high_open else ']'}"
+    return f"{kind} in {where}"
+
+
+_SPEED = "speeds sqrt(T/m) within [1e-100, 1e100], their squares far inside float64"
+_LENGTH = "volumes and squared distances stay finite in float64"
+_TIME = "time x speed stays finite in float64"
+_MEMORY = "the engine state, the initial placement and the output must fit the memory and disk available"
+
+SCHEMA: tuple[Key, ...] = (
+    # [system]
+    Key("system", "dimension", "integer", "2 (disks) or 3 (spheres).", default=3, choices=(2, 3)),
+    Key("system", "particles", "integer",
+        "Number of particles; the box must hold at least 3.15 largest diameters per side.",
+        default=1000, low=2, high=MAX_PARTICLES, reason="the engine indexes particles with int32",
+        run_check=f"{_MEMORY} (about 1 kB per particle; estimated before allocating)"),
+    Key("system", "packing_fraction", "number",
+        "Fraction of the volume (area in 2D) covered by the particles; sets the box. Random placement "
+        "works up to about 0.54 (3D) and 0.76 (2D).",
+        default=0.1, low=0.0, low_open=True, high_by_dimension=MAX_PACKING, high_open=True,
+        reason="below the densest packing of spheres / disks",
+        run_check="the engine's cell grid (one cell per ~2 diameters of box edge, 68 bytes each) must "
+                  "fit in memory, which bounds very dilute packings; the box edge must be at least "
+                  "3.15 largest diameters"),
+    Key("system", "seed", "integer",
+        "Seed of all randomness (diameters, positions, velocities); a seed gives the same initial "
+        "state on every machine.", default=1, low=0, high=2**63 - 1, reason="any TOML integer >= 0"),
+    # [particles]
+    Key("particles", "diameter", "number or table",
+        "Particle diameter, or `{ min = ..., max = ... }` for a uniform polydisperse mix (the "
+        "reference diameter is then the mean).", default=1.0, unit="reference diameter",
+        low=LENGTH_RANGE[0], high=LENGTH_RANGE[1], reason=_LENGTH),
+    Key("particles", "diameter.min", "number", "Smallest diameter of a polydisperse mix.",
+        unit="reference diameter", low=LENGTH_RANGE[0], high=LENGTH_RANGE[1], reason=_LENGTH,
+        field="diameter_min", required_in_table=True),
+    Key("particles", "diameter.max", "number", "Largest diameter of a polydisperse mix (>= `min`).",
+        unit="reference diameter", low=LENGTH_RANGE[0], high=LENGTH_RANGE[1], reason=_LENGTH,
+        field="diameter_max", required_in_table=True),
+    Key("particles", "mass", "number", "Mass of every particle (give `mass` or `density`, not both).",
+        default_text="1.0 when `density` is not given", unit="reference mass",
+        low=SCALE_RANGE[0], high=SCALE_RANGE[1], reason=_SPEED),
+    Key("particles", "density", "number",
+        "Instead of `mass`: mass = density × π d³/6 (3D) or π d²/4 (2D); the masses it gives must "
+        "lie in the range of `mass`.", unit="reference mass per reference volume",
+        low=0.0, low_open=True, high=SCALE_RANGE[1] / 1e-50, reason="the masses it gives are checked like `mass`"),
+    # [initial]
+    Key("initial", "temperature", "number",
+        "Maxwell–Boltzmann velocities with zero total momentum and exactly this temperature "
+        "T = m⟨c²⟩/d.", default=1.0, unit="T0", low=SCALE_RANGE[0], high=SCALE_RANGE[1], reason=_SPEED),
+    Key("initial", "from", "string",
+        "Start from the last snapshot of this granulargas H5MD file instead (time, event count, "
+        "collisions and dissipated energy continue; box, radii and masses come from the file; "
+        "`dimension` and `particles` must match). Same as `--restart`.",
+        field="from_file", run_check="the file must exist and hold a complete snapshot"),
+    # [collision]
+    Key("collision", "model", "string",
+        "The coefficient of restitution: elastic, constant, or the viscoelastic ε(g) of the contact law.",
+        default="viscoelastic", choices=MODELS),
+    Key("collision", "restitution", "number", '`model = "constant"` only: the constant ε.',
+        low=0.0, low_open=True, high=1.0),
+    Key("collision", "damping", "number",
+        '`model = "viscoelastic"` only: β at normal impact speed 1 for two reference particles '
+        "(diameter 1, mass 1); other pairs scale with R_eff and m_eff, β = k (R_eff g / m_eff²)^(1/5). "
+        "Give `damping` or `[collision.material]`.",
+        low=0.0, high=TABLE_BETA_MAX, reason="the restitution table covers beta <= 40; the model holds "
+                                             "for beta well below 3",
+        run_check="beta of the fastest impact the run's energy allows must stay <= 40"),
+    Key("collision", "contact_end", "string",
+        '`"overlap"`: the contact ends when the compression returns to zero (Schwager & Pöschel '
+        '(1997), eq. (4)); `"force"`: when the repulsive force vanishes (Schwager & Pöschel 2008).',
+        default="overlap", choices=CONTACT_ENDS),
+    Key("collision", "tc_time", "number",
+        '`model = "constant"` only: TC model (Luding & McNamara 1998); a collision within `tc_time` '
+        "of either particle's previous one is elastic, which guards against inelastic collapse. "
+        "Leave the key out for no TC model.",
+        unit="reduced time", low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
+    Key("collision", "material", "table",
+        "Instead of `damping`: the viscoelastic contact from material constants "
+        "(`[collision.material]`, below)."),
+    # [collision.material]
+    Key("collision.material", "young_modulus", "number", "Young's modulus Y.", unit="Pa",
+        low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite",
+        required_in_table=True, run_check="beta of the fastest impact must stay <= 40"),
+    Key("collision.material", "poisson_ratio", "number", "Poisson ratio ν.",
+        low=-1.0, high=0.5, low_open=True, high_open=True, reason="elastic stability",
+        required_in_table=True),
+    Key("collision.material", "dissipation_time", "number",
+        "The dissipative constant A of Schwager & Pöschel (1997), eq. (2).", unit="s",
+        low=0.0, high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
+    Key("collision.material", "diameter", "number", "Diameter of the reference particle.", unit="m",
+        low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
+    Key("collision.material", "density", "number",
+        "Material density; the reference mass is density × π d³/6 (also for disks).", unit="kg/m³",
+        low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
+    Key("collision.material", "speed_unit", "number",
+        "The reduced velocity unit √(T0/m); time is then in diameter / speed_unit.", unit="m/s",
+        low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
+    # [run]
+    Key("run", "end_time", "number",
+        "Stop at this time (give `end_time`, `collisions_per_particle` or both; the first reached stops).",
+        unit="reduced time", low=0.0, low_open=True, high=TIME_MAX, reason=_TIME,
+        run_check="the float64 clock at end_time must resolve a millionth of the time between a "
+                  "particle's events (mean free time or diameter crossing time at the predicted "
+                  "final temperature), e.g. end_time below about 4e9 mean free times of an elastic gas"),
+    Key("run", "collisions_per_particle", "number",
+        "Stop after s = 2C/N collisions per particle (each pair collision counts for both partners).",
+        low=0.0, low_open=True, high=float(MAX_COLLISIONS),
+        reason="C = s N / 2 pair collisions must stay <= 2^53 (exact in float64; room in the int64 "
+               "event counter)"),
+    # [output]
+    Key("output", "file", "string", "The H5MD output file, relative to the working directory.",
+        default_text="runs/<config name>.h5",
+        run_check="its directory must exist (it is not created); an existing file needs --overwrite"),
+    Key("output", "snapshots", "integer",
+        "Number of full snapshots, the initial and the final state included, log-spaced in time "
+        "from `first_snapshot` to `end_time` (without `end_time`: log-spaced in collisions from one "
+        "per particle to the budget).", default_text=str(DEFAULT_SNAPSHOTS), low=2,
+        run_check="the schedule must fit in memory and the snapshots on the disk"),
+    Key("output", "snapshot_interval", "number", "Instead of `snapshots`: a snapshot every this much time.",
+        unit="reduced time", low=0.0, low_open=True, high=TIME_MAX, reason=_TIME,
+        run_check="end_time / snapshot_interval snapshots must fit in memory and on the disk"),
+    Key("output", "first_snapshot", "number", "Time of the first log-spaced snapshot after the start.",
+        default_text="the Enskog mean free time at T0", unit="reduced time", low=0.0, low_open=True,
+        high=TIME_MAX, reason=_TIME),
+    Key("output", "observables_interval", "number",
+        "Sampling interval of the observables (temperature, energies, counts, momentum, pressure); "
+        "they are also sampled at every snapshot, at the start and at the end.",
+        default_text="end_time / 200", unit="reduced time", low=0.0, low_open=True, high=TIME_MAX,
+        reason=_TIME, run_check="end_time / observables_interval samples must fit in memory and on the disk"),
+)
+
+#: section -> its dataclass (sub-tables: the dataclass of the table)
+SECTION_CLASSES = {
+    "system": SystemConfig, "particles": ParticlesConfig, "initial": InitialConfig,
+    "collision": CollisionConfig, "collision.material": MaterialConfig, "run": RunSection, "output": OutputConfig,
+}
+SECTIONS = ("system", "particles", "initial", "collision", "run", "output")
+#: keys whose value is a sub-table with its own section in SCHEMA
+SUBTABLES = {"collision.material": "collision.material"}
+#: keys that take a number or an inline table of sub-keys (dotted in SCHEMA)
+INLINE_TABLES = {"particles.diameter": ("min", "max")}
+
+_BY_DOTTED = {k.dotted: k for k in SCHEMA}
+
+
+def config_schema() -> tuple[Key, ...]:
+    """Every key, in the order of the reference (and of validation)."""
+    return SCHEMA
+
+
+# --------------------------------------------------------------------------- values and errors
 
 
 def _show(value: Any) -> str:
@@ -239,10 +481,221 @@ def _show(value: Any) -> str:
         return "true" if value else "false"
     if isinstance(value, dict):
         return "{ " + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, list):
+        return "[" + ", ".join(_show(v) for v in value) + "]"
     return repr(value) if not isinstance(value, float) else f"{value:g}"
 
 
-SECTIONS = ("system", "particles", "initial", "collision", "run", "output")
+class Values:
+    """The values of one document during validation: given or default, and where each came from."""
+
+    def __init__(self, source: str, overridden: set[str]):
+        self.source = source
+        self.overridden = overridden
+        self.value: dict[str, Any] = {}
+        self.given: set[str] = set()
+        self.raw: dict[str, Any] = {}
+
+    def origin(self, dotted: str) -> str:
+        return "override" if dotted in self.overridden else self.source
+
+    def where(self, dotted: str) -> str:
+        return f"{self.origin(dotted)}: {dotted}"
+
+    def fail(self, dotted: str, message: str, value: Any = ..., ) -> None:
+        if value is ...:
+            value = self.raw.get(dotted, ...)
+        shown = "" if value is ... else f" = {_show(value)}"
+        raise ConfigError(f"{self.where(dotted)}{shown}: {message}")
+
+    def get(self, dotted: str):
+        return self.value.get(dotted)
+
+    def has(self, dotted: str) -> bool:
+        return dotted in self.given
+
+
+def _check_type(key: Key, v: Any, values: Values):
+    """The value converted to its type (int for integers, float for numbers) or a ConfigError."""
+    d = key.dotted
+    if key.type == "integer":
+        if isinstance(v, float) and v.is_integer() and abs(v) < 2**53:
+            v = int(v)
+        if isinstance(v, bool) or not isinstance(v, int):
+            values.fail(d, f"must be {key.range_text() if key.choices is None else 'an integer: ' + key.range_text()}")
+        return v
+    if key.type in ("number", "number or table"):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            extra = " or { min = ..., max = ... }" if key.type == "number or table" else ""
+            values.fail(d, f"must be {key.range_text()}{extra}")
+        return float(v)
+    if key.type == "string":
+        if not isinstance(v, str):
+            values.fail(d, "must be a string")
+        return v
+    if key.type == "table":
+        if not isinstance(v, dict):
+            values.fail(d, "must be a table")
+        return v
+    raise AssertionError(key.type)
+
+
+def _check_range(key: Key, v: Any, values: Values, dimension: int):
+    d = key.dotted
+    ok = True
+    if key.choices is not None:
+        ok = v in key.choices
+    elif key.type == "string":
+        ok = bool(v.strip())
+    elif key.type in ("number", "integer", "number or table"):
+        x = float(v)
+        high = key.high_by_dimension[dimension] if key.high_by_dimension is not None else key.high
+        ok = math.isfinite(x)
+        if key.low is not None:
+            ok &= x > key.low if key.low_open else x >= key.low
+        if high is not None:
+            ok &= x < high if key.high_open else x <= high
+    if not ok:
+        reason = ""
+        if key.reason and key.type != "string" and key.choices is None:
+            reason = f" ({key.reason})"
+        if key.high_by_dimension is not None:
+            reason = f" ({key.reason} in {dimension}D)"
+        text = key.range_text(dimension)
+        if key.type == "number or table":
+            text += " or { min = ..., max = ... }"
+        values.fail(d, f"must be {text}{reason}")
+
+
+# --------------------------------------------------------------------------- rules across keys
+
+
+@dataclass(frozen=True)
+class Rule:
+    """A rule across keys: ``text`` for the reference, ``check(values)`` raises ConfigError."""
+
+    text: str
+    check: Callable[[Values], None]
+
+
+def _model_is(*models):
+    return lambda v: v.get("collision.model") in models
+
+
+def _only_with(dotted: str, models: tuple[str, ...]) -> Rule:
+    shown = " or ".join(f'"{m}"' for m in models)
+
+    def check(v: Values):
+        if v.has(dotted) and v.get("collision.model") not in models:
+            value = "{...}" if dotted == "collision.material" else ...
+            v.fail(dotted, f"is only used with model = {shown} (model = \"{v.get('collision.model')}\")", value)
+
+    key = dotted.split(".", 1)[1]
+    return Rule(f"`{key}` is used only with `model = {shown}`.", check)
+
+
+def _exclusive(a: str, b: str, why: str = "") -> Rule:
+    def check(v: Values):
+        if v.has(a) and v.has(b):
+            value = "{...}" if b == "collision.material" else ...
+            v.fail(b, f"give either {a.split('.')[-1]} or {b.split('.')[-1]}, not both{why}", value)
+
+    return Rule(f"`{a}` and `{b}` exclude each other.", check)
+
+
+def _check_constant_needs_restitution(v: Values):
+    if v.get("collision.model") == "constant" and not v.has("collision.restitution"):
+        v.fail("collision.restitution", 'missing; model = "constant" needs restitution in (0, 1]')
+
+
+def _check_viscoelastic_needs_contact(v: Values):
+    if v.get("collision.model") == "viscoelastic" and not (v.has("collision.damping") or v.has("collision.material")):
+        v.fail("collision.damping", 'missing; model = "viscoelastic" needs damping in [0, 40] or a '
+                                    "[collision.material] table")
+
+
+def _check_run_has_an_end(v: Values):
+    if not (v.has("run.end_time") or v.has("run.collisions_per_particle")):
+        raise ConfigError(f"{v.source}: run: needs end_time and/or collisions_per_particle (both > 0)")
+
+
+def _check_needs_end_time(v: Values):
+    if v.has("run.end_time"):
+        return
+    for key in ("output.snapshot_interval", "output.first_snapshot", "output.observables_interval"):
+        if v.has(key):
+            v.fail(key, "needs run.end_time (without it, output is scheduled in collisions per particle)")
+
+
+def _check_first_snapshot_below_end(v: Values):
+    first, end = v.get("output.first_snapshot"), v.get("run.end_time")
+    if first is not None and end is not None and first >= end:
+        v.fail("output.first_snapshot", f"must be below run.end_time = {end:g}")
+
+
+def _check_first_snapshot_log_spaced(v: Values):
+    if v.has("output.snapshot_interval") and v.has("output.first_snapshot"):
+        v.fail("output.first_snapshot", "is only used for log-spaced snapshots (without snapshot_interval)")
+
+
+def _check_diameter_range(v: Values):
+    lo, hi = v.get("particles.diameter.min"), v.get("particles.diameter.max")
+    if lo is not None and hi is not None and lo > hi:
+        v.fail("particles.diameter", "needs min <= max", v.raw.get("particles.diameter"))
+
+
+def _check_masses_from_density(v: Values):
+    rho = v.get("particles.density")
+    if rho is None:
+        return
+    dim = v.get("system.dimension")
+    lo = v.get("particles.diameter.min") or v.get("particles.diameter")
+    hi = v.get("particles.diameter.max") or v.get("particles.diameter")
+    unit = math.pi / 6.0 if dim == 3 else math.pi / 4.0
+    m_lo, m_hi = rho * unit * lo**dim, rho * unit * hi**dim
+    if not (SCALE_RANGE[0] <= m_lo and m_hi <= SCALE_RANGE[1]):
+        v.fail("particles.density", f"gives masses {m_lo:.3g} to {m_hi:.3g}, outside [1e-100, 1e100] "
+                                    f"({_SPEED})")
+
+
+def _check_collision_count(v: Values):
+    s, n = v.get("run.collisions_per_particle"), v.get("system.particles")
+    if s is not None and 0.5 * s * n > MAX_COLLISIONS:
+        v.fail("run.collisions_per_particle",
+               f"gives {0.5 * s * n:.3g} pair collisions for {n} particles; at most 2^53 = {MAX_COLLISIONS:.4g} "
+               f"(exact in float64)")
+
+
+RULES: tuple[Rule, ...] = (
+    Rule('`model = "constant"` needs `restitution`.', _check_constant_needs_restitution),
+    _only_with("collision.restitution", ("constant",)),
+    _only_with("collision.tc_time", ("constant",)),
+    _only_with("collision.damping", ("viscoelastic",)),
+    _only_with("collision.material", ("viscoelastic",)),
+    Rule('`model = "viscoelastic"` needs `damping` or `[collision.material]`.', _check_viscoelastic_needs_contact),
+    _exclusive("collision.damping", "collision.material"),
+    Rule("`diameter = { min, max }` needs both keys and min <= max (min = max is monodisperse).",
+         _check_diameter_range),
+    _exclusive("particles.mass", "particles.density"),
+    Rule("The masses `density` gives (for the smallest and largest diameter) lie in the range of `mass`.",
+         _check_masses_from_density),
+    Rule("`[run]` needs `end_time`, `collisions_per_particle` or both.", _check_run_has_an_end),
+    Rule("`collisions_per_particle` × `particles` / 2 pair collisions at most 2^53.", _check_collision_count),
+    _exclusive("output.snapshots", "output.snapshot_interval", " (snapshots: log-spaced)"),
+    Rule("`first_snapshot` is for log-spaced snapshots only (not with `snapshot_interval`).",
+         _check_first_snapshot_log_spaced),
+    Rule("Without `end_time` the output is scheduled in collisions: `snapshot_interval`, `first_snapshot` "
+         "and `observables_interval` need `end_time`.", _check_needs_end_time),
+    Rule("`first_snapshot` lies below `end_time`.", _check_first_snapshot_below_end),
+)
+
+
+def config_rules() -> tuple[Rule, ...]:
+    """The rules across keys, in the order they are checked."""
+    return RULES
+
+
+# --------------------------------------------------------------------------- parsing
 
 
 def load_config(path, overrides: dict[str, Any] | None = None) -> RunConfig:
@@ -289,14 +742,26 @@ def parse_config(text: str, source: str = "<config>", overrides: dict[str, Any] 
     return build_config(data, source=source, text=text, overridden=overridden)
 
 
+def _suggest(name: str, candidates) -> str:
+    close = difflib.get_close_matches(name, list(candidates), n=1, cutoff=0.6)
+    return f"; did you mean `{close[0]}`?" if close else ""
+
+
+def _section_keys(section: str) -> list[str]:
+    """TOML keys of a section (inline-table sub-keys and sub-tables by their first part)."""
+    return list(dict.fromkeys(k.key.split(".")[0] for k in SCHEMA if k.section == section))
+
+
 def apply_overrides(data: dict, overrides: dict[str, Any], source: str = "<config>") -> set[str]:
     """Set dotted keys in a nested dict in place; return the set of keys set."""
     done = set()
     for dotted, value in overrides.items():
         parts = str(dotted).split(".")
         if len(parts) < 2 or not all(parts) or parts[0] not in SECTIONS:
+            hint = _suggest(parts[0], SECTIONS) if parts and parts[0] and len(parts) >= 2 else ""
             raise ConfigError(
-                f"override {dotted} = {_show(value)}: key must be section.key with section one of {', '.join(SECTIONS)}"
+                f"override {dotted} = {_show(value)}: key must be section.key with section one of "
+                f"{', '.join(SECTIONS)}{hint}"
             )
         node = data
         for part in parts[:-1]:
@@ -309,160 +774,125 @@ def apply_overrides(data: dict, overrides: dict[str, Any], source: str = "<confi
     return done
 
 
+def _check_structure(data: dict, values: Values):
+    """Unknown sections and keys (with the nearest valid name), non-table sections."""
+    all_keys = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA}
+    for name, table in data.items():
+        if name not in SECTIONS:
+            origin = "override" if any(o.startswith(name + ".") for o in values.overridden) else values.source
+            close = difflib.get_close_matches(name, SECTIONS, n=1, cutoff=0.6)
+            hint = f"; did you mean [{close[0]}]?" if close else ""
+            raise ConfigError(f"{origin}: [{name}]: unknown section (allowed: "
+                              f"{', '.join(f'[{s}]' for s in SECTIONS)}){hint}")
+        _check_table(name, table, values, all_keys)
+
+
+def _check_table(section: str, table: Any, values: Values, all_keys: dict):
+    if not isinstance(table, dict):
+        values.fail(section, "must be a table", table)
+    known = _section_keys(section)
+    for key, value in table.items():
+        dotted = f"{section}.{key}"
+        if key not in known:
+            hint = _suggest(key, known)
+            if not hint:  # a key of another section, maybe misspelt too
+                close = difflib.get_close_matches(key, list(all_keys), n=1, cutoff=0.75)
+                if close and all_keys[close[0]] != dotted:
+                    hint = f"; did you mean `{all_keys[close[0]]}`?"
+            values.fail(dotted, f"unknown key{hint}", value)
+        if dotted in SUBTABLES:
+            if not isinstance(value, dict):
+                values.fail(dotted, "must be a table", value)
+            _check_table(SUBTABLES[dotted], value, values, all_keys)
+        elif dotted in INLINE_TABLES and isinstance(value, dict):
+            subs = INLINE_TABLES[dotted]
+            for sub, subvalue in value.items():
+                if sub not in subs:
+                    values.fail(f"{dotted}.{sub}", f"unknown key{_suggest(sub, subs)}", subvalue)
+
+
+def _lookup(data: dict, key: Key):
+    """(present, value) of a schema key in the document."""
+    node = data
+    for part in key.section.split(".") + key.key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return False, None
+        node = node[part]
+    return True, node
+
+
 def build_config(data: dict, *, source: str = "<config>", text: str = "", overridden=frozenset()) -> RunConfig:
-    """Validate a parsed TOML document (nested dict) into a :class:`RunConfig`."""
-    overridden = set(overridden)
-    for key, value in data.items():
-        if key not in SECTIONS:
-            origin = "override" if any(o.startswith(key + ".") for o in overridden) else source
-            raise ConfigError(
-                f"{origin}: [{key}]: unknown section (allowed: {', '.join(f'[{s}]' for s in SECTIONS)})"
-            )
+    """Validate a parsed TOML document (nested dict) into a :class:`RunConfig` (module docstring)."""
+    values = Values(source, set(overridden))
+    _check_structure(data, values)
+    dimension = 3
+    for key in SCHEMA:
+        dotted = key.dotted
+        present, raw = _lookup(data, key)
+        if dotted in INLINE_TABLES and present and isinstance(raw, dict):
+            values.raw[dotted] = raw
+            values.given.add(dotted)
+            sub_keys = [f"{dotted}.{s}" for s in INLINE_TABLES[dotted]]
+            missing = [s for s in sub_keys if s.split(".")[-1] not in raw]
+            if missing:
+                values.fail(dotted, f"needs both {' and '.join(s.split('.')[-1] for s in sub_keys)}, "
+                                    "e.g. { min = 0.8, max = 1.2 }", raw)
+            continue  # the sub-keys are checked as their own entries
+        if dotted in SUBTABLES:
+            if present:
+                values.given.add(dotted)
+                values.raw[dotted] = raw
+            continue
+        if not present:
+            parent = key.section if key.section in SUBTABLES else None
+            if key.required_in_table and parent and parent in values.given:
+                required = [k.key for k in SCHEMA if k.section == key.section and k.required_in_table]
+                missing = [k for k in required if k not in values.raw[parent]]
+                raise ConfigError(f"{values.where(parent)}: missing key(s) {', '.join(missing)} "
+                                  f"(all of {', '.join(required)} are needed)")
+            values.value[dotted] = key.default
+            continue
+        values.raw[dotted] = raw
+        values.given.add(dotted)
+        v = _check_type(key, raw, values)
+        _check_range(key, v, values, dimension)
+        if dotted == "system.dimension":
+            dimension = v
+        values.value[dotted] = v
+    for rule in RULES:
+        rule.check(values)
+    return _assemble(values, source, text)
 
-    def reader(section):
-        return _Reader(source, section, data.get(section, {}), overridden)
 
-    # [system]
-    r = reader("system")
-    dimension = r.integer("dimension", 3, allowed=(2, 3))
-    particles = r.integer("particles", SystemConfig.particles, minimum=2)
-    eta_max = MAX_PACKING[dimension]
-    packing = r.number(
-        "packing_fraction",
-        SystemConfig.packing_fraction,
-        low=0.0,
-        high=eta_max,
-        high_open=True,
-        what=f"in (0, {eta_max:.4f}) (densest packing of {'spheres' if dimension == 3 else 'disks'} in {dimension}D)",
-    )
-    seed = r.integer("seed", 1, minimum=0)
-    r.done()
-    system = SystemConfig(dimension, particles, packing, seed)
-
-    # [particles]
-    r = reader("particles")
-    diameter, dmin, dmax = 1.0, None, None
-    if "diameter" in r.table:
-        raw = r.table["diameter"]
-        if isinstance(raw, dict):
-            r.pop("diameter")
-            sub = _Reader(source, "particles.diameter", raw, overridden)
-            dmin = sub.number("min", None, low=0.0)
-            dmax = sub.number("max", None, low=0.0)
-            sub.done()
-            if dmin is None or dmax is None:
-                r.fail("diameter", raw, "needs both min and max, e.g. { min = 0.8, max = 1.2 }")
-            if dmin > dmax:
-                r.fail("diameter", raw, "needs min <= max")
-            diameter = 0.5 * (dmin + dmax)
-            if dmin == dmax:
-                dmin = dmax = None
-        else:
-            diameter = r.number("diameter", 1.0, low=0.0, what="a number > 0 or { min = ..., max = ... }")
-    mass = r.number("mass", None, low=0.0)
-    density = r.number("density", None, low=0.0)
-    if mass is not None and density is not None:
-        r.fail("density", density, "give either mass or density, not both")
-    if mass is None and density is None:
-        mass = 1.0
-    r.done()
-    particles_cfg = ParticlesConfig(diameter, dmin, dmax, mass, density)
-
-    # [initial]
-    r = reader("initial")
-    temperature = r.number("temperature", 1.0, low=0.0)
-    from_file = r.string("from", None)
-    if from_file is not None and not from_file:
-        r.fail("from", from_file, "must be a file name")
-    r.done()
-    initial = InitialConfig(temperature, from_file)
-
-    # [collision]
-    r = reader("collision")
-    model = r.string("model", "viscoelastic", allowed=MODELS)
-    restitution = r.number("restitution", None, low=0.0, high=1.0, what="in (0, 1]")
-    damping = r.number("damping", None, low=0.0, low_open=False, what="a number >= 0")
-    contact_end = r.string("contact_end", "overlap", allowed=CONTACT_ENDS)
-    # > 0, as CollisionRule.constant asserts: tc_time = 0 would make no collision elastic (the
-    # TC model off) while still tracking and writing last-collision times; leave the key out instead
-    tc_time = r.number("tc_time", None, low=0.0, low_open=True,
-                       what="a number > 0 (TC-model time; leave tc_time out for no TC model)")
+def _assemble(values: Values, source: str, text: str) -> RunConfig:
+    """The dataclasses from the checked values (plus the few values derived from others)."""
+    v = dict(values.value)
+    # derived values: the mean diameter of a polydisperse mix, the default mass, the default file
+    lo, hi = v.get("particles.diameter.min"), v.get("particles.diameter.max")
+    if lo is not None:
+        v["particles.diameter"] = 0.5 * (lo + hi)
+        if lo == hi:
+            v["particles.diameter.min"] = v["particles.diameter.max"] = None
+    if v.get("particles.mass") is None and v.get("particles.density") is None:
+        v["particles.mass"] = 1.0
+    if v.get("output.file") is None:
+        v["output.file"] = default_output(source)
     material = None
-    if "material" in r.table:
-        m = _Reader(source, "collision.material", r.pop("material"), overridden)
-        vals = {}
-        specs = {
-            "young_modulus": dict(low=0.0, what="a number > 0 (Pa)"),
-            "poisson_ratio": dict(low=-1.0, high=0.5, high_open=True, what="in (-1, 0.5)"),
-            "dissipation_time": dict(low=0.0, low_open=False, what="a number >= 0 (s)"),
-            "diameter": dict(low=0.0, what="a number > 0 (m)"),
-            "density": dict(low=0.0, what="a number > 0 (kg/m^3)"),
-            "speed_unit": dict(low=0.0, what="a number > 0 (m/s)"),
-        }
-        for key, spec in specs.items():
-            vals[key] = m.number(key, None, **spec)
-        m.done()
-        missing = [k for k, v in vals.items() if v is None]
-        if missing:
-            raise ConfigError(f"{m.where(None)}: missing key(s) {', '.join(missing)} (all of {', '.join(specs)} are needed)")
-        material = MaterialConfig(**vals)
-    r.done()
-    if model == "constant":
-        if restitution is None:
-            raise ConfigError(f"{r.where('restitution')}: missing; model = \"constant\" needs restitution in (0, 1]")
-        for key, val in (("damping", damping), ("material", material)):
-            if val is not None:
-                r.fail(key, val if key != "material" else "{...}", 'is only used with model = "viscoelastic"')
-    elif model == "viscoelastic":
-        if restitution is not None:
-            r.fail("restitution", restitution, 'is only used with model = "constant"')
-        if tc_time is not None:
-            r.fail("tc_time", tc_time, 'is only used with model = "constant"')
-        if damping is None and material is None:
-            raise ConfigError(
-                f"{r.where('damping')}: missing; model = \"viscoelastic\" needs damping >= 0 or a [collision.material] table"
-            )
-        if damping is not None and material is not None:
-            r.fail("damping", damping, "give either damping or [collision.material], not both")
-    else:  # elastic
-        for key, val in (("restitution", restitution), ("damping", damping), ("material", material), ("tc_time", tc_time)):
-            if val is not None:
-                r.fail(key, val if key != "material" else "{...}", 'is not used with model = "elastic"')
-    collision = CollisionConfig(model, restitution, damping, material, contact_end, tc_time)
+    if values.has("collision.material"):
+        material = MaterialConfig(**{k.attribute: v[k.dotted] for k in SCHEMA if k.section == "collision.material"})
 
-    # [run]
-    r = reader("run")
-    end_time = r.number("end_time", None, low=0.0)
-    cpp = r.number("collisions_per_particle", None, low=0.0)
-    r.done()
-    if end_time is None and cpp is None:
-        raise ConfigError(f"{source}: run: needs end_time and/or collisions_per_particle (both > 0)")
-    run = RunSection(end_time, cpp)
+    def section(name):
+        kwargs = {k.attribute: v[k.dotted] for k in SCHEMA if k.section == name and k.dotted not in SUBTABLES}
+        if name == "collision":
+            kwargs["material"] = material
+        return SECTION_CLASSES[name](**kwargs)
 
-    # [output]
-    r = reader("output")
-    default_file = f"runs/{Path(source).stem}.h5" if source and not source.startswith("<") else "runs/run.h5"
-    file = r.string("file", default_file)
-    if not file.strip():
-        r.fail("file", file, "must be a file name")
-    snapshots = r.integer("snapshots", None, minimum=2)
-    snap_dt = r.number("snapshot_interval", None, low=0.0)
-    if snapshots is not None and snap_dt is not None:
-        r.fail("snapshot_interval", snap_dt, "give either snapshots (log-spaced) or snapshot_interval, not both")
-    first = r.number("first_snapshot", None, low=0.0)
-    obs_dt = r.number("observables_interval", None, low=0.0)
-    if snap_dt is not None and first is not None:
-        r.fail("first_snapshot", first, "is only used for log-spaced snapshots (without snapshot_interval)")
-    if end_time is None:
-        for key, val in (("snapshot_interval", snap_dt), ("first_snapshot", first), ("observables_interval", obs_dt)):
-            if val is not None:
-                r.fail(key, val, "needs run.end_time (without it, output is scheduled in collisions per particle)")
-    if end_time is not None and first is not None and first >= end_time:
-        r.fail("first_snapshot", first, f"must be below run.end_time = {end_time:g}")
-    r.done()
-    output = OutputConfig(file, snapshots, snap_dt, first, obs_dt)
+    return RunConfig(*(section(s) for s in SECTIONS), source=source, text=text)
 
-    return RunConfig(system, particles_cfg, initial, collision, run, output, source=source, text=text)
+
+def default_output(source: str) -> str:
+    """``runs/<config name>.h5`` for a config file, ``runs/run.h5`` for text without a file."""
+    return f"runs/{Path(source).stem}.h5" if source and not source.startswith("<") else "runs/run.h5"
 
 
 # --------------------------------------------------------------------------- writing
@@ -481,31 +911,23 @@ def _toml_value(v: Any) -> str:
 
 
 def dump_toml(config: RunConfig) -> str:
-    """Resolved config as TOML (round-trips through :func:`parse_config`)."""
+    """Resolved config as TOML (round-trips through :func:`parse_config`), key order of :data:`SCHEMA`."""
     lines = [f"# resolved from {config.source}"]
-
-    def section(name, pairs):
+    objects = {s: getattr(config, s) for s in SECTIONS}
+    objects["collision.material"] = config.collision.material
+    for name in SECTIONS + tuple(SUBTABLES):
+        obj = objects[name]
+        if obj is None:
+            continue
         lines.append(f"\n[{name}]")
-        for k, v in pairs:
-            if v is not None:
-                lines.append(f"{k} = {v if isinstance(v, _Raw) else _toml_value(v)}")
-
-    s, p, i, c, r, o = (config.system, config.particles, config.initial, config.collision, config.run, config.output)
-    section("system", [(f.name, getattr(s, f.name)) for f in fields(s)])
-    diam = _Raw(f"{{ min = {p.diameter_min!r}, max = {p.diameter_max!r} }}") if p.polydisperse else p.diameter
-    section("particles", [("diameter", diam), ("mass", p.mass), ("density", p.density)])
-    section("initial", [("temperature", i.temperature), ("from", i.from_file)])
-    section(
-        "collision",
-        [("model", c.model), ("restitution", c.restitution), ("damping", c.damping),
-         ("contact_end", c.contact_end), ("tc_time", c.tc_time)],
-    )
-    if c.material is not None:
-        section("collision.material", [(f.name, getattr(c.material, f.name)) for f in fields(c.material)])
-    section("run", [(f.name, getattr(r, f.name)) for f in fields(r)])
-    section("output", [(f.name, getattr(o, f.name)) for f in fields(o)])
+        for key in SCHEMA:
+            if key.section != name or key.dotted in SUBTABLES or key.dotted.startswith(tuple(f"{t}." for t in INLINE_TABLES)):
+                continue
+            if key.dotted in INLINE_TABLES and getattr(obj, "polydisperse", False):
+                subs = ", ".join(f"{s} = {getattr(obj, f'{key.key}_{s}')!r}" for s in INLINE_TABLES[key.dotted])
+                lines.append(f"{key.key} = {{ {subs} }}")
+                continue
+            value = getattr(obj, key.attribute)
+            if value is not None:
+                lines.append(f"{key.key} = {_toml_value(value)}")
     return "\n".join(lines) + "\n"
-
-
-class _Raw(str):
-    """A pre-formatted TOML value."""

@@ -16,6 +16,7 @@ import numpy as np
 
 from granulargas.errors import InputFileError, UserError
 from granulargas.io.h5md import iter_snapshots, snapshot_count
+from granulargas.io.paths import output_file
 
 #: Time of each frame in the GSD file (OVITO shows log/ entries as global attributes).
 GSD_TIME_KEY = "granulargas/time"
@@ -61,8 +62,9 @@ def export_gsd(h5_path, gsd_path=None, *, overwrite: bool = False) -> tuple[Path
     gsd_path = Path(gsd_path) if gsd_path is not None else h5_path.with_suffix(".gsd")
     if gsd_path.resolve() == h5_path.resolve():
         raise InputFileError(f"{gsd_path}: output would overwrite the input file")
-    if gsd_path.exists() and not overwrite:
+    if gsd_path.exists() and not overwrite and not gsd_path.is_dir():
         raise InputFileError(f"{gsd_path}: output file exists (use --overwrite to replace it)")
+    output_file(gsd_path, str(gsd_path), overwrite=overwrite)
     if snapshot_count(h5_path) == 0:
         raise InputFileError(f"{h5_path}: holds no snapshot")
     tmp = gsd_path.with_name(gsd_path.name + ".part")
@@ -78,6 +80,9 @@ def export_gsd(h5_path, gsd_path=None, *, overwrite: bool = False) -> tuple[Path
     except OSError as exc:
         tmp.unlink(missing_ok=True)
         raise InputFileError(f"{gsd_path}: cannot write GSD file ({exc})") from None
+    except BaseException:  # a damaged input frame, an interrupt: no partial output stays behind
+        tmp.unlink(missing_ok=True)
+        raise
     tmp.replace(gsd_path)
     return gsd_path, frames
 

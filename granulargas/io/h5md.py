@@ -38,19 +38,31 @@ before a snapshot), so a run killed in the compiled loop leaves a file that
 holds every frame written before, readable by any HDF5 reader (no SWMR flag to
 clear); the readers ignore a last frame whose time was not yet written.
 
+Continuing a run into the same file (:meth:`H5MDWriter.append`): the file is
+opened for writing, cut back to the state the continuation starts from (its last
+complete frame and the observables sample at that frame: a run killed after it
+may have written a few samples more) and its datasets are extended; every time
+stays absolute. A frame written when a run was stopped by a signal (off the
+output schedule) is listed in ``parameters/interrupted_frames``
+(:func:`interrupted_frames`).
+
 The readers (:func:`read_observables`, :func:`iter_snapshots`,
-:func:`load_snapshot`, :func:`read_parameters`) read one frame at a time.
+:func:`load_snapshot`, :func:`read_parameters`) read one frame at a time. A file
+that is not ours, or one that is truncated or lacks an element the readers need
+(a dataset removed, shapes that do not fit together), raises
+:class:`granulargas.errors.InputFileError` with one line naming the file and
+what is missing or unreadable.
 """
 
 from __future__ import annotations
 
 import os
+import re
+import time as _time
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
-
-import re
-import time as _time
 
 import h5py
 import numpy as np
@@ -114,6 +126,59 @@ class H5MDWriter:
 
     #: longest wall time (s) observables samples stay buffered in memory
     flush_seconds = 2.0
+
+    @classmethod
+    def append(cls, path, *, particles: int, dimension: int, last_collision: bool, step: int, time: float):
+        """Open one of our files to continue its run in it (module docstring).
+
+        The file must hold ``particles`` particles in ``dimension`` dimensions and end
+        with a complete frame at (``step``, ``time``) with an observables sample there
+        (the state the continuation starts from); frames and samples after it (a
+        half-written frame, samples of a killed run) are cut off. Everything is checked
+        with the file open read-only: a file that does not fit raises
+        :class:`InputFileError` and stays unchanged.
+        """
+        path = Path(path)
+        with open_run(path) as f, _damaged(path, "the run to continue"):
+            frames, samples = _continuation_point(f, path, particles, dimension, last_collision, step, time)
+        f = open_run(path, "r+")
+        try:
+            with _damaged(path, "the run to continue"):
+                self = cls.__new__(cls)
+                self.path, self.file, self.n, self.d = path, f, particles, dimension
+                part = f["particles/all"]
+                self.box = np.ascontiguousarray(part["box/edges/value"][frames - 1], dtype=np.float64)
+                names = ["position", "velocity", "image", "box/edges"] + (["last_collision"] if last_collision else [])
+                self._frame_groups = [part[name] for name in names]
+                for g in self._frame_groups:
+                    g["value"].resize(frames, axis=0)
+                for key in ("step", "time"):
+                    part["position"][key].resize(frames, axis=0)
+                self._obs = {name: g for name, g in f["observables"].items()}
+                self._obs_clock = (f["observables/temperature/step"], f["observables/temperature/time"])
+                for g in self._obs.values():
+                    g["value"].resize(samples, axis=0)
+                for ds in self._obs_clock:
+                    ds.resize(samples, axis=0)
+                self._pending = []
+                self._last_flush = _wall()
+                f.flush()
+        except BaseException:
+            f.close()
+            raise
+        return self
+
+    def mark_interrupted(self, reason: str):
+        """Record the last frame as written off the schedule, when a signal stopped the run."""
+        g = self.file["parameters"]
+        old = list(g["interrupted_frames"][()]) if "interrupted_frames" in g else []
+        if "interrupted_frames" in g:
+            del g["interrupted_frames"]
+        g.create_dataset("interrupted_frames", data=np.asarray(old + [self.frames - 1], dtype=np.int64))
+        g["interrupted_frames"].attrs["description"] = (
+            "frames written when a signal stopped the run (the state reached, off the output schedule)")
+        g["interrupted_frames"].attrs["last_reason"] = reason
+        self.file.flush()
 
     # ----------------------------------------------------------------- layout
     def _create(self, box, radii, masses, species, parameters, last_collision, author):
@@ -258,6 +323,33 @@ class H5MDWriter:
         self.close()
 
 
+def _continuation_point(f, path, particles, dimension, last_collision, step, time) -> tuple[int, int]:
+    """(frames, samples) to keep of a file a run continues in (:meth:`H5MDWriter.append`)."""
+    part = f["particles/all"]
+    n, d = (int(x) for x in part["position/value"].shape[1:])
+    if (n, d) != (particles, dimension):
+        raise InputFileError(f"{path}: holds {n} particles in {d}D, the continuation {particles} in {dimension}D")
+    if ("last_collision" in part) != bool(last_collision):
+        raise InputFileError(f"{path}: {'has' if 'last_collision' in part else 'lacks'} the TC model's "
+                             "last-collision times; continue it with the same collision model")
+    frames = _frame_count(f)
+    if frames == 0 or int(part["position/step"][frames - 1]) != step or float(
+            part["position/time"][frames - 1]) != time:
+        raise InputFileError(f"{path}: its last frame is not the state the continuation starts from")
+    names = list(f["observables"])
+    if "temperature" not in names:
+        raise InputFileError(f"{path}: damaged H5MD file: observables/temperature is missing")
+    obs_step, obs_time = f["observables/temperature/step"][()], f["observables/temperature/time"][()]
+    hits = np.nonzero((obs_step == step) & (obs_time == time))[0]
+    if len(hits) == 0:
+        raise InputFileError(f"{path}: no observables sample at its last frame (t = {time:g})")
+    samples = int(hits[-1]) + 1
+    for name in names:
+        if f[f"observables/{name}/value"].shape[0] < samples:
+            raise InputFileError(f"{path}: damaged H5MD file: observables/{name} ends before its last frame")
+    return frames, samples
+
+
 def _short(exc) -> str:
     """The useful part of an HDF5 error message."""
     text = str(exc).strip()
@@ -314,7 +406,8 @@ class Snapshot:
 
 
 def open_run(path, mode="r") -> h5py.File:
-    """Open one of our H5MD files; :class:`InputFileError` if missing or not ours."""
+    """Open one of our H5MD files; :class:`InputFileError` if missing, not ours or damaged
+    (a truncated file, an element the readers need missing, shapes that do not fit)."""
     path = Path(path)
     if not path.exists():
         raise InputFileError(f"{path}: file not found")
@@ -324,7 +417,12 @@ def open_run(path, mode="r") -> h5py.File:
         f = h5py.File(path, mode)
     except OSError as exc:
         if "lock" not in str(exc) or mode != "r":
-            raise InputFileError(f"{path}: not an HDF5 file or unreadable ({_short(exc)})") from None
+            why = _short(exc)
+            if "truncated" in str(exc).lower():
+                raise InputFileError(f"{path}: truncated HDF5 file ({why}): the file was cut short") from None
+            if "lock" in str(exc):
+                raise InputFileError(f"{path}: locked by a running simulation; wait until it has finished") from None
+            raise InputFileError(f"{path}: not an HDF5 file or unreadable ({why})") from None
         # a running simulation holds the HDF5 lock; it flushes after every snapshot,
         # so reading without the lock sees the frames written so far
         try:
@@ -332,20 +430,81 @@ def open_run(path, mode="r") -> h5py.File:
         except OSError:
             raise InputFileError(f"{path}: locked by a running simulation; try again when it has finished") from None
     try:
-        creator = f["h5md/creator"].attrs.get("name", None)
-        if isinstance(creator, bytes):
-            creator = creator.decode()
-        if creator != CREATOR or "particles/all/position" not in f:
-            raise KeyError
-    except KeyError:
+        try:
+            creator = f["h5md/creator"].attrs.get("name", None)
+            if isinstance(creator, bytes):
+                creator = creator.decode()
+            ours = creator == CREATOR
+        except (KeyError, OSError, RuntimeError):
+            ours = False
+        if not ours:
+            raise InputFileError(f"{path}: not an H5MD file written by granulargas (no h5md/creator "
+                                 f'name "{CREATOR}")')
+        with _damaged(path, "its layout"):
+            _check_layout(f, path)
+    except BaseException:
         f.close()
-        raise InputFileError(f"{path}: not an H5MD file written by granulargas") from None
+        raise
     return f
+
+
+#: datasets every reader needs, relative to particles/all
+_REQUIRED = ("position/step", "position/time", "position/value", "velocity/value", "image/value",
+             "box/edges/value", "radius", "mass", "species")
+
+
+def _check_layout(f, path):
+    """Every element the readers need exists, with shapes that fit together (metadata only)."""
+    part = f.get("particles/all")
+    if not isinstance(part, h5py.Group):
+        raise InputFileError(f"{path}: damaged H5MD file: particles/all is missing")
+    for name in _REQUIRED:
+        if not isinstance(part.get(name), h5py.Dataset):
+            raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} is missing")
+    pos = part["position/value"].shape
+    if len(pos) != 3 or pos[2] not in (2, 3):
+        raise InputFileError(f"{path}: damaged H5MD file: particles/all/position/value has shape {pos}, "
+                             "expected (frames, particles, 2 or 3)")
+    n, d = pos[1], pos[2]
+    expect = {"velocity/value": (n, d), "image/value": (n, d), "box/edges/value": (d,), "radius": None,
+              "mass": None, "species": None, "position/step": (), "position/time": ()}
+    for name, tail in expect.items():
+        shape = part[name].shape
+        ok = shape == (n,) if tail is None else (len(shape) == len(tail) + 1 and shape[1:] == tail)
+        if not ok:
+            want = "(particles,)" if tail is None else "(frames" + "".join(f", {x}" for x in tail) + ")"
+            raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} has shape {shape}, "
+                                 f"expected {want} with {n} particles in {d}D")
+    if "last_collision" in part:
+        lc = part.get("last_collision/value")
+        if not isinstance(lc, h5py.Dataset) or lc.shape[1:] != (n,):
+            raise InputFileError(f"{path}: damaged H5MD file: particles/all/last_collision/value is missing "
+                                 f"or not (frames, {n})")
+    if not isinstance(f.get("observables"), h5py.Group):
+        raise InputFileError(f"{path}: damaged H5MD file: observables/ is missing")
+    if not isinstance(f.get("parameters"), h5py.Group):
+        raise InputFileError(f"{path}: damaged H5MD file: parameters/ is missing")
+
+
+@contextmanager
+def _damaged(path, what: str):
+    """Turn what h5py raises on damaged content into one line naming the file and the element."""
+    try:
+        yield
+    except InputFileError:
+        raise
+    except (OSError, KeyError, ValueError, TypeError, IndexError, RuntimeError) as exc:
+        raise InputFileError(f"{path}: damaged H5MD file: cannot read {what} ({_short(exc)})") from None
 
 
 def _frame_count(f) -> int:
     pos = f["particles/all/position"]
-    return int(min(pos["step"].shape[0], pos["time"].shape[0], pos["value"].shape[0]))
+    part = f["particles/all"]
+    lengths = [pos["step"].shape[0], pos["time"].shape[0], pos["value"].shape[0]]
+    lengths += [part[name].shape[0] for name in ("velocity/value", "image/value", "box/edges/value")]
+    if "last_collision" in part:
+        lengths.append(part["last_collision/value"].shape[0])
+    return int(min(lengths))
 
 
 def _snapshot(f, k, static) -> Snapshot:
@@ -375,9 +534,13 @@ def _static(f):
 def iter_snapshots(path) -> Iterator[Snapshot]:
     """Yield the snapshots of a run in time order, one frame at a time."""
     with open_run(path) as f:
-        static = _static(f)
-        for k in range(_frame_count(f)):
-            yield _snapshot(f, k, static)
+        with _damaged(path, "particles/all (radius, mass, species)"):
+            static = _static(f)
+            count = _frame_count(f)
+        for k in range(count):
+            with _damaged(path, f"frame {k}"):
+                snap = _snapshot(f, k, static)
+            yield snap
 
 
 def snapshot_count(path) -> int:
@@ -395,25 +558,41 @@ def load_snapshot(path, index: int = -1) -> Snapshot:
         k = index + n if index < 0 else index
         if not 0 <= k < n:
             raise InputFileError(f"{path}: snapshot index {index} out of range ({n} snapshots)")
-        return _snapshot(f, k, _static(f))
+        with _damaged(path, f"frame {k}"):
+            return _snapshot(f, k, _static(f))
+
+
+def interrupted_frames(path) -> list[int]:
+    """Indices of the frames written when a signal stopped the run (off the schedule)."""
+    with open_run(path) as f, _damaged(path, "parameters/interrupted_frames"):
+        g = f["parameters"]
+        return [int(k) for k in g["interrupted_frames"][()]] if "interrupted_frames" in g else []
 
 
 def read_observables(path) -> dict:
     """All observables: ``{name: (step, time, value)}`` as numpy arrays."""
     out = {}
     with open_run(path) as f:
-        for name, g in f["observables"].items():
-            n = min(g["step"].shape[0], g["time"].shape[0], g["value"].shape[0])
-            out[name] = (g["step"][:n], g["time"][:n], g["value"][:n])
+        for name in list(f["observables"]):
+            with _damaged(path, f"observables/{name}"):
+                g = f["observables"][name]
+                for part in ("step", "time", "value"):
+                    if not isinstance(g.get(part), h5py.Dataset):
+                        raise InputFileError(f"{path}: damaged H5MD file: observables/{name}/{part} is missing")
+                if g["step"].ndim != 1 or g["time"].ndim != 1 or g["value"].ndim < 1:
+                    raise InputFileError(f"{path}: damaged H5MD file: observables/{name} has step/time/value "
+                                         f"of shapes {g['step'].shape}, {g['time'].shape}, {g['value'].shape}")
+                n = min(g["step"].shape[0], g["time"].shape[0], g["value"].shape[0])
+                out[name] = (g["step"][:n], g["time"][:n], g["value"][:n])
     return out
 
 
 def read_parameters(path) -> dict:
     """The ``parameters/`` group as a nested dict (attributes and datasets), plus
     ``creator_version``; strings decoded, ``config`` the resolved TOML text."""
-    with open_run(path) as f:
+    with open_run(path) as f, _damaged(path, "parameters/"):
         out = _read_group(f["parameters"])
-        out["creator_version"] = _decode(f["h5md/creator"].attrs["version"])
+        out["creator_version"] = _decode(f["h5md/creator"].attrs.get("version", "unknown"))
     return out
 
 

@@ -31,7 +31,7 @@ def read_index(path: str | os.PathLike) -> dict:
 def write_index(directory: str | os.PathLike, payload: dict) -> Path:
     """Write ``payload`` as ``directory/index.json`` atomically (temp file + rename)."""
     directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
+    directory.mkdir(exist_ok=True)  # its parent exists (checked by the sweep loader; never created)
     fd, tmp = tempfile.mkstemp(dir=directory, prefix=".index.", suffix=".tmp")
     with os.fdopen(fd, "w") as fh:
         json.dump(payload, fh, indent=1)

@@ -34,8 +34,10 @@ from granulargas.engine import CollisionRule
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
 from granulargas.initial import InitialState, box_for_packing, random_state
-from granulargas.io.config import RunConfig
-from granulargas.io.h5md import load_snapshot, open_run, snapshot_count
+from granulargas.initial.lattice_gas import RANDOM_PLACEMENT_MAX
+from granulargas.io.config import TABLE_BETA_MAX, RunConfig
+from granulargas.io.h5md import load_snapshot, read_observables, snapshot_count
+from granulargas.run.resources import check_memory
 from granulargas.theory import particle_volume
 
 
@@ -84,6 +86,7 @@ def fresh_state(config: RunConfig) -> InitialState:
     ``numpy.random.default_rng(system.seed)`` (radii, then positions, then velocities)
     by :func:`granulargas.initial.random_state`."""
     s = config.system
+    check_memory(config)  # before anything is allocated
     rng = np.random.default_rng(s.seed)
     radii, masses = make_particles(config, rng)
     box = box_for_packing(radii, s.packing_fraction, s.dimension)
@@ -98,7 +101,9 @@ def fresh_state(config: RunConfig) -> InitialState:
         return random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
                             radii=radii, masses=masses, rng=rng)
     except ConfigError as exc:
-        raise ConfigError(f"{config.source}: system.packing_fraction = {s.packing_fraction:g}: {exc}") from None
+        limit = RANDOM_PLACEMENT_MAX[s.dimension]
+        raise ConfigError(f"{config.source}: system.packing_fraction = {s.packing_fraction:g}: {exc}; random "
+                          f"placement works up to about {limit:g} in {s.dimension}D") from None
 
 
 def restart_state(config: RunConfig) -> InitialState:
@@ -111,17 +116,23 @@ def restart_state(config: RunConfig) -> InitialState:
         raise InputFileError(f"{where}: {str(exc).split(': ', 1)[-1]}") from None
     if count == 0:
         raise InputFileError(f"{where}: holds no snapshot")
-    snap = load_snapshot(path, -1)
-    with open_run(path) as f:
-        g = f["observables/collisions"]
-        steps = g["step"][()]
-        times = g["time"][()]
-        hits = np.nonzero((steps == snap.step) & (times == snap.time))[0]
-        if len(hits) == 0:
-            raise InputFileError(f"{where}: no observables sample at its last snapshot (t = {snap.time:g})")
-        k = int(hits[-1])
-        collisions = int(g["value"][k])
-        dissipated = float(f["observables/dissipated_energy/value"][k])
+    try:
+        snap = load_snapshot(path, -1)
+        obs = read_observables(path)
+    except InputFileError as exc:
+        raise InputFileError(f"{where}: {str(exc).split(': ', 1)[-1]}") from None
+    for name in ("collisions", "dissipated_energy"):
+        if name not in obs:
+            raise InputFileError(f"{where}: damaged H5MD file: observables/{name} is missing")
+    steps, times, _ = obs["collisions"]
+    hits = np.nonzero((steps == snap.step) & (times == snap.time))[0]
+    if len(hits) == 0:
+        raise InputFileError(f"{where}: no observables sample at its last snapshot (t = {snap.time:g})")
+    k = int(hits[-1])
+    if k >= len(obs["dissipated_energy"][2]):
+        raise InputFileError(f"{where}: damaged H5MD file: observables/dissipated_energy ends before its last snapshot")
+    collisions = int(obs["collisions"][2][k])
+    dissipated = float(obs["dissipated_energy"][2][k])
     n, dim = snap.positions.shape
     if dim != config.system.dimension:
         raise ConfigError(f"{config.source}: system.dimension = {config.system.dimension}: restart file {path} is {dim}D")
@@ -129,6 +140,13 @@ def restart_state(config: RunConfig) -> InitialState:
         raise ConfigError(
             f"{config.source}: system.particles = {config.system.particles}: restart file {path} has {n} particles"
         )
+    bad = [name for name in ("positions", "velocities", "radii", "masses", "box")
+           if not np.all(np.isfinite(np.asarray(getattr(snap, name), dtype=np.float64)))]
+    if bad or not (np.all(snap.radii > 0) and np.all(snap.masses > 0) and np.all(snap.box > 0)):
+        raise InputFileError(f"{where}: damaged H5MD file: the last snapshot holds non-finite or non-positive "
+                             f"{', '.join(bad) or 'radii, masses or box'}")
+    packing = float(particle_volume(2.0 * snap.radii, dim).sum() / np.prod(snap.box))
+    check_memory(config, n=n, packing=packing, fresh=False)
     return InitialState(
         positions=np.ascontiguousarray(snap.positions, dtype=np.float64),
         velocities=np.ascontiguousarray(snap.velocities, dtype=np.float64),
@@ -221,6 +239,12 @@ def make_rule(config: RunConfig, state: InitialState):
         return CollisionRule.constant(c.restitution, tc_time=c.tc_time), "constant", None, None, [], params
     k = reduced_prefactor(config)
     bmax = beta_bound(k, state)
+    if not bmax <= TABLE_BETA_MAX:
+        key = (f"collision.damping = {c.damping:g}" if c.material is None else "collision.material")
+        raise ConfigError(
+            f"{config.source}: {key}: the fastest impact the run's kinetic energy allows reaches beta = {bmax:.3g}, "
+            f"beyond the restitution table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well below 3); "
+            "lower the damping")
     table = restitution_table(max(bmax, 1e-6), end=c.contact_end)
     warns = validity_warnings(config, k, state)
     params.update(prefactor=k, contact_end=c.contact_end, damping=c.damping,

@@ -1,13 +1,17 @@
-"""The run loop: progress bar, H5MD writing and the summary.
+"""The run loop: progress bar, H5MD writing, stopping on a signal, and the summary.
 
 Order of operations of :func:`run_config` (everything before the output file
-is created can fail without leaving a file)::
+is created or opened can fail without leaving a file or changing one)::
 
-    check the output path (exists without overwrite? same as the restart file?)
-    setup = run.prepare.prepare(config)       # rule, table, initial state
+    check the output path (directory exists? exists without overwrite? the restart file?)
+    --append: the config keeps the file's physics
+    setup = run.prepare.prepare(config)       # memory check, rule, table, initial state
+    check the schedule's memory and the output file's size against the disk
     sim = Simulation(...); sim.run(until=start)   # JIT compile / queue build, untimed
     writer = H5MDWriter(...)                     # the file exists from here on
-    sample observables and write a snapshot at the start time
+             (--append: H5MDWriter.append, the file cut back to its last frame)
+    sample observables and write a snapshot at the start time (not with --append:
+    the file holds both)
     for each output target (time, or collision count without run.end_time):
         sim.run(until=target, max_collisions=budget)   # compiled chunks
         sample observables (pressure: mean over the interval just ended)
@@ -17,16 +21,31 @@ is created can fail without leaving a file)::
 The schedule (:mod:`granulargas.run.schedule`) is a pure function of the config (never of the start time), so a
 run to 2t and a run to t followed by a restart to 2t synchronise at the same
 times and do the same arithmetic (restart equality; the engine rebuilds its
-queue from the synchronised state).
+queue from the synchronised state). The same holds for a run continued into its
+own file (``--append``): the file is then frame for frame the uninterrupted run's.
+
+Signals (:func:`stop_on_signals`, :class:`StopRequest`): SIGINT and SIGTERM set a
+request that the runner checks between the engine's compiled chunks (and between
+output targets); the run stops at that chunk boundary, where every event up to
+the current time is processed, samples the observables, writes the synchronised
+state as a last frame listed in ``parameters/interrupted_frames``, closes the file
+and raises :class:`RunInterrupted` (exit 130 / 143). ``--restart FILE [--append]``
+continues from that frame to the config's absolute end. Such a continuation
+synchronises the engine at a time the uninterrupted run does not, so it equals
+the run that stops and restarts at that same time bit for bit, and the
+uninterrupted run only up to round-off. A run killed outright (SIGKILL) leaves
+every frame flushed before.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import signal
 import sys
 import time as _time
-from dataclasses import dataclass, field
+from contextlib import contextmanager
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 import numpy as np
@@ -34,13 +53,15 @@ import numpy as np
 from tqdm import tqdm
 
 from granulargas.engine import Simulation
-from granulargas.errors import ConfigError, InputFileError, SimulationError
-from granulargas.io.config import RunConfig
-from granulargas.io.h5md import H5MDWriter
+from granulargas.errors import ConfigError, InputFileError, SimulationError, UserError
+from granulargas.io.config import RunConfig, parse_config
+from granulargas.io.h5md import H5MDWriter, read_parameters
+from granulargas.io.paths import existing_directory, output_file
 from granulargas.run.prepare import prepare
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
     Schedule,
+    check_output_size,
     collision_budget,
     mean_free_time,
     output_schedule,
@@ -122,33 +143,142 @@ def _want_progress(quiet: bool, progress) -> bool:
         return False
 
 
+# --------------------------------------------------------------------- stopping on a signal
+
+
+class StopRequest:
+    """What a signal asks of a run: stop at the next chunk boundary and keep the state.
+
+    :func:`stop_on_signals` installs handlers that call :meth:`request`. Before the
+    runner has created its output file (:meth:`arm`) there is nothing to keep and a
+    signal raises :class:`Interrupted` at once; afterwards the first signal only sets
+    the request, which the runner checks between the engine's compiled chunks, and a
+    second one raises at once (the file still holds every frame flushed before).
+    """
+
+    def __init__(self):
+        self.signum: int | None = None
+        self.armed = False
+
+    def request(self, signum, frame=None):  # noqa: ARG002 (signal handler signature)
+        if not self.armed or self.signum is not None:
+            self.signum = signum
+            raise Interrupted(signum)
+        self.signum = signum
+
+    def arm(self):
+        self.armed = True
+        if self.signum is not None:
+            raise Interrupted(self.signum)
+
+    def __bool__(self) -> bool:
+        return self.signum is not None
+
+
+class Interrupted(KeyboardInterrupt):
+    """A signal stopped the program before there was a state to keep (exit 128 + signal)."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = int(signum)
+
+
+@contextmanager
+def stop_on_signals(signals=(signal.SIGINT, signal.SIGTERM)):
+    """Handlers for ``signals`` that fill a :class:`StopRequest` (yielded); the previous
+    handlers are restored on exit. Outside the main thread nothing is installed."""
+    stop = StopRequest()
+    previous = {}
+    try:
+        for signum in signals:
+            previous[signum] = signal.signal(signum, stop.request)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        yield stop
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+class RunInterrupted(UserError):
+    """The run stopped on a signal at a chunk boundary; its state is the file's last frame.
+
+    ``exit_code`` is 128 + the signal number (130 for SIGINT, 143 for SIGTERM)."""
+
+    prefix = "interrupted"
+
+    def __init__(self, message: str, *, signum: int, time: float, collisions: int, output: Path):
+        super().__init__(message)
+        self.signum, self.time, self.collisions, self.output = int(signum), time, collisions, output
+        self.exit_code = 128 + int(signum)
+
+
+class _Stop(Exception):
+    """Raised between compiled chunks when a stop was requested (never leaves the runner)."""
+
+
 # --------------------------------------------------------------------- the run
 
 
-def check_output(config: RunConfig, overwrite: bool) -> Path:
-    """Refuse an existing output without ``overwrite`` and an output that is the
-    restart file; check that the directory can be written. Creates nothing."""
+def check_output(config: RunConfig, overwrite: bool, append: bool = False) -> Path:
+    """Refuse an output that cannot or must not be written, before anything is created:
+    a directory, a directory that does not exist (it is never created: a typo would go
+    unnoticed), a directory that cannot be written, an existing file without
+    ``overwrite``, the restart file itself (unless ``append``, which needs it)."""
     path = Path(config.output.file)
-    where = f"{config.source}: output.file"
+    where = f'{config.source}: output.file = "{path}"'
     if path.is_dir():
-        raise InputFileError(f'{where} = "{path}": is a directory')
+        raise InputFileError(f"{where}: is a directory")
+    existing_directory(path, where)
+    same = False
     if config.initial.from_file is not None:
         src = Path(config.initial.from_file)
-        if src.exists() and path.exists() and src.resolve() == path.resolve():
-            raise InputFileError(
-                f'{where} = "{path}": is the restart file; write the continuation to another file (--output)'
-            )
-    if path.exists() and not overwrite:
-        raise InputFileError(f'{where} = "{path}": file exists (use --overwrite to replace it)')
-    parent = path.parent if str(path.parent) else Path(".")
-    probe = parent
-    while not probe.exists() and probe != probe.parent:
-        probe = probe.parent
-    if not probe.is_dir():
-        raise InputFileError(f'{where} = "{path}": {probe} is not a directory')
-    if not os.access(probe, os.W_OK | os.X_OK):
-        raise InputFileError(f'{where} = "{path}": directory {probe} is not writable')
-    return path
+        same = src.exists() and path.exists() and src.resolve() == path.resolve()
+    if append:
+        if config.initial.from_file is None:
+            raise InputFileError(f"{where}: --append continues a run into its own file: give --restart FILE")
+        if not same:
+            raise InputFileError(f'{where}: --append writes into the restart file "{config.initial.from_file}"; '
+                                 "drop --output (or give the same file)")
+        if not os.access(path, os.W_OK):
+            raise InputFileError(f"{where}: file is not writable")
+        return path
+    if same:
+        raise InputFileError(f"{where}: is the restart file; continue into it with --append, or write the "
+                             "continuation to another file (--output)")
+    return output_file(path, where, overwrite=overwrite)
+
+
+#: sections whose values must agree between a file and the config that continues in it
+_SAME_PHYSICS = ("system", "particles", "collision")
+
+
+def check_same_physics(config: RunConfig, path: Path) -> None:
+    """A run continued into its own file (``--append``) keeps the physics of the file's
+    config (``parameters/config``): same system (except the seed), particles and
+    collision rule; one line naming the first key that differs."""
+    try:
+        stored = read_parameters(path).get("config")
+        old = parse_config(stored, source=str(path)) if isinstance(stored, str) else None
+    except (InputFileError, ConfigError):
+        old = None
+    if old is None:
+        raise InputFileError(f"{path}: parameters/config is missing or unreadable; --append needs the file's config")
+    for section in _SAME_PHYSICS:
+        new_s, old_s = getattr(config, section), getattr(old, section)
+        for f in fields(new_s):
+            if section == "system" and f.name == "seed":
+                continue
+            a, b = getattr(new_s, f.name), getattr(old_s, f.name)
+            if a != b:
+                key = f"{section}.{'from' if f.name == 'from_file' else f.name}"
+                raise ConfigError(f"{config.source}: {key} = {_plain(a)}: the file {path} was run with {_plain(b)}; "
+                                  "--append continues the same physics (write a new file with --output instead)")
+
+
+def _plain(v):
+    return f'"{v}"' if isinstance(v, str) else ("{...}" if hasattr(v, "__dataclass_fields__") else f"{v}")
 
 
 def _observables(sim, pressure: bool) -> dict:
@@ -164,7 +294,7 @@ def _observables(sim, pressure: bool) -> dict:
 
 
 def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True, progress=None,
-               log=None) -> RunSummary:
+               log=None, append: bool = False, stop: StopRequest | None = None) -> RunSummary:
     """Run a validated config to the end and write its H5MD file.
 
     Parameters
@@ -180,6 +310,14 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         a callable ``progress(sim)`` is called between compiled chunks instead.
     log : callable, optional
         Receives one-line warnings (model validity); default: print to stderr.
+    append : bool
+        Continue into the restart file itself (``initial.from`` = ``output.file``):
+        its datasets are extended, times stay absolute, the physics must be the
+        file's (:func:`check_same_physics`).
+    stop : StopRequest, optional
+        Checked between compiled chunks: when set (by :func:`stop_on_signals`), the run
+        stops there, writes the state reached as a final frame marked as interrupted,
+        closes the file and raises :class:`RunInterrupted`.
 
     Returns
     -------
@@ -188,15 +326,19 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     Raises
     ------
     UserError
-        Bad input (nothing written) or a run that cannot continue
-        (:class:`SimulationError`; the file keeps the snapshots written so far).
+        Bad input (nothing written, nothing changed), a run that cannot continue
+        (:class:`SimulationError`; the file keeps the snapshots written so far), or
+        :class:`RunInterrupted`.
     """
-    path = check_output(config, overwrite)
-    setup = prepare(config)
+    path = check_output(config, overwrite, append)
+    if append:
+        check_same_physics(config, path)
+    setup = prepare(config)  # checks the memory before building anything
     for w in setup.warnings:
         (log or _stderr)(w)
-    schedule = output_schedule(config)
     st = setup.state
+    check_output_size(config, len(st.radii))
+    schedule = output_schedule(config)
     run = config.run
     if run.end_time is not None and st.time >= run.end_time:
         raise ConfigError(f"{config.source}: run.end_time = {run.end_time:g}: the restart file "
@@ -224,14 +366,22 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     if config.run.collisions_per_particle is not None:
         budget = collision_budget(config)
 
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputFileError(f'{config.source}: output.file = "{path}": cannot create its directory '
-                             f"({exc.strerror or exc})") from None
     tc = setup.rule_name == "constant" and config.collision.tc_time is not None
-    writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
-                        last_collision=tc, overwrite=overwrite)
+    if append:
+        writer = H5MDWriter.append(path, particles=len(st.radii), dimension=st.box.shape[0], last_collision=tc,
+                                   step=st.events, time=st.time)
+        writer.set_parameters(_continuation_record(writer, config, setup, st))
+    else:
+        writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
+                            last_collision=tc, overwrite=overwrite)
+    try:
+        if stop is not None:
+            stop.arm()  # from here on a signal keeps the state reached
+    except BaseException:
+        writer.close()
+        if not append:
+            path.unlink(missing_ok=True)
+        raise
 
     show = _want_progress(quiet, progress)
     bar = None
@@ -244,6 +394,12 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
             bar = _Progress(total, schedule.clock, start_key, sim)
             callback = bar
 
+    def between_chunks(sim_):
+        if stop:
+            raise _Stop
+        if callback is not None:
+            callback(sim_)
+
     def snapshot():
         sim.synchronise()
         lc = np.asarray(sim.last_collision) if tc else None
@@ -253,15 +409,18 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     c0 = sim.collisions
     stop_reason = "end_time" if schedule.clock == "time" else "collisions_per_particle"
     try:
-        writer.write_observables(sim.events, sim.time, _observables(sim, False), flush=False)
-        snapshot()
+        if not append:  # a continued file already holds the starting frame and its sample
+            writer.write_observables(sim.events, sim.time, _observables(sim, False), flush=False)
+            snapshot()
         for target, snap in zip(targets, is_snap):
+            if stop:
+                raise _Stop
             if schedule.clock == "time":
                 left = None if budget is None else budget - sim.collisions
-                sim.run(until=float(target), max_collisions=left, progress=callback)
+                sim.run(until=float(target), max_collisions=left, progress=between_chunks)
                 hit_budget = budget is not None and sim.collisions >= budget and sim.time < target
             else:
-                sim.run(until=math.inf, max_collisions=int(target) - sim.collisions, progress=callback)
+                sim.run(until=math.inf, max_collisions=int(target) - sim.collisions, progress=between_chunks)
                 hit_budget = False
             writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
             if snap or hit_budget:
@@ -271,6 +430,23 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
             if hit_budget:
                 stop_reason = "collisions_per_particle"
                 break
+    except _Stop:
+        # the state at the last chunk boundary: every event up to sim.time is processed
+        name = signal.Signals(stop.signum).name
+        try:
+            writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
+            snapshot()
+            writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
+            writer.set_parameters({"summary": {"stop_reason": f"interrupted by {name}", "time": float(sim.time),
+                                               "collisions": int(sim.collisions), "events": int(sim.events)}})
+        finally:
+            writer.close()
+            if bar is not None:
+                bar.close()
+        raise RunInterrupted(
+            f"{name} at t = {sim.time:.6g} ({sim.collisions} collisions); {path} keeps the state reached as its "
+            "last frame", signum=stop.signum, time=float(sim.time), collisions=int(sim.collisions),
+            output=path) from None
     except BaseException as exc:
         reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else f"error: {exc}"
         try:
@@ -283,6 +459,12 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
                 bar.close()
         if isinstance(exc, SimulationError) and type(exc).__init__ is Exception.__init__:
             raise type(exc)(f"{exc} ({path} keeps {kept} snapshots)") from None
+        if isinstance(exc, KeyboardInterrupt):  # a second signal: stopped at once
+            signum = getattr(exc, "signum", signal.SIGINT)
+            raise RunInterrupted(
+                f"{signal.Signals(signum).name} again: stopped at once at t = {sim.time:.6g}; {path} keeps the "
+                f"{kept} frames flushed before", signum=signum, time=float(sim.time), collisions=int(sim.collisions),
+                output=path) from None
         raise
     wall = _time.perf_counter() - wall0
     done = sim.collisions - c0
@@ -309,6 +491,24 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     if bar is not None:
         bar.close()
     return summary
+
+
+def _continuation_record(writer, config: RunConfig, setup, st) -> dict:
+    """``parameters/`` entries of a run continued into its file: the new resolved config
+    (``config``) and, under ``continuations/<k>``, where it started and the config it replaced."""
+    g = writer.file["parameters"]
+    k = len(g["continuations"]) if "continuations" in g else 0
+    previous = g["config"][()] if "config" in g else b""
+    previous = previous.decode() if isinstance(previous, bytes) else str(previous)
+    return {
+        "config": setup.parameters["config"],
+        "config_source": setup.parameters["config_source"],
+        "continuations": {f"{k:04d}": {
+            "time": float(st.time), "step": int(st.events), "collisions": int(st.collisions),
+            "frame": writer.frames - 1, "version": setup.parameters["version"],
+            "config_file": setup.parameters["config_file"], "previous_config": previous,
+        }},
+    }
 
 
 def _stderr(msg: str):

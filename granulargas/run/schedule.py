@@ -9,16 +9,22 @@ total pair-collision counts (``run.collisions_per_particle`` alone).
 from __future__ import annotations
 
 import math
+import shutil
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from granulargas import theory
+from granulargas.errors import ConfigError
 from granulargas.io.config import RunConfig
 from granulargas.run.prepare import mean_particle
+from granulargas.run.resources import available_memory, format_bytes
 
 #: default number of evenly spaced observables samples (plus every snapshot time)
 DEFAULT_OBSERVABLE_SAMPLES = 200
+#: memory of the schedule per output time (the arrays output_schedule builds and merges)
+SCHEDULE_BYTES_PER_TARGET = 64.0
 
 
 @dataclass(frozen=True)
@@ -94,3 +100,59 @@ def output_schedule(config: RunConfig) -> Schedule:
     targets = targets[targets > 0]
     snapshot = np.isin(targets, snaps)
     return Schedule(clock, targets, snapshot)
+
+
+def output_counts(config: RunConfig) -> tuple[float, float]:
+    """(snapshots, observables-only samples) of the config's schedule, counted without
+    building it (floats: inf or astronomically large counts are possible)."""
+    out, run = config.output, config.run
+    if run.end_time is not None:
+        end = run.end_time
+        snaps = end / out.snapshot_interval + 1 if out.snapshot_interval is not None else float(out.snapshot_count)
+        samples = end / out.observables_interval + 1 if out.observables_interval is not None else float(
+            DEFAULT_OBSERVABLE_SAMPLES + 1)
+        return snaps, samples
+    return float(out.snapshot_count), float(DEFAULT_OBSERVABLE_SAMPLES + 1)
+
+
+def check_output_size(config: RunConfig, n: int | None = None, *, available: float | None = None,
+                      free_disk: float | None = None) -> tuple[float, float]:
+    """Refuse a schedule that does not fit in memory, or an output file that does not fit
+    on its disk (one line naming the key), before :func:`output_schedule` allocates it.
+
+    Memory: 64 B per output time (the arrays the schedule builds and merges). Disk:
+    24 d B per particle and frame (positions, velocities, images; 8 B more with the TC
+    model's last collision times), 8 (8 + d) B per observables sample. Returns
+    (schedule bytes, file bytes)."""
+    s, out = config.system, config.output
+    n = s.particles if n is None else int(n)
+    d = s.dimension
+    snaps, obs = output_counts(config)
+    samples = snaps + obs
+    if obs > snaps:
+        key, value = "output.observables_interval", out.observables_interval
+    elif out.snapshot_interval is not None:
+        key, value = "output.snapshot_interval", out.snapshot_interval
+    else:
+        key, value = "output.snapshots", out.snapshot_count
+    schedule = SCHEDULE_BYTES_PER_TARGET * samples
+    if available is None:
+        available = available_memory()
+    src = config.source
+    if not math.isfinite(samples) or (available is not None and schedule > available):
+        raise ConfigError(f"{src}: {key} = {value!r}: {samples:.3g} output times; the schedule alone needs "
+                          f"{format_bytes(schedule)} of memory, {format_bytes(available) if available is not None else 'an unknown amount'} are available")
+    tc = config.collision.model == "constant" and config.collision.tc_time is not None
+    frame = n * 8.0 * (3 * d + (1 if tc else 0))
+    file_bytes = snaps * frame + samples * 8.0 * (8 + d) + n * 24.0
+    if free_disk is None:
+        directory = Path(out.file).parent
+        try:
+            free_disk = float(shutil.disk_usage(directory if str(directory) else ".").free)
+        except OSError:
+            free_disk = None
+    if free_disk is not None and file_bytes > free_disk:
+        raise ConfigError(f"{src}: {key} = {value!r}: the output file would need about {format_bytes(file_bytes)} "
+                          f"({snaps:.3g} snapshots of {format_bytes(frame)}), the disk holding "
+                          f"{Path(out.file).parent or Path('.')} has {format_bytes(free_disk)} free")
+    return schedule, file_bytes

@@ -33,7 +33,9 @@ failed run is reported with its parameters and does not stop the others.
 
 from __future__ import annotations
 
+import difflib
 import itertools
+import math
 import multiprocessing
 import os
 import time
@@ -46,6 +48,7 @@ import h5py
 
 from granulargas.errors import ConfigError, InputFileError
 from granulargas.io.config import load_config
+from granulargas.io.paths import existing_directory
 from granulargas.io.sweep_index import INDEX_NAME, read_index, write_index
 from granulargas.run.runner import run_config
 
@@ -74,12 +77,18 @@ class Sweep:
         return self.output_dir / INDEX_NAME
 
 
-def _flatten(table: dict, prefix: str = "") -> dict:
+#: most runs a sweep file may expand to: the run list (about 2 kB per run) must fit in memory
+MAX_RUNS = 10_000_000
+
+
+def _flatten(path: Path, table, prefix: str) -> dict:
+    if not isinstance(table, dict):
+        raise ConfigError(f"{path}: {prefix.rstrip('.')} = {table!r}: must be a table")
     out = {}
     for key, value in table.items():
         dotted = f"{prefix}{key}"
         if isinstance(value, dict) and not _is_generator(value):
-            out.update(_flatten(value, dotted + "."))
+            out.update(_flatten(path, value, dotted + "."))
         else:
             out[dotted] = value
     return out
@@ -89,35 +98,51 @@ def _is_generator(value: dict) -> bool:
     return len(value) == 1 and next(iter(value)) in ("range", "linspace", "logspace")
 
 
-def _expand_values(path: Path, key: str, spec) -> list:
-    """A list of values from a list, a scalar, or {range|linspace|logspace = [...]}."""
+def _count(path: Path, key: str, spec) -> int:
+    """How many values ``spec`` gives, without expanding it (ConfigError if malformed)."""
     where = f"{path}: vary.{key}"
     if isinstance(spec, list):
         if not spec:
             raise ConfigError(f"{where} = []: give at least one value")
-        return spec
+        return len(spec)
     if isinstance(spec, dict):
         (kind, args), = spec.items()
-        if not isinstance(args, list) or not all(isinstance(a, (int, float)) for a in args):
-            raise ConfigError(f"{where}.{kind} = {args!r}: expected a list of numbers")
+        numbers = isinstance(args, list) and all(isinstance(a, (int, float)) and not isinstance(a, bool)
+                                                 for a in args)
+        if not numbers or not all(math.isfinite(a) for a in args):
+            raise ConfigError(f"{where}.{kind} = {args!r}: expected a list of finite numbers")
         if kind == "range":
-            if not all(isinstance(a, int) for a in args) or not 1 <= len(args) <= 3:
-                raise ConfigError(f"{where}.range = {args!r}: expected 1 to 3 integers [start, stop, step]")
-            values = list(range(*args))
+            if not all(isinstance(a, int) for a in args) or not 1 <= len(args) <= 3 or (len(args) == 3 and args[2] == 0):
+                raise ConfigError(f"{where}.range = {args!r}: expected 1 to 3 integers [start, stop, step], step != 0")
+            count = len(range(*args))
         else:
             if len(args) != 3 or not isinstance(args[2], int) or args[2] < 1:
                 raise ConfigError(f"{where}.{kind} = {args!r}: expected [start, stop, count] with count >= 1")
-            a, b, n = args
-            step = (b - a) / (n - 1) if n > 1 else 0.0
-            values = [a + i * step for i in range(n)]
-            if kind == "logspace":
-                values = [10.0**v for v in values]
-        if not values:
+            if kind == "logspace" and max(abs(args[0]), abs(args[1])) > 300:
+                raise ConfigError(f"{where}.logspace = {args!r}: exponents must lie in [-300, 300] (float64)")
+            count = args[2]
+        if count == 0:
             raise ConfigError(f"{where} = {spec!r}: gives no values")
-        return values
+        return count
     if isinstance(spec, (int, float, str, bool)):
-        return [spec]
+        return 1
     raise ConfigError(f"{where} = {spec!r}: expected a list, a value, or range/linspace/logspace")
+
+
+def _expand_values(path: Path, key: str, spec) -> list:
+    """A list of values from a list, a scalar, or {range|linspace|logspace = [...]}."""
+    _count(path, key, spec)
+    if isinstance(spec, list):
+        return spec
+    if isinstance(spec, dict):
+        (kind, args), = spec.items()
+        if kind == "range":
+            return list(range(*args))
+        a, b, n = args
+        step = (b - a) / (n - 1) if n > 1 else 0.0
+        values = [a + i * step for i in range(n)]
+        return [10.0**v for v in values] if kind == "logspace" else values
+    return [spec]
 
 
 def format_value(value) -> str:
@@ -126,41 +151,61 @@ def format_value(value) -> str:
     return str(value)
 
 
-def load_sweep(path: str | os.PathLike) -> Sweep:
-    """Read and expand a sweep file (the base config is validated per run later)."""
+def load_sweep(path: str | os.PathLike, *, validate: bool = True) -> Sweep:
+    """Read and expand a sweep file; with ``validate`` every run's config is checked too
+    (:func:`granulargas.io.config.load_config`), so a bad value stops the sweep before any
+    run starts, with one line naming the run and the key."""
     path = Path(path)
     try:
         with open(path, "rb") as fh:
             data = tomllib.load(fh)
     except FileNotFoundError:
         raise InputFileError(f"{path}: sweep file not found") from None
+    except IsADirectoryError:
+        raise InputFileError(f"{path}: is a directory, not a sweep file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputFileError(f"{path}: cannot read sweep file ({exc})") from None
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path}: TOML syntax error: {exc}") from None
     unknown = sorted(set(data) - _TOP_KEYS)
     if unknown:
-        raise ConfigError(f"{path}: unknown key {unknown[0]!r}; allowed: {', '.join(sorted(_TOP_KEYS))}")
-    if not isinstance(data.get("base"), str):
+        close = difflib.get_close_matches(unknown[0], sorted(_TOP_KEYS), n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise ConfigError(f"{path}: unknown key {unknown[0]!r}; allowed: {', '.join(sorted(_TOP_KEYS))}{hint}")
+    if not isinstance(data.get("base"), str) or not data["base"].strip():
         raise ConfigError(f"{path}: key 'base' is required: the path of the base config (string)")
+    for key in ("output_dir", "name"):
+        if key in data and (not isinstance(data[key], str) or not data[key].strip()):
+            raise ConfigError(f"{path}: {key} = {data[key]!r}: must be a non-empty string")
     base = (path.parent / data["base"]).resolve()
     if not base.is_file():
         raise InputFileError(f"{path}: base = {data['base']!r}: no such config file ({base})")
-    out_dir = (path.parent / str(data.get("output_dir", f"runs/{path.stem}"))).resolve()
+    out_name = str(data.get("output_dir", f"runs/{path.stem}"))
+    out_dir = (path.parent / out_name).resolve()
+    if not out_dir.is_dir():  # the sweep makes output_dir itself, never its parents
+        existing_directory(out_dir, f"{path}: output_dir = {out_name!r}")
     mode = data.get("mode", "product")
     if mode not in ("product", "zip"):
         raise ConfigError(f"{path}: mode = {mode!r}; allowed: 'product', 'zip'")
-    fixed = _flatten(data.get("set", {}))
-    vary = _flatten(data.get("vary", {}))
+    fixed = _flatten(path, data.get("set", {}), "set.")
+    fixed = {k[len("set."):]: v for k, v in fixed.items()}
+    vary = _flatten(path, data.get("vary", {}), "vary.")
+    vary = {k[len("vary."):]: v for k, v in vary.items()}
     if not vary:
         raise ConfigError(f"{path}: [vary] is empty: name at least one parameter to vary")
     keys = sorted(vary)
-    value_lists = [_expand_values(path, key, vary[key]) for key in keys]
+    counts = [_count(path, key, vary[key]) for key in keys]
     if mode == "zip":
-        lengths = {len(v) for v in value_lists}
-        if len(lengths) != 1:
-            raise ConfigError(f"{path}: mode = 'zip' needs lists of equal length; got {dict(zip(keys, map(len, value_lists)))}")
-        combos = list(zip(*value_lists))
+        if len(set(counts)) != 1:
+            raise ConfigError(f"{path}: mode = 'zip' needs lists of equal length; got {dict(zip(keys, counts))}")
+        total = counts[0]
     else:
-        combos = list(itertools.product(*value_lists))
+        total = math.prod(counts)
+    if total > MAX_RUNS:
+        raise ConfigError(f"{path}: [vary] gives {total:.3g} runs; at most {MAX_RUNS:.0e} (the list of runs must "
+                          "fit in memory)")
+    value_lists = [_expand_values(path, key, vary[key]) for key in keys]
+    combos = list(zip(*value_lists)) if mode == "zip" else list(itertools.product(*value_lists))
     width = max(3, len(str(len(combos) - 1)))
     runs = []
     for i, combo in enumerate(combos):
@@ -169,6 +214,13 @@ def load_sweep(path: str | os.PathLike) -> Sweep:
         file = str(out_dir / f"{name}.h5")
         overrides = {**fixed, **params, "output.file": file}
         runs.append(RunSpec(name=name, file=file, parameters=params, overrides=overrides))
+    if validate:
+        for spec in runs:
+            try:
+                load_config(base, overrides=spec.overrides)
+            except ConfigError as exc:
+                params = ", ".join(f"{k}={format_value(v)}" for k, v in spec.parameters.items())
+                raise ConfigError(f"{path}: {spec.name} ({params}): {exc}") from None
     return Sweep(path=path, base=base, output_dir=out_dir, runs=tuple(runs))
 
 

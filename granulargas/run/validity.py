@@ -35,6 +35,19 @@ and small distances) is refused: constant eps reaches it after
 ``s = 250 d ln(10) / (1 - eps^2)`` collisions per particle (2400 for eps = 0.5 in
 3D); a viscoelastic gas, whose ``T ~ t^(-5/3)``, never does in practice.
 
+The float64 clock
+-----------------
+Event times are absolute float64 numbers: near time t they are resolved to
+``ulp(t) = t 2^-52``. A particle's events are spaced by the shorter of its mean
+free time ``1/omega(T)`` and the time it takes to cross one diameter
+``sigma / sqrt(T/m)`` (neighbour-list expiries of a dilute gas), both growing as
+the gas cools. A run is refused when, at its predicted end, ``ulp(t_end)`` exceeds
+``CLOCK_RESOLUTION = 1e-6`` of that spacing: events would then be placed at
+times rounded by more than a millionth of their spacing, and further on at the
+same float (zero-time events). For an elastic gas this bounds the run to about
+``1e-6 2^52 = 4.5e9`` mean free times; a cooling gas, whose event spacing grows
+with t, stays resolved much longer.
+
 Centre-of-mass drift
 --------------------
 Zero total momentum holds only to round-off: the centre-of-mass velocity stays
@@ -104,6 +117,8 @@ UNDERFLOW_T = 1e-250
 #: warn when the predicted T_end / T0 falls below this: the centre-of-mass velocity left by
 #: round-off (~1e-16 of the initial thermal speed) then overtakes the thermal speed
 DRIFT_T_RATIO = 1e-30
+#: the float64 clock must resolve this fraction of the time between a particle's events
+CLOCK_RESOLUTION = 1e-6
 #: beta above which the viscoelastic force is questionable (contact.material.BETA_VALID_MAX)
 BETA_VALID = 1.0
 
@@ -255,7 +270,30 @@ def check_run(config) -> RunValidity:
             f"{src}: {key}: the gas would cool to T ~ 1e{ln_T_end / math.log(10):.0f} (T0 = {gas.temperature:g}), below "
             f"{UNDERFLOW_T:g}, where squared velocities underflow float64; shorten the run or rescale it "
             "(restart with [initial] temperature)")
+    else:
+        clock = _clock_error(gas, float(t_end), ln_T_end, key)
+        if clock:
+            rv.errors.append(clock)
     return rv
+
+
+def _clock_error(gas, t_end: float, ln_T_end: float, key: str) -> str | None:
+    """The float64-clock check of the module docstring (None when the run is resolved)."""
+    if not (t_end > 0 and math.isfinite(t_end)):
+        return None
+    # logarithms throughout: T_end may be far below T0
+    ln_free = -math.log(gas.collision_frequency) + 0.5 * (math.log(gas.temperature) - ln_T_end)
+    ln_cross = math.log(gas.sigma) - 0.5 * (ln_T_end - math.log(gas.mass))
+    ln_spacing = min(ln_free, ln_cross)
+    ln_ulp = math.log(t_end) - 52.0 * math.log(2.0)
+    if ln_ulp <= math.log(CLOCK_RESOLUTION) + ln_spacing:
+        return None
+    limit = math.exp(math.log(CLOCK_RESOLUTION) + ln_spacing + 52.0 * math.log(2.0))
+    value = gas.end_time if key == "run.end_time" else gas.collisions_per_particle
+    return (f"{gas.source}: {key} = {value:g}: at t = {t_end:.3g} the float64 clock resolves {math.exp(ln_ulp):.3g}, "
+            f"more than {CLOCK_RESOLUTION:g} of the time between a particle's events "
+            f"({math.exp(ln_spacing):.3g} at the predicted T = {math.exp(ln_T_end):.3g}); the run can reach about "
+            f"t = {limit:.3g}")
 
 
 def summary_lines(config) -> list[str]:

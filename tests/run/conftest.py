@@ -29,6 +29,7 @@ def write_config(tmp_path):
 
     def make(text=SMALL_3D, name="c.toml", out=None):
         out = out or str(tmp_path / "runs" / "out.h5")
+        (tmp_path / "runs").mkdir(exist_ok=True)  # the runner never creates output directories
         p = tmp_path / name
         p.write_text(text.replace("{out}", out))
         return p

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from granulargas.cli import main
-from granulargas.errors import ConfigError
+from granulargas.errors import ConfigError, InputFileError
 from granulargas.run.sweep import load_sweep, make_executor, read_index, run_sweep
 
 BASE = """\
@@ -110,12 +110,32 @@ def test_local_pool_skips_done_and_redoes_broken(tmp_path):
 
 
 def test_failed_run_is_reported_and_others_go_on(tmp_path):
-    path = write_sweep(tmp_path, "collision.restitution = [0.9, 1.5]")
+    # 4 particles: a valid config whose box is too small for the engine (found when the run starts)
+    path = write_sweep(tmp_path, "system.particles = [64, 2]")
     with ThreadPoolExecutor(1) as pool:
         entries = run_sweep(load_sweep(path), pool, log=lambda *a: None)
     assert entries[0]["status"] == "done"
     assert entries[1]["status"] == "failed"
-    assert "restitution" in entries[1]["error"]
+    assert "system.particles = 2" in entries[1]["error"]
+
+
+def test_every_run_config_is_validated_before_any_run(tmp_path, capsys):
+    path = write_sweep(tmp_path, "collision.restitution = [0.9, 1.5]")
+    with pytest.raises(ConfigError, match=r"run_001 \(collision.restitution=1.5\): override: collision.restitution = "
+                                          r"1.5: must be a number in \(0, 1\]"):
+        load_sweep(path)
+    assert main(["sweep", str(path), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "run_001" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_output_directory_parent_must_exist(tmp_path):
+    path = write_sweep(tmp_path, "system.seed = [1]").read_text().replace('output_dir = "out"', 'output_dir = "no/out"')
+    (tmp_path / "s2.toml").write_text(path)
+    with pytest.raises(InputFileError, match="directory .*no does not exist"):
+        load_sweep(tmp_path / "s2.toml")
+    assert not (tmp_path / "no").exists()
 
 
 def test_cli_exit_codes(tmp_path, capsys):
