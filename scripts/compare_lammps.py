@@ -185,10 +185,10 @@ def plot_cooling(path, config, t_ed, T_ed, ed_wall, dem, tau0, spread=None):
     plt = _plt()
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.3))
     s = config.system
-    ax.loglog(t_ed[1:], T_ed[1:], "-", color="C0", lw=2.5, label=f"granulargas (event-driven), {ed_wall:.3g} s")
+    ax.loglog(t_ed[1:], T_ed[1:], "-", color="C0", lw=2.5, label="granulargas (event-driven)")
     styles = ["--", ":", "-."]
     for (f, ex, th, wall), ls, c in zip(dem, styles, ["C3", "C2", "C4"]):
-        lab = f"LAMMPS, $t_c$ = {f:g} $t_{{free}}$ (Y = {ex.contact.young_modulus:.2g}), {wall:.3g} s"
+        lab = f"LAMMPS, $t_c$ = {f:g} $t_{{free}}$ (Y = {ex.contact.young_modulus:.2g})"
         ax.loglog(th["Time"][1:], th["c_granT"][1:], ls, color=c, lw=1.8, label=lab)
         T_l = np.interp(t_ed, th["Time"], th["c_granT"])
         ax2.plot(t_ed, (T_l / T_ed - 1.0) * 100, ls, color=c,
@@ -261,9 +261,13 @@ def head_on(args):
     ax.set_ylabel(r"coefficient of restitution $\varepsilon$")
     ax.set_title("two spheres head-on: LAMMPS hertz/material + viscoelastic", fontsize=10)
     ax.legend(fontsize=8)
+    # colour = end of contact, as in the left panel; line style and marker = beta
+    # (markers other than the left panel's, which mark the end there)
+    colour = {"force": "C3", "overlap": "C0"}
+    style = {0.1: ("--", "^", "none"), 1.0: ("-", "D", None)}
     for (beta, end), err in conv.items():
-        ls = "-" if end == "force" else "--"
-        ax2.loglog(steps, np.maximum(err, 1e-12), ls, marker="o", ms=4,
+        ls, mk, mfc = style[beta]
+        ax2.loglog(steps, np.maximum(err, 1e-12), ls, marker=mk, ms=5, color=colour[end], mfc=mfc,
                    label=fr"$\beta$ = {beta:g}, '{end}' end")
     ax2.loglog(steps, 0.05 / steps, "k:", lw=1, label="first order ($\\propto \\Delta t$)")
     ax2.set_xlabel(r"steps per contact $t_c/\Delta t$")
