@@ -62,6 +62,20 @@ def smoothing_length(info: RunInfo, particles: float = 200.0) -> float:
     return (particles / ((2.0 * math.pi) ** 1.5 * n)) ** (1.0 / 3.0)
 
 
+def vorticity_noise(info: RunInfo, ell: float) -> float:
+    """RMS vorticity (in sqrt(T)/sigma) that thermal noise alone gives after the smoothing.
+
+    For uncorrelated particles with velocity variance T/m per component at number
+    density n, the Gaussian-smoothed velocity has the noise spectrum
+    (T/m)/n |K(k)|^2, K = exp(-k^2 ell^2 / 2); integrating k^2 |K|^2 over the
+    wavevectors gives <w^2> = (T/m) / (4 pi n ell^4) in 2D and
+    (T/m) / (8 pi^(3/2) n ell^5) in 3D (before the z average)."""
+    n = info.particles / float(np.prod(info.box))
+    if info.dimension == 2:
+        return 1.0 / math.sqrt(4.0 * math.pi * n * ell**4 * info.mass)
+    return 1.0 / math.sqrt(8.0 * math.pi**1.5 * n * ell**5 * info.mass)
+
+
 def smoothed_vorticity(pos, vel, masses, box, info: RunInfo):
     """Vorticity of the mass-weighted velocity field smoothed by a Gaussian.
 
@@ -156,8 +170,8 @@ def figure_snapshot(snap, info, cells, k_max, path, theory_law):
     im = ax[2].imshow(w.T, origin="lower", extent=(0, box[0], 0, box[1]), cmap=cmap, vmin=-wmax, vmax=wmax)
     fig.colorbar(im, ax=ax[2], fraction=0.046,
                  label="vorticity" + (" $\\omega_z$" if info.dimension == 3 else "") + " [$\\sqrt{T}/\\sigma$]")
-    ax[2].set_title(f"vorticity of the flow smoothed over {ell:.3g} $\\sigma$\n(grey: below 5 % of the mean density)",
-                    fontsize=9)
+    ax[2].set_title(f"vorticity of the flow smoothed over {ell:.3g} $\\sigma$ (thermal noise alone:\n"
+                    f"rms {vorticity_noise(info, ell):.2g}; grey: below 5 % of the mean density)", fontsize=9)
     for a in ax[:3]:
         a.set_aspect("equal")
         a.set(xlim=(0, box[0]), ylim=(0, box[1]))

@@ -9,6 +9,9 @@ Markdown, so that the text cannot drift from the code it describes:
 ``<!-- generated: cli-reference -->``
     The ``--help`` text of every command (:func:`cli_reference_markdown`).
 
+The docstrings use Sphinx roles (``:func:`name```), which mkdocstrings shows
+verbatim; :func:`on_page_content` drops the role prefix and keeps the code span.
+
 Where the configuration reference comes from
 --------------------------------------------
 :func:`config_entries` returns one :class:`ConfigKey` per key. If
@@ -336,3 +339,10 @@ def on_page_markdown(markdown, page, config, files):  # noqa: ARG001 (MkDocs hoo
     if CLI_MARKER in markdown:
         markdown = markdown.replace(CLI_MARKER, cli_reference_markdown())
     return markdown
+
+
+_ROLE = re.compile(r":(?:func|class|mod|meth|data|attr|exc|obj):(?=<code>)")
+
+
+def on_page_content(html, page, config, files):  # noqa: ARG001 (MkDocs hook signature)
+    return _ROLE.sub("", html)
