@@ -26,7 +26,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from granulargas.contact import material, ode, restitution, seed_route
+from granulargas.contact import material, ode, perturbation, restitution
 from granulargas.contact.pade import C1, C2
 
 # Fig. 3 material: soft (rubber-like) spheres; g <= 5 m/s keeps the Mach number (c = 95 m/s) below 0.1
@@ -36,7 +36,7 @@ YOUNG, POISSON, A, RADIUS, DENSITY = 1.0e7, 0.45, 3.0e-5, 0.01, 1100.0
 def fig1(beta, out):
     t_d, x_d, _ = ode.trajectory(beta, "overlap", n=600)
     t_e, x_e, _ = ode.trajectory(0.0, "overlap", n=600)
-    sol, t_half = seed_route.perturbation_solution(None)
+    sol, t_half = perturbation.perturbation_solution(None)
     tt = np.linspace(1e-3, t_half, 300)
     x0, _, x1, _, x2, _ = sol(tt)
     x_force = ode.trajectory(beta, "force", n=600)
