@@ -297,12 +297,12 @@ class Key:
             text = "; ".join(f"{d}D: {self.range_text(d)}" for d in sorted(self.high_by_dimension, reverse=True))
         else:
             text = self.range_text()
-        if self.key == "diameter" and self.section == "particles":
-            text += ", or a table { min, max } (below)"
-        if self.required_in_table:
-            text += "; required in the table"
         if self.reason:
             text += f" ({self.reason})"
+        if self.key == "diameter" and self.section == "particles":
+            text += "; or a table { min, max } (below)"
+        if self.required_in_table:
+            text += "; required in the table"
         if self.run_check:
             text += f"; when the run starts: {self.run_check}"
         return text
@@ -365,7 +365,7 @@ SCHEMA: tuple[Key, ...] = (
     Key("particles", "density", "number",
         "Instead of `mass`: mass = density × π d³/6 (3D) or π d²/4 (2D); the masses it gives must "
         "lie in the range of `mass`.", unit="reference mass per reference volume",
-        low=0.0, low_open=True, high=SCALE_RANGE[1] / 1e-50, reason="the masses it gives are checked like `mass`"),
+        low=0.0, low_open=True, high=1e250, reason="finite; the masses it gives are checked like `mass`"),
     # [initial]
     Key("initial", "temperature", "number",
         "Maxwell–Boltzmann velocities with zero total momentum and exactly this temperature "
@@ -474,16 +474,34 @@ def config_schema() -> tuple[Key, ...]:
 # --------------------------------------------------------------------------- values and errors
 
 
+def quote(text: str) -> str:
+    """A string as a TOML basic string, control and line-break characters escaped, so that
+    an error message naming it stays on one line."""
+    out = []
+    for ch in str(text):
+        if ch in '"\\':
+            out.append("\\" + ch)
+        elif ch.isprintable() and ch not in "\x1c\x1d\x1e\x85\u2028\u2029":
+            out.append(ch)
+        else:
+            code = ord(ch)
+            out.append(f"\\u{code:04X}" if code <= 0xFFFF else f"\\U{code:08X}")
+    return '"' + "".join(out) + '"'
+
+
 def _show(value: Any) -> str:
     if isinstance(value, str):
-        return f'"{value}"'
+        return quote(value)
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, dict):
         return "{ " + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + " }"
     if isinstance(value, list):
         return "[" + ", ".join(_show(v) for v in value) + "]"
-    return repr(value) if not isinstance(value, float) else f"{value:g}"
+    if isinstance(value, float):
+        short = f"{value:g}"
+        return short if math.isnan(value) or float(short) == value else repr(value)
+    return repr(value)
 
 
 class Values:
@@ -515,19 +533,19 @@ class Values:
         return dotted in self.given
 
 
-def _check_type(key: Key, v: Any, values: Values):
+def _check_type(key: Key, v: Any, values: Values, dimension: int):
     """The value converted to its type (int for integers, float for numbers) or a ConfigError."""
     d = key.dotted
     if key.type == "integer":
         if isinstance(v, float) and v.is_integer() and abs(v) < 2**53:
             v = int(v)
         if isinstance(v, bool) or not isinstance(v, int):
-            values.fail(d, f"must be {key.range_text() if key.choices is None else 'an integer: ' + key.range_text()}")
+            values.fail(d, f"must be {key.range_text(dimension) if key.choices is None else 'an integer: ' + key.range_text()}")
         return v
     if key.type in ("number", "number or table"):
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             extra = " or { min = ..., max = ... }" if key.type == "number or table" else ""
-            values.fail(d, f"must be {key.range_text()}{extra}")
+            values.fail(d, f"must be {key.range_text(dimension)}{extra}")
         return float(v)
     if key.type == "string":
         if not isinstance(v, str):
@@ -854,7 +872,7 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
             continue
         values.raw[dotted] = raw
         values.given.add(dotted)
-        v = _check_type(key, raw, values)
+        v = _check_type(key, raw, values, dimension)
         _check_range(key, v, values, dimension)
         if dotted == "system.dimension":
             dimension = v

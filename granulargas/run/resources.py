@@ -153,19 +153,24 @@ def check_memory(config: RunConfig, *, n: int | None = None, packing: float | No
     est = run_memory(n, s.dimension, packing, _volume_ratio(config), fresh=fresh)
     cells = max(est["engine_cells"], est["placement_cells"])
     src = config.source
-    if cells > MAX_CELLS:
-        raise ConfigError(
-            f"{src}: system.packing_fraction = {s.packing_fraction:g}: too dilute for {n} particles: the "
-            f"engine's cell grid would need {cells:.3g} cells (one per ~2 diameters of box edge; cell ids are "
-            f"int32, at most 2^31 - 1); use a higher packing_fraction or more particles")
     if available is None:
         available = available_memory()
+    grid = est["engine_cells"] * ENGINE_BYTES_PER_CELL
+    dilute = cells > 64.0 * n  # the grid, not the particles, is what is too large
+    if cells > MAX_CELLS and dilute:
+        raise ConfigError(
+            f"{src}: system.packing_fraction = {packing:g}: too dilute for {n} particles: the engine's cell "
+            f"grid would need {cells:.3g} cells (one per ~2 diameters of box edge; cell ids are int32, at most "
+            "2^31 - 1); use a higher packing_fraction or more particles")
     if available is not None and est["total"] > available:
-        grid = est["engine_cells"] * ENGINE_BYTES_PER_CELL
-        key, value = ("system.packing_fraction", f"{s.packing_fraction:g}") if grid > 0.5 * est["total"] else (
+        key, value = ("system.packing_fraction", f"{packing:g}") if grid > 0.5 * est["total"] else (
             "system.particles", str(n))
         raise ConfigError(
             f"{src}: {key} = {value}: the run needs about {format_bytes(est['total'])} of memory "
             f"({format_bytes(est['total'] / n)} per particle, of which the cell grid {format_bytes(grid)}), "
             f"{format_bytes(available)} are available")
+    if cells > MAX_CELLS:
+        raise ConfigError(
+            f"{src}: system.particles = {n}: the engine's cell grid would need {cells:.3g} cells (cell ids are "
+            "int32, at most 2^31 - 1); use fewer particles")
     return est

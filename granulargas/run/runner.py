@@ -361,7 +361,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
 
     start_key = st.time if schedule.clock == "time" else st.collisions
     keep = schedule.targets > start_key
-    targets, is_snap = schedule.targets[keep], schedule.snapshot[keep]
+    targets, is_snap, is_sample = schedule.targets[keep], schedule.snapshot[keep], schedule.sample[keep]
     budget = None
     if config.run.collisions_per_particle is not None:
         budget = collision_budget(config)
@@ -400,10 +400,13 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         if callback is not None:
             callback(sim_)
 
+    frame = [(st.events, st.time)]  # (step, time) of the file's last frame
+
     def snapshot():
         sim.synchronise()
         lc = np.asarray(sim.last_collision) if tc else None
         writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc)
+        frame[0] = (sim.events, sim.time)
 
     wall0 = _time.perf_counter()
     c0 = sim.collisions
@@ -412,7 +415,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         if not append:  # a continued file already holds the starting frame and its sample
             writer.write_observables(sim.events, sim.time, _observables(sim, False), flush=False)
             snapshot()
-        for target, snap in zip(targets, is_snap):
+        last_sample = (sim.events, sim.time)
+        for target, snap, sample in zip(targets, is_snap, is_sample):
             if stop:
                 raise _Stop
             if schedule.clock == "time":
@@ -422,7 +426,10 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
             else:
                 sim.run(until=math.inf, max_collisions=int(target) - sim.collisions, progress=between_chunks)
                 hit_budget = False
+            if not (sample or hit_budget):
+                continue  # an engine pacing stop (run.schedule.pacing_stops): no output
             writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
+            last_sample = (sim.events, sim.time)
             if snap or hit_budget:
                 snapshot()
             if callback is not None:
@@ -434,9 +441,11 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         # the state at the last chunk boundary: every event up to sim.time is processed
         name = signal.Signals(stop.signum).name
         try:
-            writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
-            snapshot()
-            writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
+            if (sim.events, sim.time) != last_sample:  # the stop may fall right after a sample
+                writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
+            if (sim.events, sim.time) != frame[0]:  # ... or right after a scheduled frame
+                snapshot()
+                writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
             writer.set_parameters({"summary": {"stop_reason": f"interrupted by {name}", "time": float(sim.time),
                                                "collisions": int(sim.collisions), "events": int(sim.events)}})
         finally:

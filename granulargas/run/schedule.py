@@ -31,11 +31,17 @@ SCHEDULE_BYTES_PER_TARGET = 64.0
 class Schedule:
     """Output targets. ``clock`` is "time" or "collisions" (targets are then
     total collision counts); ``snapshot[k]`` tells whether target k is also a
-    snapshot (every target samples the observables)."""
+    snapshot; ``sample[k]`` whether the observables are sampled there (False for
+    the engine's pacing stops, :func:`pacing_stops`)."""
 
     clock: str
     targets: np.ndarray
     snapshot: np.ndarray
+    sample: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.sample is None:
+            object.__setattr__(self, "sample", np.ones(len(self.targets), dtype=bool))
 
 
 def mean_free_time(config: RunConfig) -> float:
@@ -96,10 +102,30 @@ def output_schedule(config: RunConfig) -> Schedule:
             snaps = np.unique(np.geomspace(n, total, nsnap - 1).round().astype(np.int64))
         obs = np.unique(np.linspace(0, total, DEFAULT_OBSERVABLE_SAMPLES + 1).round().astype(np.int64)[1:])
         clock = "collisions"
-    targets = np.union1d(snaps, obs)
+    outputs = np.union1d(snaps, obs)
+    targets = np.union1d(outputs, pacing_stops(config)) if clock == "time" else outputs
     targets = targets[targets > 0]
     snapshot = np.isin(targets, snaps)
-    return Schedule(clock, targets, snapshot)
+    sample = np.isin(targets, outputs)
+    return Schedule(clock, targets, snapshot, sample)
+
+
+def pacing_stops(config: RunConfig) -> np.ndarray:
+    """Times t_free 2^k (k = 0, 1, ...) below ``run.end_time``, t_free the Enskog mean free
+    time at T0: the engine stops there without output.
+
+    At the start of each ``run`` call the engine matches its event calendar to the
+    current event rate; a gas cooling by many orders of magnitude within one call (Haff
+    cooling over 1e20 mean free times) would leave the calendar's window far too
+    narrow, and its scan for the next event would stall the compiled loop. Between
+    stops a factor 2 apart in time, a cooling gas's event rate changes by a factor 4
+    at most. The stops depend on the config only (never on the start time), so a
+    restart makes the same calls as the uninterrupted run."""
+    first, end = mean_free_time(config), config.run.end_time
+    if not (first > 0 and math.isfinite(first)) or end is None or first >= end:
+        return np.empty(0)
+    count = int(math.floor(math.log2(end / first))) + 1
+    return first * np.exp2(np.arange(count))
 
 
 def output_counts(config: RunConfig) -> tuple[float, float]:

@@ -157,13 +157,24 @@ def mutated_config(draw, bases=tuple(BASES)):
     name = draw(st.sampled_from(bases))
     doc = copy.deepcopy(BASES[name])
     overrides, done = [], []
+    # half of the examples change values only within what the schema allows (legal runs of
+    # other sizes, rules and models); the others also break things
+    legal = draw(st.booleans())
     for _ in range(draw(st.sampled_from([1, 1, 1, 2, 3]))):
         paths = _paths(doc)
-        kind = draw(st.sampled_from(["extreme", "extreme", "extreme", "extreme", "set", "set", "scale", "scale",
-                                     "drop", "unknown-key", "drop-section", "unknown-section"]))
+        kind = "plausible" if legal else draw(st.sampled_from(
+            ["extreme", "extreme", "extreme", "extreme", "plausible", "set", "set", "scale", "scale", "drop",
+             "unknown-key", "drop-section", "unknown-section"]))
+        if kind == "plausible":
+            m = _plausible(draw, doc, paths)
+            if m is None:
+                continue
+            kind = "done"
         if kind in ("set", "scale", "drop", "extreme") and not paths:
             kind = "unknown-section"
-        if kind == "extreme":
+        if kind == "done":
+            pass
+        elif kind == "extreme":
             numeric = [p for p in paths if isinstance(_get(doc, p), (int, float)) and not isinstance(_get(doc, p), bool)]
             if not numeric:
                 continue
@@ -203,6 +214,39 @@ def mutated_config(draw, bases=tuple(BASES)):
             _apply(doc, m)
         done.append(m)
     return MutatedConfig(name, doc, overrides, done)
+
+
+def _plausible(draw, doc, paths):
+    """A value the schema allows for one of the document's keys, or another allowed choice
+    (legal runs of the same size: counts up to 400, values within a factor 1000)."""
+    try:
+        from granulargas.io.config import config_schema
+    except ImportError:
+        return None
+    keys = {tuple(k.dotted.split(".")): k for k in config_schema()}
+    known = [p for p in paths if p in keys and keys[p].type != "table"]
+    if not known:
+        return None
+    path = draw(st.sampled_from(known))
+    key, old = keys[path], _get(doc, path)
+    if key.choices is not None:
+        return Mutation("set", path, draw(st.sampled_from(list(key.choices))))
+    if key.type == "string" or isinstance(old, (dict, str, bool)) or not isinstance(old, (int, float)):
+        return None
+    low = key.low if key.low is not None else -1e300
+    high = min(x for x in (key.high, *(key.high_by_dimension or {}).values(), 1e300) if x is not None)
+    if key.type == "integer":
+        top = {"particles": 400, "snapshots": 50}.get(key.key, 2**31)
+        return Mutation("set", path, draw(st.integers(int(max(low, 0)), int(min(high, top)))))
+    a = max(low, abs(old) / 1000.0) if old else max(low, 1e-3)
+    b = min(high, abs(old) * 1000.0) if old else min(high, 1e3)
+    if not a < b:
+        return None
+    x = math.exp(draw(st.floats(math.log(max(a, 1e-300)), math.log(b))))
+    x = min(max(x, a), b)
+    if (key.low_open and x <= key.low) or (key.high_open and x >= high):
+        return None
+    return Mutation("set", path, x)
 
 
 def _get(doc, path):
@@ -320,6 +364,11 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
     the SIGINT is a hang: faulthandler dumps the stacks and ends the test process.
     """
     start = time.perf_counter()
+    trace = os.environ.get("GRANULARGAS_FUZZ_TRACE")  # a file: every example is appended before it runs
+    if trace:
+        with open(trace, "a") as fh:
+            texts = {p.name: p.read_text(errors="replace") for p in Path(cwd).glob("*.toml")}
+            fh.write(f"=== {argv}\n" + "".join(f"--- {k}\n{v}" for k, v in texts.items()))
     if subprocess_run:
         proc = subprocess.Popen([sys.executable, "-m", "granulargas", *argv], cwd=cwd, stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True, env=env)
@@ -371,6 +420,9 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
         faulthandler.cancel_dump_traceback_later()
         os.chdir(old)
         timer.join()
+    if trace:
+        with open(trace, "a") as fh:
+            fh.write(f"--> exit {code} ({time.perf_counter() - start:.2f} s) {err.getvalue().strip()[:200]}\n")
     return Outcome(code, out.getvalue(), err.getvalue(), time.perf_counter() - start, fired.is_set(), exc)
 
 
