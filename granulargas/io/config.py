@@ -489,7 +489,13 @@ def quote(text: str) -> str:
     return '"' + "".join(out) + '"'
 
 
+class _Shown(str):
+    """A value shown in a message as it is (e.g. ``{...}`` for a table)."""
+
+
 def _show(value: Any) -> str:
+    if isinstance(value, _Shown):
+        return str(value)
     if isinstance(value, str):
         return quote(value)
     if isinstance(value, bool):
@@ -605,7 +611,7 @@ def _only_with(dotted: str, models: tuple[str, ...]) -> Rule:
 
     def check(v: Values):
         if v.has(dotted) and v.get("collision.model") not in models:
-            value = "{...}" if dotted == "collision.material" else ...
+            value = _Shown("{...}") if dotted == "collision.material" else ...
             v.fail(dotted, f"is only used with model = {shown} (model = \"{v.get('collision.model')}\")", value)
 
     key = dotted.split(".", 1)[1]
@@ -615,7 +621,7 @@ def _only_with(dotted: str, models: tuple[str, ...]) -> Rule:
 def _exclusive(a: str, b: str, why: str = "") -> Rule:
     def check(v: Values):
         if v.has(a) and v.has(b):
-            value = "{...}" if b == "collision.material" else ...
+            value = _Shown("{...}") if b == "collision.material" else ...
             v.fail(b, f"give either {a.split('.')[-1]} or {b.split('.')[-1]}, not both{why}", value)
 
     return Rule(f"`{a}` and `{b}` exclude each other.", check)

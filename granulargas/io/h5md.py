@@ -42,9 +42,9 @@ Continuing a run into the same file (:meth:`H5MDWriter.append`): the file is
 opened for writing, cut back to the state the continuation starts from (its last
 complete frame and the observables sample at that frame: a run killed after it
 may have written a few samples more) and its datasets are extended; every time
-stays absolute. A frame written when a run was stopped by a signal (off the
-output schedule) is listed in ``parameters/interrupted_frames``
-(:func:`interrupted_frames`).
+stays absolute. The frame at which a signal stopped a run (the state reached,
+written off the output schedule unless the stop fell on a scheduled frame) is
+listed in ``parameters/interrupted_frames`` (:func:`interrupted_frames`).
 
 The readers (:func:`read_observables`, :func:`iter_snapshots`,
 :func:`load_snapshot`, :func:`read_parameters`) read one frame at a time. A file
@@ -169,14 +169,16 @@ class H5MDWriter:
         return self
 
     def mark_interrupted(self, reason: str):
-        """Record the last frame as written off the schedule, when a signal stopped the run."""
+        """Record the last frame as the state at which a signal stopped the run (written off the
+        schedule, unless the stop fell on a scheduled frame)."""
         g = self.file["parameters"]
         old = list(g["interrupted_frames"][()]) if "interrupted_frames" in g else []
         if "interrupted_frames" in g:
             del g["interrupted_frames"]
         g.create_dataset("interrupted_frames", data=np.asarray(old + [self.frames - 1], dtype=np.int64))
         g["interrupted_frames"].attrs["description"] = (
-            "frames written when a signal stopped the run (the state reached, off the output schedule)")
+            "frames at which a signal stopped the run (the state reached; off the output schedule unless "
+            "the stop fell on a scheduled frame)")
         g["interrupted_frames"].attrs["last_reason"] = reason
         self.file.flush()
 
@@ -416,11 +418,15 @@ def open_run(path, mode="r") -> h5py.File:
     try:
         f = h5py.File(path, mode)
     except OSError as exc:
-        if "lock" not in str(exc) or mode != "r":
+        text = str(exc).lower()
+        locked = "unable to lock file" in text
+        if not locked or mode != "r":
             why = _short(exc)
-            if "truncated" in str(exc).lower():
-                raise InputFileError(f"{path}: truncated HDF5 file ({why}): the file was cut short") from None
-            if "lock" in str(exc):
+            if "truncated file" in text:
+                m = re.search(r"eof = (\d+).*stored_eof = (\d+)", text)
+                size = f": {m.group(1)} of its {m.group(2)} bytes" if m else f" ({why})"
+                raise InputFileError(f"{path}: truncated HDF5 file{size} (the file was cut short)") from None
+            if locked:
                 raise InputFileError(f"{path}: locked by a running simulation; wait until it has finished") from None
             raise InputFileError(f"{path}: not an HDF5 file or unreadable ({why})") from None
         # a running simulation holds the HDF5 lock; it flushes after every snapshot,
@@ -475,6 +481,10 @@ def _check_layout(f, path):
             want = "(particles,)" if tail is None else "(frames" + "".join(f", {x}" for x in tail) + ")"
             raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} has shape {shape}, "
                                  f"expected {want} with {n} particles in {d}D")
+    for name in _REQUIRED:
+        if part[name].dtype.kind not in "fiu":
+            raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} holds {part[name].dtype} "
+                                 "values, not numbers")
     if "last_collision" in part:
         lc = part.get("last_collision/value")
         if not isinstance(lc, h5py.Dataset) or lc.shape[1:] != (n,):
@@ -563,7 +573,7 @@ def load_snapshot(path, index: int = -1) -> Snapshot:
 
 
 def interrupted_frames(path) -> list[int]:
-    """Indices of the frames written when a signal stopped the run (off the schedule)."""
+    """Indices of the frames at which a signal stopped the run (:meth:`H5MDWriter.mark_interrupted`)."""
     with open_run(path) as f, _damaged(path, "parameters/interrupted_frames"):
         g = f["parameters"]
         return [int(k) for k in g["interrupted_frames"][()]] if "interrupted_frames" in g else []
@@ -579,6 +589,9 @@ def read_observables(path) -> dict:
                 for part in ("step", "time", "value"):
                     if not isinstance(g.get(part), h5py.Dataset):
                         raise InputFileError(f"{path}: damaged H5MD file: observables/{name}/{part} is missing")
+                if any(g[p].dtype.kind not in "fiu" for p in ("step", "time", "value")):
+                    raise InputFileError(f"{path}: damaged H5MD file: observables/{name} holds values that are "
+                                         "not numbers")
                 if g["step"].ndim != 1 or g["time"].ndim != 1 or g["value"].ndim < 1:
                     raise InputFileError(f"{path}: damaged H5MD file: observables/{name} has step/time/value "
                                          f"of shapes {g['step'].shape}, {g['time'].shape}, {g['value'].shape}")

@@ -258,13 +258,14 @@ def check_same_physics(config: RunConfig, path: Path) -> None:
     """A run continued into its own file (``--append``) keeps the physics of the file's
     config (``parameters/config``): same system (except the seed), particles and
     collision rule; one line naming the first key that differs."""
+    stored = read_parameters(path).get("config")  # InputFileError names what is wrong with the file
     try:
-        stored = read_parameters(path).get("config")
         old = parse_config(stored, source=str(path)) if isinstance(stored, str) else None
-    except (InputFileError, ConfigError):
+    except ConfigError:
         old = None
     if old is None:
-        raise InputFileError(f"{path}: parameters/config is missing or unreadable; --append needs the file's config")
+        raise InputFileError(f"{path}: parameters/config is missing or not a valid config; --append needs the "
+                             "file's config")
     for section in _SAME_PHYSICS:
         new_s, old_s = getattr(config, section), getattr(old, section)
         for f in fields(new_s):
@@ -445,7 +446,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
                 writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
             if (sim.events, sim.time) != frame[0]:  # ... or right after a scheduled frame
                 snapshot()
-                writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
+            writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
             writer.set_parameters({"summary": {"stop_reason": f"interrupted by {name}", "time": float(sim.time),
                                                "collisions": int(sim.collisions), "events": int(sim.events)}})
         finally:

@@ -179,6 +179,6 @@ def check_output_size(config: RunConfig, n: int | None = None, *, available: flo
             free_disk = None
     if free_disk is not None and file_bytes > free_disk:
         raise ConfigError(f"{src}: {key} = {value!r}: the output file would need about {format_bytes(file_bytes)} "
-                          f"({snaps:.3g} snapshots of {format_bytes(frame)}), the disk holding "
+                          f"({snaps:.6g} snapshots of {format_bytes(frame)}), the disk holding "
                           f"{Path(out.file).parent or Path('.')} has {format_bytes(free_disk)} free")
     return schedule, file_bytes
