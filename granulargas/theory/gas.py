@@ -47,6 +47,20 @@ The Maxwellian average ``(1 - eps^2)_eff(T) = <(1 - eps^2) g^3> / <g^3>`` over t
 collision kernel (:func:`effective_inelasticity`, the same quadrature at a2 = 0)
 sets the constant eps equivalent to the viscoelastic gas at temperature T.
 
+Pressure
+--------
+A collision transfers the momentum ``m_eff (1 + eps) g_n`` across the distance sigma,
+so the collisional part of the pressure carries ``(1 + eps)/2`` averaged with the
+weight ``Theta(c_n) c_n^2`` of the normal impact speeds (Enskog's collisional
+transfer; for eps = 1 the virial theorem's ``Z = 1 + 2^(d-1) eta chi``):
+
+    Z = P / (n T) = 1 + 2^(d-1) eta chi <(1 + eps)/2>,                           (G4)
+
+:func:`pressure_factor` is the average, with the same quadrature and a2 weight as
+the moments; for constant eps it is ``(1 + eps)/2`` whatever a2 (the second
+moment of the relative velocity does not depend on a2), the Enskog pressure of
+the homogeneous cooling state ``1 + 2^(d-2)(1 + eps) eta chi``.
+
 Shear instability
 -----------------
 :meth:`Gas.instability_length` is the box length above which the homogeneous
@@ -87,6 +101,8 @@ __all__ = [
     "effective_inelasticity",
     "restitution_at_nodes",
     "cooling_rates",
+    "pressure_factor",
+    "compressibility_factor",
     "cooling_curve",
     "viscoelastic_cooling",
     "predicted_end",
@@ -312,6 +328,27 @@ def cooling_rates(gas: Gas, temperature, a2, restitution=None, table=None):
     da2 = 4.0 / d * scale * source
     omega = scale * (nu[..., 0] + a * nu[..., 1])
     return zeta, da2, omega
+
+
+def pressure_factor(gas: Gas, temperature, a2=0.0, restitution=None):
+    """``<(1 + eps)/2>`` of eq. (G4) at temperature T and Sonine coefficient a2.
+
+    Returns
+    -------
+    float or array (K,)
+    """
+    q = speed_quadrature(gas.dimension)
+    eps = restitution_at_nodes(gas, temperature, restitution)
+    a = np.asarray(a2, dtype=float)[..., None]
+    w = (q.nu[:, 0] + a * q.nu[:, 1]) * q.u  # Theta(c_n) c_n^2 with the a2 weight
+    out = (w * 0.5 * (1.0 + eps)).sum(-1) / w.sum(-1)
+    return out if np.ndim(out) else float(out)
+
+
+def compressibility_factor(gas: Gas, temperature, a2=0.0, restitution=None):
+    """``Z = P / (n T)`` of the gas, eq. (G4)."""
+    d = gas.dimension
+    return 1.0 + 2.0 ** (d - 1) * gas.packing_fraction * gas.chi * pressure_factor(gas, temperature, a2, restitution)
 
 
 @dataclass(frozen=True)
