@@ -29,7 +29,7 @@ over the run, plus the inelastic-collapse risk.
 The prediction is the kinetic theory of :mod:`granulargas.theory.gas`: a homogeneous
 gas whose temperature and second Sonine coefficient a2 evolve together (moment
 equations with the exact eps(g)); it is checked against real runs in
-``scripts/rule_choice.py`` (README, "Speed against accuracy").
+``scripts/rule_choice.py`` (docs/choosing-a-model.md).
 
 Runner API: :func:`summary_line` ``(config, tolerance=DEFAULT_TOLERANCE) -> str | None``.
 """
