@@ -384,9 +384,11 @@ class CoolingAnalysis:
 
     @property
     def a2_late(self):
-        """(mean, standard error, count) of the snapshots' a2 over the later half of the run's time."""
+        """(mean, standard error, count) of a2 over the later half of the snapshots (in their order;
+        log-spaced snapshots make that the later half in log time). The error is the sampling
+        error of N particles, ``sqrt(8 / (d (d + 2) N))`` per snapshot."""
         ts, a2, _ = self.sonine
-        sel = ts >= 0.5 * self.time[-1]
+        sel = np.arange(ts.size) >= ts.size // 2
         if not np.any(sel):
             return math.nan, math.nan, 0
         d, N = self.info.dimension, self.info.particles

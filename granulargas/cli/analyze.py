@@ -107,7 +107,7 @@ def cooling_report(a, rows: int = 10) -> str:
             f"t={ts[i] + a.t_offset:.3g}: {a2[i]:+.4f} ({th[j]:+.4f})" for j, i in enumerate(k)))
         mean, se, count = a.a2_late
         if count:
-            lines.append(f"  a2 mean over the later half of the run ({count} snapshots) {mean:+.4f} +- {se:.2g} "
+            lines.append(f"  a2 mean over the later half of the snapshots ({count}) {mean:+.4f} +- {se:.2g} "
                          f"(sampling error of N = {info.particles}); theory at the end "
                          f"{_fmt(float(a.theory.a2_at(t[-1])) if a.theory is not None else math.nan, '+.4f')}"
                          + (f", van Noije-Ernst {p.a2:+.4f}" if p.law == "haff" else ""))
@@ -162,7 +162,13 @@ def sweep_report(results, summaries) -> str:
     return "\n".join(lines)
 
 
+#: kind -> text report ``f(analysis, rows) -> str``
 REPORTS = {"cooling": cooling_report, "elastic": elastic_report}
+
+
+def report(analysis, rows: int = 10) -> str:
+    """The text report of an analysis of any kind (:data:`REPORTS`)."""
+    return REPORTS[analysis.kind](analysis, rows=rows)
 
 
 def _is_sweep(path: Path) -> bool:
@@ -210,7 +216,7 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(a.summary(), indent=1, ensure_ascii=False))
     else:
-        print(REPORTS[a.kind](a, rows=args.rows))
+        print(report(a, rows=args.rows))
     if args.plot:
         from granulargas.analysis.plots import plot_analysis  # matplotlib only when a plot is asked for
 
