@@ -40,8 +40,9 @@ def _title(info, what):
         extra = f", $\\varepsilon$ = {info.restitution:g}"
     elif info.model == "viscoelastic" and info.prefactor is not None:
         extra = f", k = {info.prefactor:.3g}"
-    return (f"{what}\n{name}: {info.model}{extra}, {info.dimension}D, N = {info.particles}, "
-            f"$\\eta$ = {info.packing_fraction:.3g}" + ("" if info.monodisperse else " (polydisperse: mean size)"))
+    eta = info.solid_fraction if math.isfinite(info.solid_fraction) else info.packing_fraction
+    return (f"{what}\n{name}: {info.model}{extra}, {info.dimension}D, N = {info.particles}, $\\eta$ = {eta:.3g}"
+            + ("" if info.monodisperse else "; polydisperse, theory for particles of the mean diameter"))
 
 
 def plot_cooling(analysis, path):
@@ -89,7 +90,7 @@ def plot_cooling(analysis, path):
     ax.set_ylabel("$T/T_\\mathrm{theory}$")
     ax.text(0.01, 0.95, f"last 10 % of t: {a.T_ratio_final:.4f};  last decade: {a.T_ratio_last_decade:.4f}",
             transform=ax.transAxes, fontsize=8, va="top")
-    ax.legend(fontsize=7.5, loc="lower right")
+    ax.legend(fontsize=7.5, loc="upper right")
 
     ax = axes[2]
     ts_, a2, a3 = a.sonine
@@ -168,7 +169,7 @@ def plot_elastic(analysis, path):
     ax.set_ylim(s["Z_theory"] - pad, s["Z_theory"] + pad)
     _no_offset(ax)
     ax.set_ylabel("$Z = P/(nT)$")
-    ax.legend(fontsize=7.5, loc="lower right")
+    ax.legend(fontsize=7.5, loc="lower right", framealpha=0.7)
 
     ax = axes[2]
     tw, om = a.collision_windows
@@ -185,7 +186,7 @@ def plot_elastic(analysis, path):
     ax.set_ylim(th - pad, th + pad)
     _no_offset(ax)
     ax.set_ylabel("collisions per particle\nper unit time", fontsize=9)
-    ax.legend(fontsize=7.5, loc="lower right")
+    ax.legend(fontsize=7.5, loc="lower right", framealpha=0.7)
     ax.set_xlabel(f"time t  [$\\sigma\\,(m/T_0)^{{1/2}}$]; averages from t = {a.t_equilibrated:.3g}")
     for ax in axes[1:]:
         ax.axvline(a.t_equilibrated, color="0.8", lw=0.8, ls=":")

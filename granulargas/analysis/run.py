@@ -113,6 +113,7 @@ class RunInfo:
     prefactor: float | None
     contact_end: str = "overlap"
     parameters: dict = field(repr=False, default_factory=dict)
+    solid_fraction: float = math.nan  # sum of the particle volumes over the box volume
 
     @classmethod
     def from_file(cls, path) -> "RunInfo":
@@ -127,13 +128,15 @@ class RunInfo:
             particles=int(radii.shape[0]),
             box=np.asarray(snap.box, dtype=float),
             diameter=float(2.0 * radii.mean()),
-            mass=float(masses.mean()),
+            mass=_mean_particle_mass(radii, masses, int(snap.box.shape[0])),
             monodisperse=bool(np.ptp(radii) == 0 and np.ptp(masses) == 0),
             model=model,
             restitution=_float_or_none(coll.get("restitution")),
             prefactor=_float_or_none(coll.get("prefactor")),
             contact_end=str(coll.get("contact_end", "overlap")),
             parameters=params,
+            solid_fraction=float(np.sum(theory.particle_volume(2.0 * radii, int(snap.box.shape[0])))
+                                 / float(np.prod(snap.box))),
         )
 
     @property
@@ -146,6 +149,8 @@ class RunInfo:
 
     @property
     def packing_fraction(self) -> float:
+        """Packing fraction of the theory's gas: identical particles of the mean diameter at
+        the run's number density (the run's own, :attr:`solid_fraction`, if monodisperse)."""
         return float(theory.packing_fraction(self.number_density, self.dimension, self.diameter))
 
     @property
@@ -178,6 +183,19 @@ class RunInfo:
             tau2 = float(theory.viscoelastic_tau0(self.prefactor, n, T0, d, s, m, order=2))
             return Prediction("viscoelastic", T0, tau0, 5.0 / 3.0, 0.0, omega0, ell, lc, tau2)
         return Prediction("elastic", T0, math.inf, 0.0, 0.0, omega0, ell, math.inf)
+
+
+def _mean_particle_mass(radii, masses, dim) -> float:
+    """Mass of a particle of the mean diameter, as :func:`granulargas.run.prepare.mean_particle`
+    gives it for the config: the common mass, or (masses proportional to the particle volumes,
+    a material density) the density times the volume of the mean diameter; else the mean mass."""
+    if np.ptp(masses) == 0:
+        return float(masses[0])
+    vol = theory.particle_volume(2.0 * radii, dim)
+    rho = masses / vol
+    if np.ptp(rho) <= 1e-9 * rho.mean():
+        return float(rho.mean() * theory.particle_volume(2.0 * radii.mean(), dim))
+    return float(masses.mean())
 
 
 def run_kind(info: RunInfo) -> str:

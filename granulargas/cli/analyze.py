@@ -58,8 +58,9 @@ def _header(info) -> list[str]:
         + (f" (prefactor k = {info.prefactor:.4g})" if info.prefactor is not None and info.model == "viscoelastic" else ""),
     ]
     if not info.monodisperse:
-        lines.append("  note: polydisperse run; the theory below is that of identical particles of the mean diameter "
-                     "and its mass")
+        lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
+                     f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
+                     f"same number density (packing {info.packing_fraction:.4g})")
     return lines
 
 
