@@ -122,9 +122,25 @@ def end_code(end: str) -> int:
 # --------------------------------------------------------------------------- parameters
 
 
-def compression_constant(rho):
-    """rho^{-2/5}: the compression scale is X = rho^{-2/5} g_n^{4/5} (vectorised)."""
-    return np.asarray(rho, dtype=float) ** -0.4
+def compression_prefactor(young_modulus, poisson_ratio):
+    """q = (2 Y / (3 (1 - nu^2)))^{-2/5}, the stiffness counterpart of the damping prefactor k.
+
+    The compression scale of a pair is X = q (m_eff^2 g_n^4 / R_eff)^{1/5}
+    (:func:`pair_compression_constant`), as beta = k (R_eff g_n / m_eff^2)^{1/5}.
+    In reduced units (lengths sigma, masses m, speeds v_0) Y is Y sigma^3 / (m v_0^2).
+    """
+    young = np.asarray(young_modulus, dtype=float)
+    nu = np.asarray(poisson_ratio, dtype=float)
+    if not (np.all(young > 0) and np.all((nu > -1.0) & (nu < 0.5))):
+        raise ValueError(f"need young_modulus > 0 and -1 < poisson_ratio < 0.5, got {young_modulus}, {poisson_ratio}")
+    return (2.0 * young / (3.0 * (1.0 - nu * nu))) ** -0.4
+
+
+def pair_compression_constant(prefactor, radius_i, radius_j, mass_i, mass_j):
+    """rho^{-2/5} = q (m_eff^2 / R_eff)^{1/5} of a pair: X = this g_n^{4/5} (vectorised)."""
+    r_eff = radius_i * radius_j / (radius_i + radius_j)
+    m_eff = mass_i * mass_j / (mass_i + mass_j)
+    return prefactor * (m_eff ** 2 / r_eff) ** 0.2
 
 
 def parameters(normal_speed, tangential_speed, distance, rho, dissipation_time):

@@ -132,3 +132,18 @@ def test_zeta_round_trip():
     c = np.array([0.0, 1e-6, 0.3, 1.0, 7.0, 1e8])
     np.testing.assert_allclose(ob.c_of_zeta(ob.zeta_of_c(c)), c, rtol=1e-8)
     assert ob.zeta_of_c(np.inf) == 1.0 and ob.zeta_of_c(1.0) == 0.5
+
+
+def test_compression_constant_of_a_pair():
+    """X = q (m_eff^2 g^4 / R_eff)^{1/5} equals (g^2 / rho)^{2/5} with rho of seed eq. (3)."""
+    from granulargas.contact.material import rho_from_material
+
+    Y, nu = 3.3e9, 0.27
+    q = ob.compression_prefactor(Y, nu)
+    for ri, rj, mi, mj, g in [(0.5, 0.5, 1.0, 1.0, 1.0), (0.3, 0.7, 0.4, 2.5, 0.2), (1e-3, 2e-3, 1e-5, 3e-5, 7.0)]:
+        r_eff, m_eff = ri * rj / (ri + rj), mi * mj / (mi + mj)
+        rho = rho_from_material(Y, nu, r_eff, m_eff)
+        x = ob.pair_compression_constant(q, ri, rj, mi, mj) * g ** 0.8
+        assert x == pytest.approx((g * g / rho) ** 0.4, rel=1e-13)
+    with pytest.raises(ValueError):
+        ob.compression_prefactor(-1.0, 0.3)
