@@ -206,10 +206,14 @@ def oblique_solve(beta, c, delta, end, order, tol, out):
         T[0] = t
         M[0] = m
         _coefficients(beta, c, delta, on, K, W, P, T, M, Q, U, U2, U3, F, R, WU3, W3, WP)
-        scale = max(1.0, abs(w), abs(p))
+        # step from the last coefficients of every series that must converge over it. p sees the poles
+        # of u (delta w^2 = 1) only through c w u^3; with c = 0 or after the force end (w linear in s,
+        # p constant for a head-on contact) M and u limit the step too
+        watch_m = c == 0.0 or on == 0.0
+        scale = max(1.0, abs(w), abs(p), abs(m)) if watch_m else max(1.0, abs(w), abs(p))
         h = 1e300
         for m_ in range(K - 5, K + 1):
-            for a in (abs(W[m_]), abs(P[m_])):
+            for a in (abs(W[m_]), abs(P[m_]), abs(M[m_]) if watch_m else 0.0, abs(U[m_ - 1]) if watch_m else 0.0):
                 if a > 0.0:
                     hm = (tol * scale / a) ** (1.0 / m_)
                     if hm < h:

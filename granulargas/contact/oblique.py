@@ -279,16 +279,17 @@ def solve_oblique_cartesian(beta: float, c: float, delta: float, end: str = "ove
     """Independent reference: the relative motion in Cartesian coordinates with scipy's DOP853.
 
     Units D = 1, g_n = 1, so X = delta, T = delta, rho = delta^{-5/2},
-    A = 2 beta delta / 3. State (w, r_x, r_y, v_x, v_y, t) in the fictitious time
-    s with dt = w ds; w = sqrt(xi) is a state variable, dw/ds = xi'/2 with
-    xi' = -v . r/|r|, so that w^2 = 1 - |r| holds along the solution (a check).
+    A = 2 beta delta / 3. State (w, r_x, r_y, v_x, v_y, t, M) in the fictitious
+    time s with dt = w ds; w = sqrt(xi) is a state variable, dw/ds = xi'/2 with
+    xi' = -v . r/|r|, so that w^2 = 1 - |r| holds along the solution (a check);
+    M integrates x (2 - delta x) / (1 - delta x)^2 dtau with x = w^2 / delta.
     The force ends at w = 0 (``overlap``) or at w^2 + (3/2) A xi' = 0
     (``force``), after which the spheres fly freely until w = 0.
 
     Returns
     -------
     dict
-        ``restitution`` (eps_s), ``duration`` (tau_s), ``rotation`` (Delta phi),
+        ``restitution`` (eps_s), ``duration`` (tau_s), ``turning`` (M), ``rotation`` (Delta phi),
         ``velocity`` (v_s in the frame (n_0, e_t), units g_n), ``position``
         (r_s, units D), ``force_duration``, ``drift`` (max |w^2 - (1 - |r|)| / delta).
     """
@@ -303,18 +304,20 @@ def solve_oblique_cartesian(beta: float, c: float, delta: float, end: str = "ove
     tan_theta = math.sqrt(c / delta)
 
     def rhs(s, y, on):
-        w, rx, ry, vx, vy, _ = y
+        w, rx, ry, vx, vy, _, _ = y
         r = math.hypot(rx, ry)
         nx, ny = rx / r, ry / r
         xi_dot = -(vx * nx + vy * ny)
         f = on * rho * w * (w * w + 1.5 * a * xi_dot)  # repulsive, along +n
-        return [0.5 * xi_dot, w * vx, w * vy, w * f * nx, w * f * ny, w]
+        xi = w * w  # = delta x
+        return [0.5 * xi_dot, w * vx, w * vy, w * f * nx, w * f * ny, w,
+                w / delta * (xi / delta) * (2.0 - xi) / (1.0 - xi) ** 2]
 
     def separation(s, y, on):
         return y[0]
 
     separation.terminal, separation.direction = True, -1
-    y0 = [0.0, 1.0, 0.0, -1.0, tan_theta, 0.0]
+    y0 = [0.0, 1.0, 0.0, -1.0, tan_theta, 0.0, 0.0]
     s_max = 100.0 + 200.0 * beta ** 2
     opts = dict(method="DOP853", rtol=rtol, atol=atol)
     t_force = math.nan
@@ -343,12 +346,13 @@ def solve_oblique_cartesian(beta: float, c: float, delta: float, end: str = "ove
         traj = sol.y
     if sol.status != 1:
         raise RuntimeError(f"no separation found (beta={beta}, c={c}, delta={delta})")
-    w, rx, ry, vx, vy, t = sol.y_events[0][0]
+    w, rx, ry, vx, vy, t, m = sol.y_events[0][0]
     r = math.hypot(rx, ry)
     drift = float(np.max(np.abs(traj[0] ** 2 - (1.0 - np.hypot(traj[1], traj[2]))))) / delta
     return {
         "restitution": (vx * rx + vy * ry) / r,
         "duration": t / delta,
+        "turning": m,
         "rotation": math.atan2(ry, rx),
         "velocity": np.array([vx, vy]),
         "position": np.array([rx, ry]),

@@ -65,7 +65,7 @@ from granulargas.contact.oblique_lookup import oblique_lookup_many
 from granulargas.contact.table import _cache_file, load_cached, save_cached
 from granulargas.errors import TableRangeError
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 MAX_ERROR = 1e-8
 #: Largest beta an oblique table may cover (the viscoelastic model needs beta well below ~3).
 BETA_MAX = 2.0

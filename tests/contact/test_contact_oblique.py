@@ -12,6 +12,7 @@ from contact_truths import HERTZ_DURATION
 CASES = [  # beta, c, delta: near head-on, oblique, grazing, strongly damped, soft
     (0.3, 1.0, 0.1), (0.0, 0.5, 0.05), (1.0, 10.0, 0.2), (0.1, 0.01, 0.01),
     (0.05, 100.0, 0.001), (2.0, 0.02, 0.3), (0.5, 3.0, 0.45),
+    (2.5, 0.0, 0.36), (1.0, 1e-12, 0.5),  # head-on: the force end's free flight alone limits the step
 ]
 
 
@@ -25,6 +26,7 @@ def test_taylor_polar_agrees_with_cartesian_dop853(beta, c, delta, end):
     assert a.restitution == pytest.approx(r["restitution"], abs=1e-11)
     assert a.duration == pytest.approx(r["duration"], rel=1e-11)
     assert a.rotation == pytest.approx(r["rotation"], abs=1e-11)
+    assert a.turning == pytest.approx(r["turning"], rel=1e-10)
     assert a.force_duration == pytest.approx(r["force_duration"], rel=1e-11)
     out = ob.frame_outcome(a.restitution, a.duration, a.turning, beta, c, delta, 0.0, 1.0, math.sqrt(c / delta), 1.0)
     np.testing.assert_allclose(out.velocity, r["velocity"], rtol=0, atol=1e-11 * max(1.0, math.sqrt(c / delta)))
