@@ -43,14 +43,7 @@ def _plt():
 def current_instability_length(info: RunInfo, T: float) -> float:
     """L_c at temperature T: constant restitution -> independent of T; viscoelastic
     -> with the effective restitution at T, which grows towards 1 as the gas cools."""
-    n = info.number_density
-    if info.model == "constant" and info.restitution is not None:
-        return float(th.instability_length(info.restitution, n, info.dimension, info.diameter))
-    if info.model == "viscoelastic" and info.prefactor is not None:
-        b = th.pair_damping(info.prefactor, info.diameter, info.mass)
-        e2 = 1.0 - float(th.effective_inelasticity(b, T, info.mass))
-        return float(th.instability_length(math.sqrt(max(e2, 0.0)), n, info.dimension, info.diameter, a2=0.0))
-    return math.inf
+    return info.gas(T).instability_length()
 
 
 def grid_cells(info: RunInfo, cell: float) -> int:

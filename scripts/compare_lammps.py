@@ -49,7 +49,7 @@ def run_granulargas(config, overrides: dict, workdir: Path, repeats: int):
     """Run the config ``repeats`` times; return (observables, wall times, compile time, summary)."""
     from granulargas.io.config import parse_config
     from granulargas.io.h5md import read_observables
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     # compile (and load the numba cache) on a tiny copy of the config
     t0 = time.perf_counter()
@@ -80,7 +80,7 @@ def seed_spread(config, overrides: dict, workdir: Path, seeds: int, t_ref, T_ref
     LAMMPS and granulargas from fluctuations alone."""
     from granulargas.io.config import parse_config
     from granulargas.io.h5md import read_observables
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     devs = []
     for k in range(1, seeds + 1):
@@ -95,8 +95,8 @@ def seed_spread(config, overrides: dict, workdir: Path, seeds: int, t_ref, T_ref
 
 
 def run_dem(config, workdir: Path, fraction: float, steps_per_contact: int, end_time: float, reuse: bool):
-    from granulargas.io.export import export_lammps
-    from granulargas.io.lammps import loop_time, read_thermo, run_lammps
+    from granulargas.dem.export import export_lammps
+    from granulargas.dem.lammps import loop_time, read_thermo, run_lammps
 
     d = workdir / f"lammps_f{fraction:g}"
     ex = export_lammps(config, d, contact_fraction=fraction, steps_per_contact=steps_per_contact, end_time=end_time)
@@ -117,8 +117,8 @@ def run_dem(config, workdir: Path, fraction: float, steps_per_contact: int, end_
 def cooling(args):
     from granulargas import theory
     from granulargas.io.config import load_config
-    from granulargas.io.lammps import find_lmp
-    from granulargas.io.run_command import parse_override
+    from granulargas.dem.lammps import find_lmp
+    from granulargas.cli._args import parse_override
 
     overrides = dict(parse_override(t) for t in args.set)
     if args.end_time is not None:
@@ -174,7 +174,7 @@ def cooling(args):
 
 
 def _prefactor(config):
-    from granulargas.io.setup import reduced_prefactor
+    from granulargas.run.prepare import reduced_prefactor
 
     return reduced_prefactor(config)
 
@@ -222,7 +222,7 @@ def plot_cooling(path, config, t_ed, T_ed, ed_wall, dem, tau0, spread=None):
 
 def head_on(args):
     from granulargas.contact import restitution
-    from granulargas.io.lammps import DemContact, find_lmp, head_on_restitution
+    from granulargas.dem.lammps import DemContact, find_lmp, head_on_restitution
 
     if find_lmp() is None:
         sys.exit("LAMMPS (lmp) not found: the head-on study needs it (apt-get install lammps)")

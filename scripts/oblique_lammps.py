@@ -6,10 +6,10 @@
 For every impact angle theta (tan theta = g_t / g_n), damping beta (at the
 normal speed g_n = 1) and compression scale delta = X / D (third parameter of
 :mod:`granulargas.contact.oblique`; sets the stiffness through
-:func:`granulargas.io.lammps.stiffness_for_compression`), LAMMPS
+:func:`granulargas.dem.lammps.stiffness_for_compression`), LAMMPS
 (``pair_style granular``, hertz/material + damping viscoelastic, frictionless;
 ``limit_damping`` for the ``force`` end; mapping of
-:class:`granulargas.io.lammps.DemContact`) integrates the collision with
+:class:`granulargas.dem.lammps.DemContact`) integrates the collision with
 ``--steps`` time steps per contact (dt = t_c / steps, t_c from the table).
 From its relative motion x1 - x2 it takes
 
@@ -69,7 +69,7 @@ def lammps_outcome(traj, distance):
 
 def run_case(case, steps_list, workdir, table_cache):
     from granulargas.contact import oblique_table, restitution
-    from granulargas.io.lammps import DemContact, oblique_trajectory, stiffness_for_compression
+    from granulargas.dem.lammps import DemContact, oblique_trajectory, stiffness_for_compression
 
     theta, beta, delta, end = case["theta"], case["beta"], case["delta"], case["end"]
     (r1, r2), (m1, m2) = case["radii"], case["masses"]
@@ -231,7 +231,7 @@ def main(argv=None):
     parser.add_argument("--json", type=Path, default=None, help="default: WORKDIR/results.json")
     args = parser.parse_args(argv)
 
-    from granulargas.io.lammps import find_lmp
+    from granulargas.dem.lammps import find_lmp
 
     bad = [a for a in args.angles if not 0.0 <= a < 90.0] + [b for b in args.betas if not 0.0 <= b <= 2.0] \
         + [d for d in args.deltas if not 0.0 < d <= 0.5] + [n for n in args.steps if n < 10]

@@ -37,8 +37,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
-from granulargas.contact import _taylor
+from granulargas.contact import _taylor, _taylor_np
 
 ENDS = ("overlap", "force")
 
@@ -99,8 +101,6 @@ def solve_many(beta, end="overlap", order=_taylor.ORDER, tol=_taylor.TOLERANCE, 
         raise ValueError("beta must be >= 0 (and not nan)")
     code = end_code(end)
     if backend == "numpy":
-        from granulargas.contact import _taylor_np
-
         out = _taylor_np.solve_many(betas, code, int(order), float(tol))
         if np.isnan(out).any():
             raise RuntimeError(f"Taylor contact integrator (numpy) failed for some beta in {betas}")
@@ -155,10 +155,6 @@ def solve_contact_scipy(beta: float, end: str = "overlap", method: str = "DOP853
     -------
     (eps, tau_c) : tuple of float
     """
-    from scipy.integrate import solve_ivp
-
-    from scipy.optimize import brentq
-
     beta = float(beta)
     end_code(end)
 
@@ -202,8 +198,6 @@ def trajectory(beta: float, end: str = "overlap", n: int = 400, rtol: float = 1e
     t, x, v : ndarray (n,)
         Dimensionless time, compression and compression rate from impact to the end.
     """
-    from scipy.integrate import solve_ivp
-
     s_end = solve_many(beta, end)[0, 4]
     s = np.linspace(0.0, s_end, n)
     sol = solve_ivp(_rhs, (0.0, s_end), [0.0, 1.0, 0.0], method="DOP853", rtol=rtol, atol=1e-14,

@@ -36,7 +36,7 @@ observables_interval = {dt}
 
 def _run(tmp_path, dim, n, eta, seed, collision, end, dt):
     from granulargas.io.config import parse_config
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     path = tmp_path / f"run_{dim}_{n}_{seed}.h5"
     text = CONFIG.format(dim=dim, n=n, eta=eta, seed=seed, collision=collision, end=end, dt=dt, file=path)
@@ -122,7 +122,7 @@ def test_sonine_a2_of_the_hcs_matches_van_noije_ernst(tmp_path):
     # than the snapshots' own scatter / sqrt(snapshots) says.
     from granulargas.analysis.run import sonine_history
     from granulargas.io.config import parse_config
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     eps, eta = 0.9, 0.05
     n = th.number_density(eta, 3)

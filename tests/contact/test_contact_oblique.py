@@ -7,7 +7,7 @@ import pytest
 
 from granulargas.contact import duration, ode, restitution
 from granulargas.contact import oblique as ob
-from contact_truths import HERTZ_DURATION
+from tests.contact.truths import HERTZ_DURATION
 
 CASES = [  # beta, c, delta: near head-on, oblique, grazing, strongly damped, soft
     (0.3, 1.0, 0.1), (0.0, 0.5, 0.05), (1.0, 10.0, 0.2), (0.1, 0.01, 0.01),

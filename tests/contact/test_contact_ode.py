@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from granulargas.contact import ode
-from contact_truths import C1, C2, HERTZ_DURATION
+from tests.contact.truths import C1, C2, HERTZ_DURATION
 
 BETAS = [1e-7, 1e-4, 1e-3, 1e-2, 0.1, 0.3, 1.0, 2.0, 5.0, 10.0]
 

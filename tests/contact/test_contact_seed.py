@@ -5,7 +5,7 @@ from scipy.integrate import solve_ivp
 
 from granulargas.contact import seed_route
 from granulargas.contact.ode import _rhs
-from contact_truths import C1, C2, HERTZ_DURATION, HERTZ_MAX_COMPRESSION
+from tests.contact.truths import C1, C2, HERTZ_DURATION, HERTZ_MAX_COMPRESSION
 
 
 def test_seed_route_gives_closed_form_constants():

@@ -7,7 +7,7 @@ from granulargas.engine import CollisionRule, Simulation
 from granulargas.engine.invariants import check
 from granulargas.errors import ConfigError
 
-from engine_factories import hermite_table, make_sim, pade_eps
+from tests.engine.factories import hermite_table, make_sim, pade_eps
 
 RULES = [CollisionRule.elastic(), CollisionRule.constant(0.8, tc_time=1e-3),
          CollisionRule.viscoelastic(0.4, hermite_table(pade_eps))]
