@@ -137,7 +137,8 @@ def test_zeta_round_trip():
 
 
 def test_compression_constant_of_a_pair():
-    """X = q (m_eff^2 g^4 / R_eff)^{1/5} equals (g^2 / rho)^{2/5} with rho of seed eq. (3)."""
+    """X = q (m_eff^2 g^4 / R_eff)^{1/5} equals (g^2 / rho)^{2/5},
+    rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)) (Schwager & Poeschel 1997)."""
     from granulargas.contact.material import rho_from_material
 
     Y, nu = 3.3e9, 0.27

@@ -19,7 +19,8 @@ import pytest
 
 from granulargas.dem.lammps import DemContact, find_lmp, oblique_input, stiffness_for_compression
 
-needs_lmp = pytest.mark.skipif(find_lmp() is None, reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
+needs_lmp = pytest.mark.skipif(find_lmp() is None,
+                               reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
 SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "oblique_lammps.py"
 
 
@@ -31,7 +32,8 @@ def load_script():
 
 
 def test_stiffness_for_compression_gives_delta():
-    for delta, g, r_eff, m_eff, dist in [(0.05, 1.0, 0.25, 0.5, 1.0), (0.2, 0.3, 0.21, 0.345, 1.0), (1e-3, 4.0, 1, 2, 4)]:
+    cases = [(0.05, 1.0, 0.25, 0.5, 1.0), (0.2, 0.3, 0.21, 0.345, 1.0), (1e-3, 4.0, 1, 2, 4)]
+    for delta, g, r_eff, m_eff, dist in cases:
         young = stiffness_for_compression(delta, g, r_eff, m_eff, dist)
         rho = DemContact(young, 0.3, 0.0).rho(r_eff, m_eff)
         assert (g * g / rho) ** 0.4 / dist == pytest.approx(delta, rel=1e-13)
