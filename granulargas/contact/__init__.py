@@ -21,7 +21,7 @@ from granulargas.contact.material import (
     validity_problems,
 )
 from granulargas.contact.oblique import solve_oblique
-from granulargas.contact.oblique_table import ObliqueTable, oblique_table
+from granulargas.contact.oblique_grid import ObliqueTable, oblique_table
 from granulargas.contact.table import RestitutionTable, ensure_covers, restitution_table
 
 __all__ = [

@@ -39,10 +39,13 @@ contact (contact time / mean free time = 0.01 - 0.1, as DEM runs are) has delta
 
 Why an exact three-parameter table, not an expansion in delta: the corrections
 are powers of c = delta tan^2(theta), unbounded for grazing impacts at any
-delta. In a gas the impact angle has density 2 cos(theta) sin(theta) (3D, flux
-weighted), so a fraction delta / (1 + delta) of the collisions has c > 1 and is
-not perturbative at all; and even at c < 1 a first-order expansion in delta
-would reach the 1e-8 of the restitution table only for delta < 1e-4. The
+delta. In a gas (3D, impact angle flux weighted, density 2 cos(theta) sin(theta))
+a fraction ~ delta_g^{5/3} of the collisions has c > 1 and is not perturbative
+at all (delta_g: delta at the total relative speed g; c = delta_g sin^2(theta)
+cos^{-6/5}(theta)), 2 % at delta_g = 0.1. And where it converges, a
+first-order expansion leaves a second-order term (at theta = 56 deg, beta = 0.4
+the outgoing velocity moves by 7.0 delta g_n + 0.75 delta^2 g_n), so the 1e-8
+of the restitution table would need delta < 1e-4. The
 variables below make all three directions smooth, including the grazing limit.
 
 End of contact and separation
@@ -88,7 +91,7 @@ DOP853 on the Cartesian relative motion in the plane (no polar reduction, no
 angular momentum used), regularised by the same dt = w ds with w carried as a
 state variable (d w/ds = xi'/2, which keeps w^2 = D - |r|).
 
-The table (:mod:`granulargas.contact.oblique_table`) holds eps_s,
+The table (:mod:`granulargas.contact.oblique_grid`) holds eps_s,
 tau_s (1 + c) and M (1 + c)^2 as smooth functions of (sqrt(beta),
 zeta = sqrt(c) / (1 + sqrt(c)), delta) in [0, sqrt(beta_max)] x [0, 1] x [0, delta_max].
 """

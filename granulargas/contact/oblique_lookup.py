@@ -1,6 +1,6 @@
 """Compiled lookup of the oblique-contact table and the resolved collision (a numba leaf module).
 
-The table (built by :mod:`granulargas.contact.oblique_table`) covers the box
+The table (built by :mod:`granulargas.contact.oblique_grid`) covers the box
 s = sqrt(beta) in [0, n_s h_s), zeta = sqrt(c) / (1 + sqrt(c)) in [0, 1],
 delta in [0, n_d h_d), cut into cells; in cell (a, b, d) with local variables
 u = 2 (position in the cell) - 1 in [-1, 1]

@@ -36,11 +36,14 @@ The nodes are solved by the compiled Taylor integrator
 (:mod:`granulargas.contact._oblique_taylor`, ~1e-14). Every build checks
 ``checks_per_cell`` seeded random points per cell against it and fails if any
 error exceeds 1e-8 (absolute for eps_s, relative to max(1, |f|) for f_1, f_2);
-the errors found are in ``parameters``. With the defaults (5 cells per unit of
-s, 16 in zeta, 10 per unit of delta; 10 x 10 x 8 nodes) the largest errors over
-the whole range, at 2 x 10^4 random points (tests/contact), are 5e-10 (eps_s),
-3e-10 (tau_s) and 2e-9 (M). The full range (beta < 2.56, delta < 0.6, 768 cells,
-15 MB) takes ~30 s per contact end to build, once; a gas needs a few cells.
+the errors found are in ``parameters``. With the defaults (8 cells per unit of
+s, 24 in zeta, 16 per unit of delta; 7 x 7 x 7 nodes) the largest errors over
+the whole range, at 2 x 10^4 random points (tests/contact), are 7e-10 (eps_s),
+8e-10 (tau_s) and 1.4e-9 (M). The full range (beta < 2.25, delta < 0.56, 2592
+cells, 21 MB) takes ~1 min per contact end to build, once; a gas needs a few
+cells. Finer cells with fewer nodes keep the lookup cheap (3 x 343
+multiply-adds): 10 x 10 x 8 nodes on a coarser grid reach the same accuracy
+with 2.3 times the work per lookup.
 
 Coverage: beta < :data:`BETA_MAX` (= 2, beyond the model's validity) and
 delta < :data:`granulargas.contact.oblique.DELTA_MAX`. Out of range, lookups
@@ -69,7 +72,7 @@ FORMAT_VERSION = 2
 MAX_ERROR = 1e-8
 #: Largest beta an oblique table may cover (the viscoelastic model needs beta well below ~3).
 BETA_MAX = 2.0
-DEFAULT_GRID = {"cells_per_unit_s": 5, "zeta_cells": 16, "cells_per_unit_delta": 10, "nodes": (10, 10, 8)}
+DEFAULT_GRID = {"cells_per_unit_s": 8, "zeta_cells": 24, "cells_per_unit_delta": 16, "nodes": (7, 7, 7)}
 CHECKS_PER_CELL = 2
 
 

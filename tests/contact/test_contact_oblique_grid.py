@@ -15,13 +15,13 @@ from granulargas.contact.oblique_lookup import (
     oblique_lookup,
     resolve_collision,
 )
-from granulargas.contact.oblique_table import BETA_MAX, oblique_table
+from granulargas.contact.oblique_grid import BETA_MAX, oblique_table
 from granulargas.errors import TableRangeError
 
 
 @pytest.fixture(scope="module")
 def tables(tmp_path_factory):
-    """One small table per contact end (beta < 0.36, delta < 0.2), built without the cache."""
+    """One small table per contact end (beta < 0.39, delta < 0.125), built without the cache."""
     return {end: oblique_table(0.3, 0.1, end=end, use_cache=False) for end in ob.ENDS}
 
 
@@ -56,7 +56,7 @@ def test_table_within_1e8_of_the_integration(tables, end):
 def test_head_on_through_the_table_is_todays_contact(tables, end):
     table = tables[end]
     beta = np.linspace(0, 0.3, 31)
-    for delta in (0.0, 0.05, 0.15):
+    for delta in (0.0, 0.05, 0.1):
         eps, tau, _ = table.lookup(beta, 0.0, delta)
         np.testing.assert_allclose(eps, restitution(beta, end=end), rtol=0, atol=1e-8)
         if end == "overlap":
@@ -126,20 +126,20 @@ def test_range_requests(cache_dir):
 
 
 def test_cache_slices_extends_and_rebuilds(cache_dir):
-    small = oblique_table(0.03, 0.05)
-    assert small.coeffs.shape[:3] == (1, 16, 1)
+    small = oblique_table(0.01, 0.05)
+    assert small.coeffs.shape[:3] == (1, 24, 1)
     files = list(cache_dir.glob("oblique-overlap-*.npz"))
     assert len(files) == 1
-    bigger = small.extended(0.1, 0.05)  # one more cell in sqrt(beta): only that one is computed
-    assert bigger.coeffs.shape[:3] == (2, 16, 1)
+    bigger = small.extended(0.03, 0.05)  # one more cell in sqrt(beta): only that one is computed
+    assert bigger.coeffs.shape[:3] == (2, 24, 1)
     np.testing.assert_array_equal(bigger.coeffs[:1], small.coeffs)
-    again = oblique_table(0.03, 0.05)  # a slice of the cached, larger table
+    again = oblique_table(0.01, 0.05)  # a slice of the cached, larger table
     np.testing.assert_array_equal(again.coeffs, small.coeffs)
-    assert small.extended(0.02, 0.01) is small
-    fresh = oblique_table(0.1, 0.05, use_cache=False)
+    assert small.extended(0.005, 0.01) is small
+    fresh = oblique_table(0.03, 0.05, use_cache=False)
     np.testing.assert_array_equal(fresh.coeffs, bigger.coeffs)
     files[0].write_bytes(b"garbage")
-    rebuilt = oblique_table(0.03, 0.05)
+    rebuilt = oblique_table(0.01, 0.05)
     np.testing.assert_array_equal(rebuilt.coeffs, small.coeffs)
     for k, v in rebuilt.parameters.items():
         assert isinstance(v, (int, float, str)), k
@@ -147,7 +147,7 @@ def test_cache_slices_extends_and_rebuilds(cache_dir):
 
 def test_coarse_grid_is_refused(cache_dir):
     with pytest.raises(RuntimeError, match="too coarse"):
-        oblique_table(0.03, 0.05, grid={"nodes": (4, 4, 3), "zeta_cells": 4})
+        oblique_table(0.01, 0.05, grid={"nodes": (4, 4, 3), "zeta_cells": 4})
 
 
 @pytest.mark.slow
