@@ -28,6 +28,7 @@ MOVED = {
     "granulargas.engine.initial": "granulargas.initial.lattice_gas",
     "granulargas.analysis.cli": "granulargas.cli.analyze",
     "granulargas.contact.cli": "granulargas.cli.epsilon",
+    "granulargas.contact.seed_route": "granulargas.contact.perturbation",
 }
 
 

@@ -1,4 +1,4 @@
-"""Cooling of granular gases against kinetic theory (issue 5), several seeds per case.
+"""Cooling of granular gases against kinetic theory, several seeds per case.
 
 Runs (or, with --reuse, reads) three kinds of cooling runs and compares them with
 :mod:`granulargas.theory`:

@@ -43,6 +43,7 @@ def test_every_command_module_has_parser_and_run(name):
     ("granulargas.io.run_command", "granulargas.cli.run", ["configure_parser", "run"]),
     ("granulargas.analysis.cli", "granulargas.cli.analyze", ["report", "run"]),
     ("granulargas.contact.cli", "granulargas.cli.epsilon", ["configure_parser", "run"]),
+    ("granulargas.contact.seed_route", "granulargas.contact.perturbation", ["perturbation_solution", "puiseux_x"]),
 ])
 def test_moved_modules_keep_their_old_name(old, new, names):
     sys.modules.pop(old, None)

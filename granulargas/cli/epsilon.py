@@ -7,7 +7,7 @@ Examples::
     granulargas epsilon --young 1e7 --poisson 0.3 --dissipation-time 1e-5 \\
         --radius 0.01 --density 1000 --speed 1.0
 
-The material form computes rho (seed eq. 3) and beta = (3/2) A rho^{2/5} g^{1/5}
+The material form computes rho (Schwager & Pöschel (1997), eq. (3)) and beta = (3/2) A rho^{2/5} g^{1/5}
 for two identical spheres (or give --radius2/--mass2), prints physical
 durations in seconds, and warns when the model leaves its validity range.
 """
@@ -76,7 +76,7 @@ def _material(args):
     unit = material.time_unit(args.young, args.poisson, r_eff, m_eff, g)
     rho = material.rho_from_material(args.young, args.poisson, r_eff, m_eff)
     k = material.prefactor_from_material(args.young, args.poisson, args.dissipation_time)
-    print(f"R_eff = {r_eff:.6g} m, m_eff = {m_eff:.6g} kg, rho = {rho:.6g} m^-1/2 s^-2 (seed eq. 3), "
+    print(f"R_eff = {r_eff:.6g} m, m_eff = {m_eff:.6g} kg, rho = {rho:.6g} m^-1/2 s^-2 (Schwager & Pöschel (1997), eq. (3)), "
           f"k = {k:.6g} (SI), b_ij = {material.pair_constant(k, r1, r2, m1, m2):.6g}")
     c = material.sound_speed(args.young, args.density) if args.density is not None else None
     for problem in material.validity_problems(beta=beta, impact_speed=g, speed_of_sound=c):

@@ -18,7 +18,7 @@ from granulargas.run.validity import raise_if_invalid
 
 
 def configure_parser(parser):
-    parser.add_argument("config", help="TOML run configuration (see the README, section 'Running from a config file')")
+    parser.add_argument("config", help="TOML run configuration (every key: docs/configuration.md)")
     parser.add_argument("--overwrite", action="store_true", help="replace an existing output file")
     parser.add_argument("--restart", metavar="FILE",
                         help="continue from the last snapshot of FILE (same as [initial] from = FILE)")

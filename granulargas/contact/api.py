@@ -38,10 +38,10 @@ def restitution(beta, method: str = "ode", end: str = "overlap", order: int | No
         Dimensionless damping (3/2) A rho^{2/5} g^{1/5}, >= 0.
     method : {"ode", "series", "pade", "table"}
     end : {"overlap", "force"}
-        End of contact: x = 0 (seed eq. 4) or vanishing repulsive force.
+        End of contact: x = 0 (Schwager & Pöschel (1997), eq. (4)) or vanishing repulsive force.
     order : int, optional
         Series order (method="series"): highest power of beta ("overlap") or of
-        sqrt(beta) ("force"). Default 2 for "overlap" (seed eq. 31), 4 for "force".
+        sqrt(beta) ("force"). Default 2 for "overlap" (Schwager & Pöschel (1997), eq. (31)), 4 for "force".
 
     Returns
     -------

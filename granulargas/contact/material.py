@@ -1,6 +1,6 @@
 """From material constants to the dimensionless damping beta, and the model's validity range.
 
-Seed eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)). The rescaled contact
+Schwager & Pöschel (1997), eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)). The rescaled contact
 equation depends on the pair and the impact speed g only through
 
     beta = (3/2) A rho^{2/5} g^{1/5} = k (R_eff g / m_eff^2)^{1/5},
@@ -9,7 +9,7 @@ equation depends on the pair and the impact speed g only through
 so a run needs one material prefactor k and, per pair, b_ij = k (R_eff/m_eff^2)^{1/5}
 with beta = b_ij g^{1/5}. Physical durations are t_c = tau_c(beta) rho^{-2/5} g^{-1/5}.
 
-Validity (Brilliantov et al. 1996; physics notes): the viscoelastic force is a
+Validity (Brilliantov, Spahn, Hertzsch & Pöschel 1996): the viscoelastic force is a
 quasi-static theory. It needs the dissipative time A well below the collision
 time, which with A / t_c = (2/3) beta / tau_c(beta) means beta well below ~3 (we
 warn above ``BETA_VALID_MAX`` = 1), and impact speeds far below the speed of sound
@@ -42,7 +42,7 @@ def effective(a_i, a_j):
 
 
 def rho_from_material(young_modulus, poisson_ratio, radius_eff, mass_eff):
-    """Seed eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)), in SI (m^{-1/2} s^{-2})."""
+    """Schwager & Pöschel (1997), eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)), in SI (m^{-1/2} s^{-2})."""
     _positive("young_modulus", young_modulus)
     if not (-1.0 < poisson_ratio < 0.5):
         raise ValueError(f"poisson_ratio must lie in (-1, 0.5), got {poisson_ratio}")

@@ -1,14 +1,14 @@
 """Direct integration of the viscoelastic contact: eps(beta) and tau_c(beta).
 
-The contact of two viscoelastic spheres (seed eq. 2) in the rescaled units of the
-physics notes (time rho^{-2/5} g^{-1/5}, length g times that) reads
+The contact of two viscoelastic spheres (Schwager & Pöschel (1997), eq. (2)) in
+rescaled units (time rho^{-2/5} g^{-1/5}, length g times that) reads
 
     x'' + beta sqrt(x) x' + x^{3/2} = 0,   x(0) = 0,  x'(0) = 1.
 
-The coefficient of restitution is eps = -x'(tau_c) (seed eq. 4) and tau_c the
+The coefficient of restitution is eps = -x'(tau_c) (Schwager & Pöschel (1997), eq. (4)) and tau_c the
 dimensionless duration, for two definitions of the end of contact:
 
-* ``"overlap"``: x returns to 0 (seed eq. 4);
+* ``"overlap"``: x returns to 0;
 * ``"force"``: the repulsive force first vanishes, x + beta x' = 0
   (Schwager & Poeschel, PRE 78, 051304 (2008)).
 

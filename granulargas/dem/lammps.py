@@ -1,18 +1,18 @@
 """LAMMPS (time-stepped DEM) with the same contact law: inputs, runs, logs.
 
 LAMMPS's ``pair_style granular`` with the ``hertz/material`` normal model and
-``damping viscoelastic`` integrates seed eq. (2). For a pair of like
+``damping viscoelastic`` integrates Schwager & Pöschel (1997), eq. (2). For a pair of like
 particles its normal force is
 
     F = (4/3) E_eff sqrt(R_eff) delta^{3/2} + eta_n0 m_eff sqrt(R_eff delta) delta',
     E_eff = E / (2 (1 - nu^2)),
 
-while seed eq. (2) reads F = m_eff rho sqrt(xi) (xi + (3/2) A xi') with
+while that equation reads F = m_eff rho sqrt(xi) (xi + (3/2) A xi') with
 rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)). So E = Y, nu = nu and
 
     eta_n0 = 3 A rho / (2 sqrt(R_eff)) = A Y / ((1 - nu^2) m_eff)
 
-(docs physics.md section 6). LAMMPS multiplies eta_n0 by the pair's m_eff,
+(docs/interoperability.md). LAMMPS multiplies eta_n0 by the pair's m_eff,
 so for unequal masses eta_n0 is set per pair of atom types. The keyword
 ``limit_damping`` (no attractive normal force) gives the ``force`` end of
 contact; without it a contact ends when the overlap vanishes (``overlap``).
@@ -562,7 +562,7 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     _write_data_file(data_file, positions, velocities, radii, masses, typeid + 1, ntypes, box, source)
     lines = [
         f"# LAMMPS input written by granulargas export lammps{' from ' + source if source else ''}",
-        "# Same contact law as granulargas (seed eq. 2): hertz/material + damping viscoelastic,",
+        "# Same contact law as granulargas (Schwager & Pöschel (1997), eq. (2)): hertz/material + damping viscoelastic,",
         "# E = Y, nu = nu, eta_n0 = A Y / ((1 - nu^2) m_eff) per pair of atom types;",
         f"# end of contact '{end}'" + (" -> limit_damping" if end == "force" else " (no limit_damping)") + ".",
         f"# Dissipation time A = {contact.dissipation_time:.6g}, pair prefactor k = {prefactor:.6g}.",

@@ -70,7 +70,7 @@ class InitialConfig:
 
 @dataclass(frozen=True)
 class MaterialConfig:
-    """``[collision.material]`` (SI): the viscoelastic contact of seed eq. (2).
+    """``[collision.material]`` (SI): the viscoelastic contact of Schwager & Pöschel (1997), eq. (2).
 
     young_modulus (Pa), poisson_ratio, dissipation_time A (s), diameter (m) and
     density (kg/m^3) of the reference particle, speed_unit (m/s): the reduced

@@ -28,7 +28,7 @@ over the run, plus the inelastic-collapse risk.
 
 The prediction assumes a homogeneous gas with a Maxwellian velocity
 distribution (the viscoelastic a2 is of order beta and left out); it is checked
-against real runs in ``scripts/rule_choice.py`` (README, "Speed against accuracy").
+against real runs in ``scripts/rule_choice.py`` (docs/choosing-a-model.md).
 
 Runner API: :func:`summary_line` ``(config, tolerance=DEFAULT_TOLERANCE) -> str | None``.
 """

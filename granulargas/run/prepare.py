@@ -5,7 +5,7 @@ Units are converted here, once (ARCHITECTURE.md "Units"):
 * ``damping``: beta at normal impact speed g = 1 for two reference particles
   (diameter 1, mass 1), so k = damping / (R_eff_ref / m_eff_ref^2)^(1/5)
   (:func:`granulargas.contact.material.prefactor_from_damping`).
-* ``[collision.material]``: k_SI from Y, nu, A (seed eq. 3 folded into
+* ``[collision.material]``: k_SI from Y, nu, A (Schwager & Pöschel (1997), eq. (3), folded into
   beta = (3/2) A rho^(2/5) g^(1/5)), then to reduced units with the reference
   diameter sigma (m), mass M = density pi sigma^3/6 (kg) and velocity unit u
   (m/s): beta = k_SI (R g / m^2)^(1/5) in SI equals

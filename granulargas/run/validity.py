@@ -18,7 +18,7 @@ dissipated in the collisions involved by an amount of their own order, so the
 relative error of the cooling rate is of order ``f``. We warn when ``f`` exceeds
 2 %, i.e. ``t_c / t_free > TC_RATIO_WARN = 0.01``: the same 2 % that
 :mod:`granulargas.run.advise` takes as the default tolerance of T(t). The duration
-``t_c = tau_c(beta) rho^(-2/5) g^(-1/5)`` (seed eq. 2 rescaled) needs the
+``t_c = tau_c(beta) rho^(-2/5) g^(-1/5)`` (Schwager & Pöschel (1997), eq. (2), rescaled) needs the
 stiffness rho, known only on the material route; the ``damping`` route fixes
 beta alone (hard spheres: ``t_c -> 0``), and the ratio is then reported as not
 determined. For the TC model the ratio ``tc_time / t_free`` is reported (a
@@ -141,7 +141,7 @@ def gas_from_config(config) -> RunGas:
 def contact_time_ratio(config_or_gas, temperature: float | None = None) -> float | None:
     """Collision-averaged contact duration over the mean free time, ``<t_c> omega``.
 
-    Material route: ``t_c = tau_c(beta) rho^(-2/5) g^(-1/5)`` (seed eq. 2 rescaled;
+    Material route: ``t_c = tau_c(beta) rho^(-2/5) g^(-1/5)`` (Schwager & Pöschel (1997), eq. (2), rescaled;
     SI, then divided by the time unit diameter / speed_unit). TC model: ``tc_time
     omega``. Otherwise None (the damping route does not fix the stiffness).
 

@@ -117,7 +117,7 @@ def compressibility_factor(eta, dim=3, form="closed"):
     ``form="closed"``: Carnahan–Starling ``(1 + eta + eta^2 - eta^3)/(1 - eta)^3`` (3D)
     or Henderson ``(1 + eta^2/8)/(1 - eta)^2`` (2D).
     ``form="virial"``: ``1 + 2^(d-1) eta chi(eta)`` (identical in 3D, to O(eta^3)
-    in 2D; physics.md section 5).
+    in 2D).
     """
     _check_dim(dim)
     eta = np.asarray(eta, dtype=float)
@@ -241,7 +241,7 @@ def temperature_vs_collisions(s, eps, dim=3, a2=None, T0=1.0):
 
     ``T = T0 exp(-(1 - eps^2)(1 + 3 a2/16) s / d)``: ``dT/ds = -zeta T / omega``
     with ``zeta / omega = (1 - eps^2)(1 + 3 a2/16)/d`` (the ``a2`` correction of
-    omega itself is left out, as in physics.md section 2). Independent of density.
+    omega itself is left out). Independent of density.
     """
     if a2 is None:
         a2 = sonine_a2(eps, dim)
@@ -285,7 +285,7 @@ def instability_length(eps, n, dim=3, sigma=1.0, chi=None, a2=None):
         ``L_c = 2 pi / k_c = 2 pi sqrt(2 eta_s / (zeta n m))``.
 
     Dilute limit: ``L_c = 10.78 l / sqrt(1 - eps^2)`` (3D) and ``10.03 l / sqrt(1 - eps^2)``
-    (2D), with ``l`` the mean free path (physics.md section 4 quotes ~10 l).
+    (2D), with ``l`` the mean free path (Goldhirsch & Zanetti 1993 quote ~10 l).
     Density clusters (the longitudinal mode) follow the shear modes nonlinearly.
 
     Returns

@@ -176,7 +176,7 @@ def test_bad_set_override_in_process(tmp_path, capsys):
 
 
 def test_summary_reports_validity_and_advice(case):
-    """Issue 7: the run summary says whether a constant eps would do and reports the model range."""
+    """The run summary says whether a constant eps would do and reports the model range."""
     visco = GOOD.replace('model = "constant"\nrestitution = 0.9', 'model = "viscoelastic"\ndamping = 0.1')
     rc, out, err, _, _ = case(visco, "--overwrite")
     assert rc == 0, err

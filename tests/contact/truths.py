@@ -1,6 +1,6 @@
 """Independent truths for the contact tests (closed forms, not computed by the package).
 
-C1, C2: Ramirez, Poeschel, Brilliantov & Schwager, PRE 60, 4465 (1999); physics notes.
+C1, C2: Ramirez, Poeschel, Brilliantov & Schwager, PRE 60, 4465 (1999).
 HERTZ_DURATION: elastic (Hertz) contact duration (4/5)(5/4)^{2/5} B(2/5, 1/2).
 """
 

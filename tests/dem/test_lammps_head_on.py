@@ -1,4 +1,4 @@
-"""Two spheres head-on in LAMMPS vs the viscoelastic contact ODE (seed eq. 2).
+"""Two spheres head-on in LAMMPS vs the viscoelastic contact ODE (Schwager & Pöschel (1997), eq. (2)).
 
 LAMMPS ``pair_style granular`` (hertz/material + damping viscoelastic, mapped
 by :class:`granulargas.dem.lammps.DemContact`) is an independent integrator of
@@ -86,7 +86,7 @@ def test_first_order_convergence_in_timestep(tmp_path, end):
 
 @needs_lmp
 def test_impact_speed_scaling(tmp_path):
-    """One material, two impact speeds: beta scales as g^{1/5} (seed eq. 2 scaling)."""
+    """One material, two impact speeds: beta scales as g^{1/5} (Schwager & Pöschel (1997), eq. (2), rescaled)."""
     contact = _contact(1.0, "force", speed=1.0)
     speed = 0.05
     beta = contact.beta(speed, 0.25, 0.5)

@@ -1,4 +1,4 @@
-"""The seed-eq.-2 <-> LAMMPS parameter mapping and the log parser (no LAMMPS needed)."""
+"""The mapping of Schwager & Pöschel (1997), eq. (2), to LAMMPS parameters, and the log parser (no LAMMPS needed)."""
 
 import math
 
@@ -28,7 +28,7 @@ def lammps_normal_force(E, nu, eta_n0, r1, r2, m1, m2, delta, delta_dot, limit_d
 
 
 def seed_force(Y, nu, A, r_eff, m_eff, xi, xi_dot):
-    """Seed eq. (2): F = m_eff rho sqrt(xi) (xi + (3/2) A xi')."""
+    """Schwager & Pöschel (1997), eq. (2): F = m_eff rho sqrt(xi) (xi + (3/2) A xi')."""
     rho = 2.0 * Y * math.sqrt(r_eff) / (3.0 * m_eff * (1.0 - nu**2))
     return m_eff * rho * math.sqrt(xi) * (xi + 1.5 * A * xi_dot)
 
@@ -44,7 +44,7 @@ def test_lammps_force_equals_seed_force(seed):
     for xi, xi_dot in [(1e-3, 0.7), (2e-4, -0.3), (1e-5, -2.0)]:
         f_l = lammps_normal_force(Y, nu, contact.eta_n0(m_eff), r1, r2, m1, m2, xi, xi_dot, False)
         assert f_l == pytest.approx(seed_force(Y, nu, A, r_eff, m_eff, xi, xi_dot), rel=1e-12)
-    # the physics.md form of the mapping: eta_n0 = 3 A rho / (2 sqrt(R_eff))
+    # the form of the mapping in docs/interoperability.md: eta_n0 = 3 A rho / (2 sqrt(R_eff))
     assert contact.eta_n0(m_eff) == pytest.approx(1.5 * A * contact.rho(r_eff, m_eff) / math.sqrt(r_eff), rel=1e-13)
 
 
@@ -72,7 +72,7 @@ def test_pair_coeff_line():
 
 
 def test_hertz_duration_and_stiffness():
-    # (4/5)(5/4)^{2/5} B(2/5, 1/2) = 3.218 (physics.md)
+    # (4/5)(5/4)^{2/5} B(2/5, 1/2) = 3.218 (Hertz)
     assert HERTZ_DURATION == pytest.approx(3.2180, abs=1e-4)
     Y = stiffness_for_contact_time(0.004, 2.0, 0.25, 0.5, 0.3)
     c = DemContact(Y, 0.3, 0.0)

@@ -33,7 +33,7 @@ C1 = 1.15344
 
 
 def pade_eps(beta):
-    """Müller & Pöschel (2011) Padé approximant of the viscoelastic eps(beta) (physics.md)."""
+    """Müller & Pöschel (2011) Padé approximant of the viscoelastic eps(beta)."""
     u = np.sqrt(beta)
     a = 2.0 / (3.0 * C1**2)
     return (1 + a * u) / (1 + a * u + C1 * u**2 + a * C1 * u**3 + 0.4 * C1**2 * u**4)

@@ -12,7 +12,7 @@ from granulargas.run import validity as V
 from granulargas.errors import ConfigError
 from granulargas.io.config import parse_config
 
-HERTZ_TAU = 3.2180654  # (4/5)(5/4)^(2/5) B(2/5, 1/2), physics.md
+HERTZ_TAU = 3.2180654  # (4/5)(5/4)^(2/5) B(2/5, 1/2), the Hertz duration
 
 
 def config(collision, run="end_time = 100.0", system="dimension = 3\nparticles = 2000\npacking_fraction = 0.1"):

@@ -229,7 +229,7 @@ def test_viscoelastic_tau0_against_brilliantov_poeschel_material_form():
     T = T0 (1 + t/tau0)^(-5/3),  1/tau0 = (16/5) q0 delta / tau_c(0),
     q0 = 2^(1/5) Gamma(21/10) C1 / 8 ~ 0.173, delta = A kappa^(2/5) T0^(1/10) (m = 1),
     1/tau_c(0) = 4 sqrt(pi) chi n sigma^2 sqrt(T0 / m).
-    Our side starts from SI-like material constants converted with the seed's
+    Our side starts from SI-like material constants converted with Schwager & Pöschel (1997)'s
     rho and the ARCHITECTURE.md prefactor k = (3/2) A (2Y/(3(1 - nu^2)))^(2/5)
     (beta = (3/2) A rho^(2/5) g^(1/5), the factor 3/2 that papers expanding in
     q = 2 beta/3 do not carry).
@@ -244,7 +244,7 @@ def test_viscoelastic_tau0_against_brilliantov_poeschel_material_form():
     beta = k * (R_eff * g / m_eff**2) ** 0.2
     assert beta == pytest.approx(A * kappa**0.4 * g**0.2, rel=1e-12)
     rho = 2 * Y * math.sqrt(R_eff) / (3 * m_eff * (1 - nu**2))
-    assert beta == pytest.approx(1.5 * A * rho**0.4 * g**0.2, rel=1e-12)  # seed eq. (32)
+    assert beta == pytest.approx(1.5 * A * rho**0.4 * g**0.2, rel=1e-12)  # Schwager & Pöschel (1997), eq. (32)
     # tau0
     eta, T0 = 0.1, 1.0
     n = th.number_density(eta, 3)

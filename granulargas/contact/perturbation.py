@@ -1,12 +1,13 @@
-"""The seed's own series route to C1, C2 and the first-order duration (seed eqs. 9-33).
+"""The perturbation route of Schwager & Pöschel (1997) to C1, C2 and the first-order duration
+(their eqs. (9)-(33)).
 
-In our rescaled units (seed with v = 1 and alpha v^{1/5} -> beta) the compression
-is expanded in the damping (seed eq. 14),
+In the rescaled units used here (theirs with v = 1 and alpha v^{1/5} -> beta) the
+compression is expanded in the damping (their eq. (14)),
 
     x(t) = x0(t) + beta x1(t) + beta^2 x2(t) + ...,
 
 with x0 the elastic (Hertz) solution. Near t = 0 the x_k are Puiseux series in
-sqrt(t) (seed eq. 13):
+sqrt(t) (their eq. (13)):
 
     x0 = t - (4/35) t^{7/2} + (1/175) t^6 + ...,
     x1 = -(4/15) t^{5/2} + (3/70) t^5 + ...,
@@ -19,8 +20,8 @@ Away from 0 we integrate the perturbation hierarchy in t (expanding the ODE in b
     x2'' = -sqrt(x0) x1' - x1 x0' / (2 sqrt(x0)) - (3/2) sqrt(x0) x2 - (3/8) x1^2 / sqrt(x0),
 
 started at a small t0 from the Puiseux values (the singular start is handled by
-the series, as the seed suggests), up to the elastic turning point
-Theta_c^0 / 2 (where x0' = 0; Theta_c^0 = Hertz duration). The seed then matches
+the series, as they suggest), up to the elastic turning point
+Theta_c^0 / 2 (where x0' = 0; Theta_c^0 = Hertz duration). They then match
 the direct collision with the time-reversed ("inverse") collision at maximum
 compression (eqs. 16-29) and reads off (eq. 30)
 
@@ -41,9 +42,9 @@ from scipy.integrate import solve_ivp
 
 
 def puiseux_x(t, beta, order: int = 3):
-    """Seed eq. 13 (v = 1): x(t) through beta^order (order <= 3), and x'(t).
+    """Schwager & Pöschel (1997), eq. (13) (v = 1): x(t) through beta^order (order <= 3), and x'(t).
 
-    Keeps the terms printed in the seed: t, t^{5/2}, t^{7/2}, t^4, t^5, t^{11/2}, t^6.
+    Keeps the terms printed there: t, t^{5/2}, t^{7/2}, t^4, t^5, t^{11/2}, t^6.
     """
     t = np.asarray(t, dtype=float)
     terms = [  # (coefficient, power of beta, power of t)
@@ -94,8 +95,8 @@ def perturbation_solution(t_end: float = None, t0: float = 1e-3, rtol: float = 1
 
 
 @dataclass(frozen=True)
-class SeedConstants:
-    """Quantities of the seed's route at the elastic turning point Theta_c^0 / 2."""
+class PerturbationConstants:
+    """Quantities of the perturbation route at the elastic turning point Theta_c^0 / 2."""
 
     theta_c0: float        # elastic duration (Hertz), 2 x turning time
     x0: float              # x0(Theta_c^0 / 2) = (5/4)^{2/5}
@@ -104,14 +105,14 @@ class SeedConstants:
     x1_dot: float
     x0_ddot: float
     delta1: float          # eq. 20: delta = beta * delta1 + O(beta^2)
-    beta26: float          # eq. 26 (the seed calls it beta; cancels from C2)
+    beta26: float          # eq. 26 (called beta there; cancels from C2)
     C1: float              # eq. 30
     C2: float              # eq. 30
     duration_slope: float  # eq. 33: d tau_c / d beta at 0 = Theta_c^0 C1 / 10
 
 
-def seed_constants(t0: float = 1e-3, rtol: float = 1e-13) -> SeedConstants:
-    """C1, C2 and the first-order duration by the seed's route (eqs. 13-33)."""
+def perturbation_constants(t0: float = 1e-3, rtol: float = 1e-13) -> PerturbationConstants:
+    """C1, C2 and the first-order duration by the route of Schwager & Pöschel (1997) (eqs. 13-33)."""
     sol, t_m = perturbation_solution(None, t0=t0, rtol=rtol)
     x0, v0, x1, v1, x2, v2 = sol(t_m)
     x0_ddot = -x0 ** 1.5
@@ -123,7 +124,7 @@ def seed_constants(t0: float = 1e-3, rtol: float = 1e-13) -> SeedConstants:
     r2 = r1 ** 2 / 10 + 1.25 * r1 * ratio
     C1 = -r1
     theta = 2 * t_m
-    return SeedConstants(
+    return PerturbationConstants(
         theta_c0=theta, x0=x0, x1=x1, x2=x2, x1_dot=v1, x0_ddot=x0_ddot,
         delta1=-v1 / x0_ddot,
         beta26=x2 - 0.5 * v1 ** 2 / x0_ddot,
