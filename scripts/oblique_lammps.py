@@ -3,6 +3,8 @@
 ``python scripts/oblique_lammps.py [--angles 0 30 60 80 88] [--betas 0.1 0.5 1.0] [--deltas 0.01 0.1]
 [--steps 100 200 400 800 1600] [--ends overlap force] [--workdir DIR] [--figure PNG] [--json FILE]``
 
+writes ``docs/figures/contact_oblique_lammps.png`` and ``runs/oblique_lammps/results.json`` by default.
+
 For every impact angle theta (tan theta = g_t / g_n), damping beta (at the
 normal speed g_n = 1) and compression scale delta = X / D (third parameter of
 :mod:`granulargas.contact.oblique`; sets the stiffness through
@@ -227,7 +229,7 @@ def main(argv=None):
     parser.add_argument("--ends", nargs="+", default=["overlap", "force"], choices=["overlap", "force"])
     parser.add_argument("--no-unequal", action="store_true", help="skip the unequal pair")
     parser.add_argument("--workdir", type=Path, default=Path("runs/oblique_lammps"))
-    parser.add_argument("--figure", type=Path, default=Path("runs/oblique_lammps.png"))
+    parser.add_argument("--figure", type=Path, default=ROOT / "docs" / "figures" / "contact_oblique_lammps.png")
     parser.add_argument("--json", type=Path, default=None, help="default: WORKDIR/results.json")
     args = parser.parse_args(argv)
 
