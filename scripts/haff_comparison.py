@@ -77,7 +77,7 @@ def seed_band(analyses, grid):
     """T/T_theory of each seed interpolated on ``grid`` (in t/tau0_theory): mean, std."""
     rows = []
     for a in analyses:
-        t = a.history.time - a.t_start
+        t = a.history.time - a.t_offset
         x = t / a.prediction.tau0
         r = a.history.temperature / a.prediction.temperature(t)
         rows.append(np.interp(grid, x, r, left=np.nan, right=np.nan))
@@ -114,10 +114,10 @@ def figure_cooling(cases, path):
     for key, (label, analyses) in cases.items():
         c = colors[key]
         p = analyses[0].prediction
-        xmax = min((a.history.time[-1] - a.t_start) / p.tau0 for a in analyses)
+        xmax = min((a.history.time[-1] - a.t_offset) / p.tau0 for a in analyses)
         grid = np.geomspace(1e-2, xmax, 300)
         for i, a in enumerate(analyses):
-            t = a.history.time - a.t_start
+            t = a.history.time - a.t_offset
             m = t > 0
             ax[0, 0].loglog(t[m] / p.tau0, a.history.temperature[m] / p.T0, color=c, lw=0.6, alpha=0.6,
                             label=f"{label} ({len(analyses)} seeds)" if i == 0 else None)
@@ -130,8 +130,8 @@ def figure_cooling(cases, path):
         ax[0, 1].semilogx(grid, mean, color=c, label=label)
         ax[0, 1].fill_between(grid, mean - std, mean + std, color=c, alpha=0.25, lw=0)
         # local exponent of the seed-averaged curve, against ln(1 + t/tau0)
-        tt = analyses[0].history.time - analyses[0].t_start
-        TT = np.mean([np.interp(tt, a.history.time - a.t_start, a.history.temperature) for a in analyses], axis=0)
+        tt = analyses[0].history.time - analyses[0].t_offset
+        TT = np.mean([np.interp(tt, a.history.time - a.t_offset, a.history.temperature) for a in analyses], axis=0)
         sel = np.unique(np.searchsorted(tt, np.geomspace(0.05 * p.tau0, tt[-1], 25)).clip(0, tt.size - 1))
         tm, slope = local_exponent(tt[sel], TT[sel], p.tau0)
         ax[1, 0].semilogx(tm / p.tau0, slope, "o-", color=c, ms=3, label=label)
@@ -176,10 +176,10 @@ def figure_instability(small, large, path):
     for g, c in ((small, "C0"), (large, "C3")):
         a = g[0]
         p = a.prediction
-        t = a.history.time - a.t_start
+        t = a.history.time - a.t_offset
         m = t > 0
         L = a.info.box[0]
-        r = np.array([np.interp(t, b.history.time - b.t_start, b.history.temperature) for b in g]) / p.temperature(t)
+        r = np.array([np.interp(t, b.history.time - b.t_offset, b.history.temperature) for b in g]) / p.temperature(t)
         lab = f"L = {L:.0f} = {L / p.instability_length:.2f} $L_c$ (N = {a.info.particles}"
         lab += f", mean of {len(g)} seeds)" if len(g) > 1 else ")"
         ax0.semilogx(t[m] / p.tau0, r.mean(axis=0)[m], color=c, label=lab)
@@ -287,8 +287,8 @@ def main(argv=None):
                        for s in seeds2])
     for g in groups:
         a = g[0]
-        t = a.history.time - a.t_start
-        r = np.array([np.interp(t, b.history.time - b.t_start, b.history.temperature) for b in g]) / a.prediction.temperature(t)
+        t = a.history.time - a.t_offset
+        r = np.array([np.interp(t, b.history.time - b.t_offset, b.history.temperature) for b in g]) / a.prediction.temperature(t)
         print(f"\n2D eps = {eps}, packing {eta2}: L = {a.info.box[0]:.1f} = {a.info.box[0] / lc:.2f} L_c (N = {a.info.particles},"
               f" {len(g)} seeds): T/T_Haff at t = {t[-1] / tau2:.0f} tau0: {r[:, -1].mean():.3f}"
               f" (seeds {', '.join(f'{x:.3f}' for x in r[:, -1])}), largest seed-mean {r.mean(axis=0).max():.3f}")

@@ -136,10 +136,9 @@ def test_restart_into_a_new_file_keeps_the_absolute_clock(small_3d, write_config
     run_config(load_config(path, {"initial.from": str(stopped), "output.file": str(new)}))
     times = [s.time for s in iter_snapshots(new)]
     assert times[0] == t_s and times[-1] == 4.0
-    a = analyze_cooling(new, with_sonine=False)
-    assert a.history.time[0] == t_s and a.t_start == t_s  # analysis reads the file's clock
-    T0 = a.history.temperature[0]
-    assert a.prediction.temperature(t_s) == pytest.approx(T0, rel=1e-12)
+    a = analyze_cooling(new, with_sonine=False, with_theory=False)
+    assert a.history.time[0] == t_s and a.t_offset == t_s  # analysis reads the file's clock
+    assert a.summary()["t_start"] == t_s
 
 
 def test_append_refuses_other_physics_and_changes_nothing(small_3d, write_config, tmp_path, capsys):
