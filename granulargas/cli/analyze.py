@@ -215,8 +215,8 @@ def run(args) -> int:
     try:
         a = analyze_file(args.file, t_range=tuple(args.fit_range) if args.fit_range else None,
                          with_sonine=not args.no_snapshots)
-    except ValueError as exc:
-        raise InputFileError(f"{args.file}: cannot analyse ({exc})") from None
+    except (ValueError, ArithmeticError) as exc:  # numbers no run of ours writes (a damaged file)
+        raise InputFileError(f"{args.file}: cannot analyse ({exc or type(exc).__name__})") from None
     if args.json:
         print(json.dumps(a.summary(), indent=1, ensure_ascii=False))
     else:

@@ -339,8 +339,10 @@ def _continuation_point(f, path, particles, dimension, last_collision, step, tim
             part["position/time"][frames - 1]) != time:
         raise InputFileError(f"{path}: its last frame is not the state the continuation starts from")
     names = list(f["observables"])
-    if "temperature" not in names:
-        raise InputFileError(f"{path}: damaged H5MD file: observables/temperature is missing")
+    for name in SCALAR_OBSERVABLES + ("momentum",):  # the writer appends to every one of them
+        g = f["observables"].get(name)
+        if not isinstance(g, h5py.Group) or any(not isinstance(g.get(p), h5py.Dataset) for p in ("step", "time", "value")):
+            raise InputFileError(f"{path}: damaged H5MD file: observables/{name} is missing or incomplete")
     obs_step, obs_time = f["observables/temperature/step"][()], f["observables/temperature/time"][()]
     hits = np.nonzero((obs_step == step) & (obs_time == time))[0]
     if len(hits) == 0:
@@ -521,6 +523,16 @@ def _snapshot(f, k, static) -> Snapshot:
     part = f["particles/all"]
     radii, masses, species = static
     lc = part["last_collision/value"][k] if "last_collision" in part else None
+    snap = _read_snapshot(part, k, radii, masses, species, lc)
+    for name in ("positions", "velocities", "box"):
+        if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
+            raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")
+    if not np.isfinite(snap.time):
+        raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} has time {snap.time}")
+    return snap
+
+
+def _read_snapshot(part, k, radii, masses, species, lc) -> Snapshot:
     return Snapshot(
         index=k,
         time=float(part["position/time"][k]),
@@ -538,7 +550,12 @@ def _snapshot(f, k, static) -> Snapshot:
 
 def _static(f):
     part = f["particles/all"]
-    return part["radius"][()], part["mass"][()], part["species"][()]
+    radii, masses = part["radius"][()], part["mass"][()]
+    for name, values in (("radius", radii), ("mass", masses)):
+        if not np.all(np.isfinite(values) & (values > 0)):
+            raise InputFileError(f"{f.filename}: damaged H5MD file: particles/all/{name} holds non-finite or "
+                                 "non-positive values")
+    return radii, masses, part["species"][()]
 
 
 def iter_snapshots(path) -> Iterator[Snapshot]:
@@ -592,11 +609,17 @@ def read_observables(path) -> dict:
                 if any(g[p].dtype.kind not in "fiu" for p in ("step", "time", "value")):
                     raise InputFileError(f"{path}: damaged H5MD file: observables/{name} holds values that are "
                                          "not numbers")
-                if g["step"].ndim != 1 or g["time"].ndim != 1 or g["value"].ndim < 1:
+                want = 1 if name in SCALAR_OBSERVABLES else 2 if name == "momentum" else g["value"].ndim
+                if g["step"].ndim != 1 or g["time"].ndim != 1 or g["value"].ndim != max(want, 1):
                     raise InputFileError(f"{path}: damaged H5MD file: observables/{name} has step/time/value "
                                          f"of shapes {g['step'].shape}, {g['time'].shape}, {g['value'].shape}")
                 n = min(g["step"].shape[0], g["time"].shape[0], g["value"].shape[0])
                 out[name] = (g["step"][:n], g["time"][:n], g["value"][:n])
+                values = out[name][2]
+                if not np.all(np.isfinite(out[name][1])) or (  # NaN: a sample the writer was not given
+                        name in ("temperature", "kinetic_energy") and np.any((values < 0) | np.isinf(values))):
+                    raise InputFileError(f"{path}: damaged H5MD file: observables/{name} holds infinite or "
+                                         "negative values")
     return out
 
 

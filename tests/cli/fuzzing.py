@@ -429,7 +429,7 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
 KEY_RE = re.compile(r"\b(system|particles|initial|collision|run|output)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
 
 
-def check_outcome(o: Outcome, before: dict, after: dict, *, output_made: bool = True):
+def check_outcome(o: Outcome, before: dict, after: dict, *, output_made: bool = True, long_runs: bool = False):
     """What every example must satisfy (the brief of the fuzz tests):
 
     * exit 0 (a result), 2 (bad input: one line on stderr naming the key or the file,
@@ -444,6 +444,7 @@ def check_outcome(o: Outcome, before: dict, after: dict, *, output_made: bool = 
     assert o.code is not None, f"hang: no exit within the bound after SIGINT\n{o.stderr[-2000:]}"
     assert "Traceback" not in o.stderr, o.stderr[-3000:]
     if o.interrupted_by_bound:
+        assert long_runs, f"no result within {o.seconds:.3g} s: a hang\n{o.stderr[-2000:]}"
         assert o.code in (0, 2, 3, 130), (o.code, o.stderr)
     else:
         assert o.code in (0, 2, 3), (o.code, o.stderr[-2000:])

@@ -86,7 +86,7 @@ def check_run(mc: MutatedConfig):
         before = _snapshot_tree(d)
         o = invoke(argv, d, bound=BOUND)
         after = _snapshot_tree(d)
-        check_outcome(o, before, after)
+        check_outcome(o, before, after, long_runs=True)
         if o.code == 0 or o.code == 130:
             outputs = [d / p for p in set(after) - set(before) if p.endswith(".h5")]
             assert len(outputs) == 1, (after, o.stdout)
