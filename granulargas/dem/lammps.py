@@ -543,7 +543,12 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     young = stiffness_for_contact_time(t_contact, g_thermal, r_eff, m_eff, poisson_ratio)
     contact = DemContact.from_prefactor(prefactor, young, poisson_ratio, end)
     # timestep <= t_contact / steps_per_contact, and a whole number of steps to end_time
-    steps = int(math.ceil(end_time * steps_per_contact / t_contact - 1e-9))
+    steps = end_time * steps_per_contact / t_contact
+    if not (1.0 - 1e-9 <= steps <= 2**53):  # at least one whole time step, an exact step count
+        raise UserError(f"{source + ': ' if source else ''}run.end_time (or --end-time) = {end_time:g}: "
+                        f"{steps:.3g} time steps of {t_contact / steps_per_contact:.3g} "
+                        "(contact time / steps per contact); a LAMMPS run takes 1 to 2^53 of them")
+    steps = int(math.ceil(steps - 1e-9))
     dt = end_time / steps
     thermo_interval = end_time / 200.0 if thermo_interval is None else thermo_interval
     thermo_every = max(1, int(round(thermo_interval / dt)))

@@ -44,6 +44,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
+from granulargas.errors import ConfigError
 from granulargas.run import validity as V
 from granulargas.run.prepare import mean_particle
 from granulargas.theory.gas import cooling_curve
@@ -151,17 +152,23 @@ def _box(config) -> float:
     return (s.particles * float(theory.particle_volume(sigma, s.dimension)) / s.packing_fraction) ** (1.0 / s.dimension)
 
 
-def _equivalent_prefactor(gas: V.Gas, eps: float) -> float:
-    """Prefactor k whose viscoelastic gas has (1 - eps^2)_eff(T0) = 1 - eps^2."""
+def _equivalent_prefactor(gas: V.Gas, eps: float) -> float | None:
+    """Prefactor k whose viscoelastic gas has (1 - eps^2)_eff(T0) = 1 - eps^2; None if no beta
+    at the thermal impact speed up to 20 gives it (eps below what the table's range reaches)."""
     target = 1.0 - eps**2
 
     def f(log_k):
         g = replace(gas, model="viscoelastic", prefactor=math.exp(log_k))
         return V.effective_inelasticity(g, gas.temperature) - target
 
-    # bracket in the pair constant b of the gas's particles: b = k (R_eff / m_eff^2)^(1/5)
-    scale = replace(gas, model="viscoelastic", prefactor=1.0).pair_constant
-    return math.exp(brentq(f, math.log(1e-8 / scale), math.log(20.0 / scale), xtol=1e-10))
+    # bracket in beta = b g^(1/5) at the thermal impact speed g ~ sqrt(2 T / m) of the gas's
+    # particles, b = k (R_eff / m_eff^2)^(1/5) their pair constant
+    g_thermal = math.sqrt(2.0 * gas.temperature / gas.mass)
+    scale = replace(gas, model="viscoelastic", prefactor=1.0).pair_constant * g_thermal**0.2
+    lo, hi = math.log(1e-8 / scale), math.log(20.0 / scale)
+    if not (math.isfinite(lo) and math.isfinite(hi)) or f(lo) * f(hi) > 0:
+        return None
+    return math.exp(brentq(f, lo, hi, xtol=1e-10))
 
 
 def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.CoolingCurve:
@@ -175,6 +182,9 @@ def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.Cooling
 def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     """Advice on the collision rule for a config (module doc)."""
     gas = V.gas_from_config(config)
+    table = V.table_range_error(gas)
+    if table:
+        raise ConfigError(table)
     t_end, T_end = V.run_temperature_range(gas)
     adv = Advice(gas.model, tolerance, t_end, T_end / gas.temperature, box=_box(config))
     notes = []
@@ -197,6 +207,11 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     elif gas.model == "constant" and gas.restitution < 1.0:
         eps = gas.restitution
         k = _equivalent_prefactor(gas, eps)
+        adv.eps_best = eps
+        if k is None:
+            adv.notes = (f"eps = {eps:g}: no viscoelastic damping within the restitution table's range cools "
+                         "at this rate",)
+            return adv
         ve = replace(gas, model="viscoelastic", prefactor=k)
         curve = V.viscoelastic_cooling(ve)
         curve = _curve_through(ve, curve, t_end)
@@ -227,7 +242,7 @@ def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
         return (f"advice       eps {sp['eps_min']:.3f}..{sp['eps_max']:.3f} over the run; best constant "
                 f"eps = {adv.eps_best:.4f} {verdict} (T(t) off by {100 * adv.error:.2g} %, "
                 f"tolerance {100 * tolerance:g} %)")
-    if adv.model == "constant":
+    if adv.model == "constant" and adv.damping_equivalent is not None:
         return (f"advice       constant eps = {adv.eps_best:g} ~ damping {adv.damping_equivalent:.3g}; a viscoelastic "
                 f"gas would differ by up to {100 * adv.error:.2g} % in T(t) over this run")
     return None

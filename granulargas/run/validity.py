@@ -77,6 +77,7 @@ from granulargas import theory
 from granulargas.contact import restitution_table
 from granulargas.contact.material import rho_from_material
 from granulargas.errors import ConfigError
+from granulargas.io.config import TABLE_BETA_MAX
 from granulargas.run.prepare import mean_particle, reduced_prefactor
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
@@ -234,10 +235,28 @@ class RunValidity:
         return out
 
 
+def table_range_error(gas: RunGas) -> str | None:
+    """One line when fast thermal impacts (the 0.9999 quantile at T0) reach beta beyond the
+    restitution table (``io.config.TABLE_BETA_MAX``); None otherwise or for other models."""
+    if gas.model != "viscoelastic" or not gas.pair_constant > 0:
+        return None
+    beta = float(gas.beta(impact_speed_quantile(0.9999, gas.temperature, gas.mass)))
+    if beta <= TABLE_BETA_MAX / 1.01:
+        return None
+    key = "collision.material" if gas.material is not None else "collision.damping"
+    return (f"{gas.source}: {key}: fast thermal impacts reach beta = {beta:.3g}, beyond the restitution "
+            f"table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well below 3)")
+
+
 def check_run(config) -> RunValidity:
     """All run-level checks for a config (module doc); no simulation."""
     gas = config if isinstance(config, RunGas) else gas_from_config(config)
     src = gas.source
+    table = table_range_error(gas)
+    if table:  # the predictions below would need the table beyond its range
+        rv = RunValidity(gas, math.nan, gas.temperature, math.nan)
+        rv.errors.append(table)
+        return rv
     spread = curve = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = viscoelastic_cooling(gas)

@@ -137,6 +137,8 @@ def _property_run(mc):
 @example(case("constant-3d", ("particles.mass", 5e-324), ("system.dimension", 0), ("system", ...)))  # ZeroDivision
 @example(case("constant-3d", ("system", "\x1e")))  # a record separator in the value split the line
 @example(case("constant-3d", ("particles.mass!", 1e-50)))  # hang in the engine's calendar (pacing stops)
+@example(case("constant-3d", ("particles.mass", 6.666666666666668e49)))  # ValueError in advise's bracket
+@example(case("material-3d", ("collision.material.young_modulus", 2**63 - 1)))  # table range: exit 3, not 2
 # the cases
 @example(case("constant-3d", ("particles.mass", 1e-300)))
 @example(case("constant-3d", ("system.packing_fraction", 1e-300)))
@@ -161,6 +163,8 @@ def _property_advise(mc):
 
 @settings(parent=FAST, max_examples=40)
 @given(mutated_config())
+@example(case("material-3d", ("system", ...), ("collision.material.young_modulus", 2**63 - 1)))  # exit 3
+@example(case("constant-3d", ("particles.mass", 6.666666666666668e49)))  # ValueError in the bracket
 def test_advise_any_config(mc):
     _property_advise(mc)
 
@@ -180,6 +184,7 @@ def _property_export(mc):
 
 @settings(parent=FAST, max_examples=30)
 @given(mutated_config(bases=("viscoelastic-2d", "material-3d", "polydisperse-elastic")))
+@example(case("viscoelastic-2d", ("run.end_time", 1e-300)))  # ZeroDivisionError: no whole time step
 def test_export_lammps_any_config(mc):
     _property_export(mc)
 
