@@ -47,7 +47,7 @@ from pathlib import Path
 import h5py
 
 from granulargas.errors import ConfigError, InputFileError
-from granulargas.io.config import load_config
+from granulargas.io.config import load_config, parse_config
 from granulargas.io.paths import existing_directory
 from granulargas.io.sweep_index import INDEX_NAME, read_index, write_index
 from granulargas.run.runner import run_config
@@ -77,8 +77,9 @@ class Sweep:
         return self.output_dir / INDEX_NAME
 
 
-#: most runs a sweep file may expand to: the run list (about 2 kB per run) must fit in memory
-MAX_RUNS = 10_000_000
+#: most runs a sweep may have: ``index.json`` is rewritten after every run (so that it is always
+#: valid), a cost that grows as the square of the number of runs
+MAX_RUNS = 10_000
 
 
 def _flatten(path: Path, table, prefix: str) -> dict:
@@ -202,8 +203,8 @@ def load_sweep(path: str | os.PathLike, *, validate: bool = True) -> Sweep:
     else:
         total = math.prod(counts)
     if total > MAX_RUNS:
-        raise ConfigError(f"{path}: [vary] gives {total:.3g} runs; at most {MAX_RUNS:.0e} (the list of runs must "
-                          "fit in memory)")
+        raise ConfigError(f"{path}: [vary] gives {total:.4g} runs; at most {MAX_RUNS} (index.json is rewritten "
+                          "after every run); split the sweep")
     value_lists = [_expand_values(path, key, vary[key]) for key in keys]
     combos = list(zip(*value_lists)) if mode == "zip" else list(itertools.product(*value_lists))
     width = max(3, len(str(len(combos) - 1)))
@@ -215,9 +216,13 @@ def load_sweep(path: str | os.PathLike, *, validate: bool = True) -> Sweep:
         overrides = {**fixed, **params, "output.file": file}
         runs.append(RunSpec(name=name, file=file, parameters=params, overrides=overrides))
     if validate:
+        try:  # read once; each run's overrides are validated on it
+            text = base.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise InputFileError(f"{path}: base = {data['base']!r}: cannot read ({exc})") from None
         for spec in runs:
             try:
-                load_config(base, overrides=spec.overrides)
+                parse_config(text, source=str(base), overrides=spec.overrides)
             except ConfigError as exc:
                 params = ", ".join(f"{k}={format_value(v)}" for k, v in spec.parameters.items())
                 raise ConfigError(f"{path}: {spec.name} ({params}): {exc}") from None

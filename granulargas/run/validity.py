@@ -75,9 +75,10 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.contact import restitution_table
-from granulargas.contact.material import rho_from_material
+from granulargas.contact.material import damping_from_prefactor, rho_from_material
 from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX
+from granulargas.theory.moments import speed_quadrature
 from granulargas.run.prepare import mean_particle, reduced_prefactor
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
@@ -236,16 +237,20 @@ class RunValidity:
 
 
 def table_range_error(gas: RunGas) -> str | None:
-    """One line when fast thermal impacts (the 0.9999 quantile at T0) reach beta beyond the
+    """One line when the fastest impacts the kinetic theory integrates over at T0 (its largest
+    speed node, :func:`granulargas.theory.moments.speed_quadrature`) reach beta beyond the
     restitution table (``io.config.TABLE_BETA_MAX``); None otherwise or for other models."""
     if gas.model != "viscoelastic" or not gas.pair_constant > 0:
         return None
-    beta = float(gas.beta(impact_speed_quantile(0.9999, gas.temperature, gas.mass)))
+    u_max = float(np.max(speed_quadrature(gas.dimension).u))
+    beta = float(gas.beta(math.sqrt(2.0 * gas.temperature / gas.mass) * u_max))
     if beta <= TABLE_BETA_MAX / 1.01:
         return None
-    key = "collision.material" if gas.material is not None else "collision.damping"
-    return (f"{gas.source}: {key}: fast thermal impacts reach beta = {beta:.3g}, beyond the restitution "
-            f"table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well below 3)")
+    key = ("collision.material" if gas.material is not None
+           else f"collision.damping = {damping_from_prefactor(gas.prefactor):.6g}")
+    return (f"{gas.source}: {key}: fast thermal impacts ({u_max:.3g} thermal speeds) reach beta = {beta:.3g}, "
+            f"beyond the restitution table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well "
+            "below 3)")
 
 
 def check_run(config) -> RunValidity:
