@@ -87,19 +87,6 @@ def uniform(state):
 
 
 @jit(inline="always")
-def bounded(state, n):
-    """Uniform integer in [0, n) from the sequential stream (Lemire, exact; 0 < n < 2^32)."""
-    m = (next_u64(state) >> _S32) * n
-    low = m & _MASK32
-    if low < n:
-        threshold = (_TWO32 - n) % n
-        while low < threshold:
-            m = (next_u64(state) >> _S32) * n
-            low = m & _MASK32
-    return np.int64(m >> _S32)
-
-
-@jit(inline="always")
 def _bounded32(x, n, seed):
     """Uniform integer in [0, n) from the 32-bit value x (Lemire), re-drawing from
     ``mix64(seed + ...)`` in the rare rejected case; returns (value, seed)."""

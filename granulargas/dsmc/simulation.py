@@ -15,12 +15,7 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.dsmc import _loop
-from granulargas.dsmc._majorant import (
-    build_fast_set,
-    majorant_parts,
-    top_classes,
-)
-from granulargas.dsmc._majorant import build_histogram, fast_set_arrays, new_histogram
+from granulargas.dsmc._majorant import build_histogram, class_edge, new_histogram, top_classes
 from granulargas.dsmc._random import STATE_WORDS, seed_state
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
@@ -159,13 +154,13 @@ class DSMC:
         rec[:, :d] = vel
         self._rec = rec
         self._ring = np.zeros((2, _loop.RING), dtype=np.int64)
-        self._reselect_every = n
 
         scal = np.zeros(_loop.N_SCAL)
         iscal = np.zeros(_loop.N_ISCAL, dtype=np.int64)
         scal[_loop.S_TIME] = float(time)
         scal[_loop.S_DISSIPATED] = float(dissipated_energy)
-        scal[_loop.S_RATE] = chi * collision_solid_angle(d) * sigma_max ** (d - 1) / vol
+        scal[_loop.S_RATE] = (0.5 * n * (n - 1) * chi * collision_solid_angle(d)
+                              * sigma_max ** (d - 1) / vol)
         iscal[_loop.I_COLLISIONS] = int(collisions)
         iscal[_loop.I_ERR_I] = iscal[_loop.I_ERR_J] = -1
         iscal[_loop.I_PENDING_I] = iscal[_loop.I_PENDING_J] = -1
@@ -178,8 +173,7 @@ class DSMC:
             rng = np.array(state["rng"], dtype=np.uint64)
             if frame.shape != (d,) or rng.shape != (STATE_WORDS,):
                 raise ConfigError(f"state: frame_velocity needs shape ({d},) and rng ({STATE_WORDS},)")
-            iscal[_loop.I_PAIR_STREAM] = int(state["pair_stream"])
-            iscal[_loop.I_FAST_CLASS] = int(state["fast_class"])
+            iscal[_loop.I_CANDIDATES] = int(state["candidates"])
             pi, pj = (int(x) for x in state["pending_pair"])
             if pi >= 0:
                 if not (0 <= pi < n and 0 <= pj < n and pi != pj):
@@ -193,12 +187,6 @@ class DSMC:
         self._rng = rng
         self._hist = new_histogram()
         iscal[_loop.I_TOP] = build_histogram(rec, d, scal[_loop.S_FRAME : _loop.S_FRAME + 3], self._hist)
-        self._bits, self._fen = fast_set_arrays(n)
-        if state is None:
-            _loop.reselect_fast(rec, d, self._hist, iscal, scal, self._bits, self._fen)
-        else:
-            iscal[_loop.I_N_FAST] = build_fast_set(rec, d, scal[_loop.S_FRAME : _loop.S_FRAME + 3],
-                                                   iscal[_loop.I_FAST_CLASS], self._bits, self._fen)
         self._scal, self._iscal = scal, iscal
         self._rate_last = float("nan")
         self._acceptance_last = float("nan")
@@ -207,9 +195,7 @@ class DSMC:
     def _rate(self):
         """Current majorant rate Lambda (candidates per unit time)."""
         k1, k2 = top_classes(self._hist, self._iscal[_loop.I_TOP])
-        a, b = majorant_parts(k1, k2, self._iscal[_loop.I_FAST_CLASS])
-        n = self.n
-        return self._scal[_loop.S_RATE] * (0.5 * n * (n - 1) * a + (n - 1) * self._iscal[_loop.I_N_FAST] * b)
+        return self._scal[_loop.S_RATE] * (class_edge(k1) + class_edge(k2))
 
     # ---------------------------------------------------------------------- run
     def run(self, until: float, max_collisions: int | None = None, progress=None) -> "DSMC":
@@ -247,9 +233,8 @@ class DSMC:
         s = self._scal
         while True:
             status = _loop.advance(self._rec, self._rad_k, self._mas_k, self._mono, d, self._hist,
-                                   self._bits, self._fen, self._rng, self._kind, self._fpar,
-                                   self._coeffs, until, target, chunk, self._reselect_every,
-                                   self._ring, s, self._iscal)
+                                   self._rng, self._kind, self._fpar, self._coeffs, until, target,
+                                   chunk, self._ring, s, self._iscal)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
@@ -292,7 +277,7 @@ class DSMC:
 
     @property
     def candidates(self) -> int:
-        """Candidate pairs drawn since construction (accepted or not)."""
+        """Candidate pairs drawn since the seed (accepted or not): the position in the pair stream."""
         return int(self._iscal[_loop.I_CANDIDATES])
 
     @property
@@ -312,15 +297,13 @@ class DSMC:
     def state(self) -> dict:
         """What continues this run bit for bit besides velocities, time and counters.
 
-        ``rng`` (uint64 (5,)), ``pair_stream`` (int, position in the pair
-        stream), ``fast_class`` (int, threshold class of the fast particles),
+        ``rng`` (uint64 (5,)), ``candidates`` (int, position in the pair stream),
         ``frame_velocity`` (d,), ``pending_pair`` ((i, j), or (-1, -1)) and
         ``pending_time`` (float; nan when there is no pending collision): the
         next collision, already drawn.
         """
         d = self.dimension
-        return {"rng": self._rng.copy(), "pair_stream": int(self._iscal[_loop.I_PAIR_STREAM]),
-                "fast_class": int(self._iscal[_loop.I_FAST_CLASS]),
+        return {"rng": self._rng.copy(), "candidates": self.candidates,
                 "frame_velocity": self._scal[_loop.S_FRAME : _loop.S_FRAME + d].copy(),
                 "pending_pair": (int(self._iscal[_loop.I_PENDING_I]), int(self._iscal[_loop.I_PENDING_J])),
                 "pending_time": float(self._scal[_loop.S_NEXT])}
