@@ -13,7 +13,7 @@ Maxwellian, from <c^(2p)>/<c^(2p)>_Maxwell = sum_k (-1)^k binom(p, k) a_k
 expansion for the velocity distribution of granular gases", EPL 74, 424).
 For unequal masses they are the cumulants of the distribution of m c^2.
 
-Finite samples: for N particles of fixed energy and momentum (any elastic
+Finite samples: for N identical particles of fixed energy and momentum (any elastic
 simulation), the exact ensemble averages are a2 = -2/(D+2) and
 a3 = -16/((D+2)(D+4)) with D = d(N - 1), so the a2 estimator is biased by
 about -2/(d N).
