@@ -32,33 +32,43 @@ from granulargas._numba import jit
 
 @jit
 def energy_moments(v, dim, masses):
-    """(T, a2, a3) of the velocities ``v[:, :dim]`` with masses (N,) or one shared mass (1,)."""
+    """(T, a2, a3) of the velocities ``v[:, :dim]`` with masses (N,) or one shared mass (1,).
+
+    The sums run over velocities divided by the largest component, so moments of
+    gases cooled far below unit speeds neither underflow nor lose precision.
+    """
     n = v.shape[0]
     shared = masses.shape[0] == 1
     p0 = 0.0
     p1 = 0.0
     p2 = 0.0
     msum = 0.0
+    vmax = 0.0
     for i in range(n):
         m = masses[0] if shared else masses[i]
         msum += m
         p0 += m * v[i, 0]
         p1 += m * v[i, 1]
+        vmax = max(vmax, abs(v[i, 0]), abs(v[i, 1]))
         if dim == 3:
             p2 += m * v[i, 2]
-    u0 = p0 / msum
-    u1 = p1 / msum
-    u2 = p2 / msum
+            vmax = max(vmax, abs(v[i, 2]))
+    if not vmax > 0.0:
+        return 0.0, np.nan, np.nan
+    scale = 1.0 / vmax
+    u0 = p0 / msum * scale
+    u1 = p1 / msum * scale
+    u2 = p2 / msum * scale
     s1 = 0.0
     s2 = 0.0
     s3 = 0.0
     for i in range(n):
         m = masses[0] if shared else masses[i]
-        c0 = v[i, 0] - u0
-        c1 = v[i, 1] - u1
+        c0 = v[i, 0] * scale - u0
+        c1 = v[i, 1] * scale - u1
         e = c0 * c0 + c1 * c1
         if dim == 3:
-            c2 = v[i, 2] - u2
+            c2 = v[i, 2] * scale - u2
             e += c2 * c2
         e *= m
         s1 += e
@@ -70,7 +80,7 @@ def energy_moments(v, dim, masses):
     r3 = s3 * n * n / (s1 * s1 * s1)
     a2 = dim / (dim + 2.0) * r2 - 1.0
     a3 = 1.0 + 3.0 * a2 - dim * dim / ((dim + 2.0) * (dim + 4.0)) * r3
-    return s1 / (dim * n), a2, a3
+    return s1 * vmax * vmax / (dim * n), a2, a3
 
 
 def _arrays(velocities, masses):

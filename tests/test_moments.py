@@ -65,3 +65,14 @@ def test_bad_shapes():
     with pytest.raises(ValueError):
         sonine_coefficients(np.zeros((5, 3)), np.ones(4))
     assert np.isnan(sonine_a2(np.zeros((5, 3))))
+
+
+def test_scale_invariance_far_from_unit_speeds():
+    rng = np.random.default_rng(4)
+    v = rng.standard_normal((500, 3)) + 0.2
+    a2, a3 = sonine_coefficients(v)
+    t = energy_moments(np.ascontiguousarray(v), 3, np.ones(1))[0]
+    for scale in (1e-150, 1e-100, 1e100, 1e140):
+        t_s, b2, b3 = energy_moments(np.ascontiguousarray(v * scale), 3, np.ones(1))
+        assert t_s == pytest.approx(t * scale**2, rel=1e-12)
+        assert b2 == pytest.approx(a2, rel=1e-12) and b3 == pytest.approx(a3, rel=1e-12)

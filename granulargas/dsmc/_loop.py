@@ -40,7 +40,7 @@ import math
 
 from granulargas._numba import jit
 from granulargas.dsmc._collide import apply_pair_update, normal_part_2d, normal_part_3d
-from granulargas.dsmc._majorant import class_edge, speed_class, top_classes
+from granulargas.dsmc._majorant import build_histogram, class_edge, speed_class, top_classes
 from granulargas.dsmc._random import pair_of, uniform
 from granulargas.engine._collide import VISCOELASTIC, restitution
 from granulargas.engine._prefetch import prefetch
@@ -56,8 +56,7 @@ S_TIME = 0  # time of the last collision (``until`` after DONE)
 S_NEXT = 1  # time of the pending collision
 S_DISSIPATED = 2  # kinetic energy lost in collisions (cumulative)
 S_RATE = 3  # Lambda / G = N (N-1)/2 chi sigma_max^(d-1) B_d / V
-S_FRAME = 4  # 4, 5, 6: frame velocity u of the speed classes
-N_SCAL = 7
+N_SCAL = 4
 
 # iscal slots (int64)
 I_COLLISIONS = 0
@@ -82,20 +81,52 @@ RING = 16  # candidates prefetched ahead (power of two)
 
 
 @jit(inline="always")
-def _class_of(rec, i, dim, fx, fy, fz):
-    """Speed class of particle i relative to the frame velocity."""
-    cx = rec[i, 0] - fx
-    cy = rec[i, 1] - fy
-    w2 = cx * cx + cy * cy
+def _class_of(rec, i, dim):
+    """Speed class of particle i."""
+    w2 = rec[i, 0] * rec[i, 0] + rec[i, 1] * rec[i, 1]
     if dim == 3:
-        cz = rec[i, 2] - fz
-        w2 += cz * cz
+        w2 += rec[i, 2] * rec[i, 2]
     return speed_class(w2)
 
 
 @jit
+def recentre(rec, mass, mono, dim, hist):
+    """Subtract the mass-weighted mean velocity from all velocities; recount the classes.
+
+    Collisions conserve momentum only to rounding, so the mean of the peculiar
+    velocities random-walks at ~1e-16 of their size. A gas that cools by many
+    orders of magnitude would end up slower than that drift, the speeds measured
+    from zero would no longer follow its temperature, and float64 could no longer
+    resolve the velocity differences. Subtracting the mean every few collisions
+    per particle (a change at the rounding level) keeps the velocities peculiar.
+    Returns the highest occupied class.
+    """
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    msum = 0.0
+    n = rec.shape[0]
+    for i in range(n):
+        m = 1.0 if mono else mass[i]
+        msum += m
+        p0 += m * rec[i, 0]
+        p1 += m * rec[i, 1]
+        if dim == 3:
+            p2 += m * rec[i, 2]
+    p0 /= msum
+    p1 /= msum
+    p2 /= msum
+    for i in range(n):
+        rec[i, 0] -= p0
+        rec[i, 1] -= p1
+        if dim == 3:
+            rec[i, 2] -= p2
+    return build_histogram(rec, dim, hist)
+
+
+@jit
 def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, target, budget,
-            ring, scal, iscal):
+            recentre_every, ring, scal, iscal):
     """Collide until ``until``, ``target`` collisions or about ``budget`` candidates.
 
     Parameters
@@ -118,6 +149,8 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
         Stop right after the collision that makes ``iscal[I_COLLISIONS] == target``.
     budget : int
         Return BUDGET after the first collision once this many candidates were drawn.
+    recentre_every : int
+        :func:`recentre` runs after every collision whose count is a multiple of this.
     ring : int64 (2, RING)
         Work space for the pairs ahead (rebuilt on entry; not state).
 
@@ -128,9 +161,6 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
     """
     n = rec.shape[0]
     key = rng[4]
-    fx = scal[S_FRAME]
-    fy = scal[S_FRAME + 1]
-    fz = scal[S_FRAME + 2] if dim == 3 else 0.0
     eps_const = fpar[F_EPS]
     prefactor = fpar[F_PREFACTOR]
     inv_h = fpar[F_INV_H]
@@ -155,6 +185,7 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
         prefetch(rec, a)
         prefetch(rec, b)
     end = k + budget
+    next_recentre = (coll // recentre_every + 1) * recentre_every
     while True:
         if pi < 0:
             # ---- draw candidates until one is accepted; its time is the sum of the gaps
@@ -234,8 +265,8 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
             iscal[I_ERR_J] = j
             status = TABLE_RANGE
             break
-        oi = _class_of(rec, i, dim, fx, fy, fz)
-        oj = _class_of(rec, j, dim, fx, fy, fz)
+        oi = _class_of(rec, i, dim)
+        oj = _class_of(rec, j, dim)
         apply_pair_update(rec, i, j, dim, px, py, pz, eps, mi, mj)
         dissipated += 0.5 * (1.0 - eps * eps) * m_eff * gn2
         time = t_next
@@ -243,13 +274,19 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
         pj = -1
         coll += 1
         # speed classes follow the two new speeds, and so does the bound
-        ni = _class_of(rec, i, dim, fx, fy, fz)
-        nj = _class_of(rec, j, dim, fx, fy, fz)
+        ni = _class_of(rec, i, dim)
+        nj = _class_of(rec, j, dim)
         hist[oi] -= 1
         hist[oj] -= 1
         hist[ni] += 1
         hist[nj] += 1
-        if max(oi, oj, ni, nj) >= k2:  # else the two fastest are untouched
+        if coll >= next_recentre:
+            next_recentre += recentre_every
+            top = recentre(rec, mass, mono, dim, hist)
+            k1, k2 = top_classes(hist, top)
+            bound = class_edge(k1) + class_edge(k2)
+            inv_rate = 1.0 / (rate_per_bound * bound)
+        elif max(oi, oj, ni, nj) >= k2:  # else the two fastest are untouched
             n1, n2 = top_classes(hist, max(k1, ni, nj))
             if n1 != k1 or n2 != k2:
                 k1 = n1

@@ -1,8 +1,8 @@
 """The relative-speed bound of the majorant: a histogram of speed classes (numba leaf module).
 
 The sequential majorant needs a number G with |v_i - v_j| <= G for every pair
-at every moment. With w_i = |v_i - u| the speed of particle i relative to a
-fixed frame velocity u (the mean velocity at construction; any u works),
+at every moment. With w_i = |v_i| the speeds (the DSMC works with peculiar
+velocities, so these are speeds about the centre of mass),
 |v_i - v_j| <= w_i + w_j <= w_(1) + w_(2), the two largest speeds. Speeds are
 kept in classes: the class of w is the IEEE-754 bit pattern of w^2 shifted
 right by 50 bits (exponent and the two leading mantissa bits), so classes are
@@ -76,15 +76,14 @@ def class_edge(k):
 
 
 @jit
-def build_histogram(rec, dim, frame, hist):
-    """Fill ``hist`` with the class counts of all particles; return the highest class."""
+def build_histogram(rec, dim, hist):
+    """Fill ``hist`` with the class counts of the speeds |rec[i, :dim]|; return the highest class."""
     hist[:] = 0
     top = 0
     for i in range(rec.shape[0]):
         w2 = 0.0
         for a in range(dim):
-            c = rec[i, a] - frame[a]
-            w2 += c * c
+            w2 += rec[i, a] * rec[i, a]
         k = speed_class(w2)
         hist[k] += 1
         if k > top:

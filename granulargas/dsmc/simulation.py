@@ -46,6 +46,9 @@ class DSMC:
     Parameters
     ----------
     velocities : array (N, d)
+        Initial velocities; the DSMC works in the centre-of-mass frame, so their
+        mass-weighted mean is subtracted (kept in :attr:`frame_velocity`) unless
+        ``state`` is given (then they are taken as they are).
     radii, masses : float or array (N,)
         In units of the reference diameter and mass.
     rule : CollisionRule
@@ -63,12 +66,17 @@ class DSMC:
     time, collisions, dissipated_energy : carried-over counters.
     state : dict, optional
         :attr:`state` of an earlier DSMC to continue bit for bit (random words,
-        candidate count, frame velocity, pending collision).
+        candidate count, pending collision, frame velocity), together with its
+        :attr:`velocities`, ``time``, ``collisions`` and ``dissipated_energy``.
 
     Notes
     -----
-    ``run(until)`` processes every candidate with time <= ``until`` and sets
+    ``run(until)`` executes every collision with time <= ``until`` and sets
     ``time = until``; a run to 2t equals a run to t continued to 2t bit for bit.
+    A homogeneous gas is Galilean invariant: :attr:`velocities` are peculiar
+    velocities. Rounding makes their mean drift at ~1e-16 of their size; it is
+    subtracted again every 2N collisions (:func:`granulargas.dsmc._loop.recentre`),
+    so a gas can cool by hundreds of orders of magnitude.
     Each particle collides at the Enskog frequency of the density (N - 1)/V of its
     partners, so the collision frequency is (N - 1)/N times Enskog's omega(n).
     """
@@ -154,6 +162,8 @@ class DSMC:
         rec[:, :d] = vel
         self._rec = rec
         self._ring = np.zeros((2, _loop.RING), dtype=np.int64)
+        # the frame of the speed classes is reset to the centre of mass every 2 N collisions
+        self._recentre_every = 2 * n
 
         scal = np.zeros(_loop.N_SCAL)
         iscal = np.zeros(_loop.N_ISCAL, dtype=np.int64)
@@ -167,6 +177,7 @@ class DSMC:
         scal[_loop.S_NEXT] = math.nan
         if state is None:
             frame = np.sum(mas[:, None] * vel, axis=0) / np.sum(mas)
+            rec[:, :d] -= frame
             rng = seed_state(seed)
         else:
             frame = np.asarray(state["frame_velocity"], dtype=np.float64)
@@ -183,10 +194,10 @@ class DSMC:
                                       f"time = {time}")
                 iscal[_loop.I_PENDING_I], iscal[_loop.I_PENDING_J] = pi, pj
                 scal[_loop.S_NEXT] = float(state["pending_time"])
-        scal[_loop.S_FRAME : _loop.S_FRAME + d] = frame
+        self.frame_velocity = frame
         self._rng = rng
         self._hist = new_histogram()
-        iscal[_loop.I_TOP] = build_histogram(rec, d, scal[_loop.S_FRAME : _loop.S_FRAME + 3], self._hist)
+        iscal[_loop.I_TOP] = build_histogram(rec, d, self._hist)
         self._scal, self._iscal = scal, iscal
         self._rate_last = float("nan")
         self._acceptance_last = float("nan")
@@ -234,7 +245,7 @@ class DSMC:
         while True:
             status = _loop.advance(self._rec, self._rad_k, self._mas_k, self._mono, d, self._hist,
                                    self._rng, self._kind, self._fpar, self._coeffs, until, target,
-                                   chunk, self._ring, s, self._iscal)
+                                   chunk, self._recentre_every, self._ring, s, self._iscal)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
@@ -282,7 +293,7 @@ class DSMC:
 
     @property
     def velocities(self) -> np.ndarray:
-        """Velocities (N, d) (a copy)."""
+        """Peculiar velocities (N, d), centre-of-mass frame (a copy)."""
         return self._rec[:, : self.dimension].copy()
 
     @property
@@ -298,13 +309,12 @@ class DSMC:
         """What continues this run bit for bit besides velocities, time and counters.
 
         ``rng`` (uint64 (5,)), ``candidates`` (int, position in the pair stream),
-        ``frame_velocity`` (d,), ``pending_pair`` ((i, j), or (-1, -1)) and
-        ``pending_time`` (float; nan when there is no pending collision): the
-        next collision, already drawn.
+        ``pending_pair`` ((i, j), or (-1, -1)) and ``pending_time`` (float; nan
+        when there is no pending collision): the next collision, already drawn;
+        ``frame_velocity`` (d,): the mean velocity subtracted at the start.
         """
-        d = self.dimension
         return {"rng": self._rng.copy(), "candidates": self.candidates,
-                "frame_velocity": self._scal[_loop.S_FRAME : _loop.S_FRAME + d].copy(),
+                "frame_velocity": self.frame_velocity.copy(),
                 "pending_pair": (int(self._iscal[_loop.I_PENDING_I]), int(self._iscal[_loop.I_PENDING_J])),
                 "pending_time": float(self._scal[_loop.S_NEXT])}
 
@@ -314,13 +324,13 @@ class DSMC:
 
     @property
     def kinetic_energy(self) -> float:
-        """Total kinetic energy sum m v^2 / 2."""
+        """Kinetic energy of the peculiar motion, sum m c^2 / 2."""
         v = self._rec[:, : self.dimension]
         return float(0.5 * np.sum(self._masses[:, None] * v * v))
 
     @property
     def momentum(self) -> np.ndarray:
-        """Total momentum (d,)."""
+        """Total momentum (d,) in the centre-of-mass frame: zero up to rounding."""
         return np.sum(self._masses[:, None] * self._rec[:, : self.dimension], axis=0)
 
     @property
