@@ -176,16 +176,16 @@ def sonine_cooling_rate(eps, dim, a2=0.0):
 def reduced_cooling_rate(times, temperatures, number_density, chi, dim, sigma=1.0, mass=1.0):
     """Measured reduced cooling rate ``zeta* = zeta / (chi n sigma^(d-1) v_T)`` of an HCS run.
 
-    With zeta* constant, ``d T^(-1/2) / dt = (zeta*/2) chi n sigma^(d-1) sqrt(2/m)``:
-    the slope of a straight-line fit of ``T^(-1/2)`` against t gives zeta*.
-    Returns (zeta*, standard error of the fit).
+    With zeta* constant, ``d T^(-1/2) / dt = (zeta*/2) chi n sigma^(d-1) sqrt(2/m)``
+    exactly, so every interval between samples gives an estimate; returns their
+    mean and its standard error (intervals taken as independent).
     """
     t = np.asarray(times, dtype=float)
     y = np.asarray(temperatures, dtype=float) ** -0.5
-    (slope, _), cov = np.polyfit(t, y, 1, cov=True) if t.size > 3 else (np.polyfit(t, y, 1), None)
     scale = 2.0 / (chi * number_density * sigma ** (dim - 1) * math.sqrt(2.0 / mass))
-    err = float(np.sqrt(cov[0, 0]) * scale) if cov is not None else float("nan")
-    return float(slope * scale), err
+    each = np.diff(y) / np.diff(t) * scale
+    err = float(each.std(ddof=1) / math.sqrt(each.size)) if each.size > 1 else float("nan")
+    return float(each.mean()), err
 
 
 def tail_constant(zeta_star, dim):
@@ -273,7 +273,8 @@ def local_slope(hist: SpeedHistogram, min_counts: int = 25, merge: int = 4):
     ok = (k[1:] >= min_counts) & (k[:-1] >= min_counts)
     f = k / vol
     dc = np.diff(c)
-    slope = -np.log(f[1:] / np.where(f[:-1] > 0, f[:-1], np.nan)) / dc
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = -np.log(f[1:] / f[:-1]) / dc
     err = np.sqrt(1.0 / np.maximum(k[1:], 1) + 1.0 / np.maximum(k[:-1], 1)) / dc
     cm = 0.5 * (c[1:] + c[:-1])
     return cm[ok], slope[ok], err[ok]
@@ -335,8 +336,8 @@ def plot_velocity_distribution(panels, path, title=None):
             ax2.axhline(value, color=f"C{3 + i}", ls="--", lw=1, label=f"A {name} = {value:.3f}")
         if fit is not None:
             ax2.axhline(fit.A, color="r", lw=1, label="A fitted")
-        top = max([2 * cmax * 0.6] + [v * 1.5 for v in (p.get("A_theory") or {}).values()])
-        ax2.set_ylim(0, top)
+        scale = [v for v in (p.get("A_theory") or {}).values()] + ([fit.A] if fit is not None else [])
+        ax2.set_ylim(0, 1.6 * max(scale) if scale else 2 * cmax)
         ax2.set_xlim(0, cmax)
         ax2.set_xlabel("$c = |v - V| / \\sqrt{2T/m}$")
         ax2.set_ylabel("local slope")
