@@ -106,7 +106,7 @@ def profile(n, packing, seed=1):
 
     import granulargas.engine._loop as loop
     from granulargas.engine import CollisionRule, Simulation
-    from granulargas.engine.initial import random_state
+    from granulargas.initial import random_state
 
     tmp = tempfile.mkdtemp(prefix="profile_loop_")
     with open(os.path.join(tmp, "_loop_profiled.py"), "w") as f:

@@ -11,7 +11,7 @@ beta-derivatives (sensitivity equations); on each interval the table holds the
 cubic Hermite polynomial in the local variable t = s/h - k matching values and
 s-derivatives (d/ds = 2 s d/dbeta) at both nodes, so the interpolant is C^1.
 
-Why s = sqrt(beta): the ``force`` end is a series in sqrt(beta) (physics notes),
+Why s = sqrt(beta): the ``force`` end is a series in sqrt(beta) (:mod:`granulargas.contact.series`),
 and the overlap end, a series in beta, is smooth in s too; at s = 0 the ODE is the
 elastic (Hertz) problem and is solved exactly like any other node, so no special
 small-beta branch is needed (the series is only used to test the first interval).

@@ -11,7 +11,7 @@ normal one becomes -eps u_n. The kinetic energy lost is
 (1 - eps^2) m_eff u_n^2 / 2 with m_eff = m_i m_j / (m_i + m_j).
 
 eps is 1 (elastic), a constant, or the viscoelastic eps(beta) with
-beta = k (R_eff g_n / m_eff^2)^(1/5) (seed eq. 3, see ARCHITECTURE.md), read
+beta = k (R_eff g_n / m_eff^2)^(1/5) (Schwager & Pöschel (1997), eq. (3); ARCHITECTURE.md), read
 from the tabulated spline :func:`granulargas.contact.lookup.table_lookup`.
 TC model (Luding & McNamara 1998): if either particle collided less than
 ``tc_time`` ago the collision is elastic.

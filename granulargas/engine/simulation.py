@@ -31,6 +31,11 @@ from granulargas.errors import (
 
 _INT_MAX = np.iinfo(np.int64).max
 
+#: Smallest box side in largest diameters: 3 cells per side (so that the 27
+#: neighbour cells are distinct), each one diameter wide plus a neighbour-list
+#: shell of at least 0.05 diameters: 3 x 1.05.
+MIN_BOX_DIAMETERS = 3.15
+
 
 def default_shell(packing: float) -> float:
     """Neighbour-list shell width in units of the largest diameter.
@@ -180,9 +185,9 @@ class Simulation:
             raise ConfigError(f"shell = {want}: must be > 0")
         # at least 3 cells per side so that the 27 neighbour cells are distinct
         fit = float(bx.min()) / 3.0 - dmax
-        if fit < 0.05 * dmax:
+        if float(bx.min()) < MIN_BOX_DIAMETERS * dmax:
             raise ConfigError(f"box = {bx.tolist()}: too small for the cell grid, each side must be "
-                              f">= {3.15 * dmax:.4g} (3.15 largest diameters)")
+                              f">= {MIN_BOX_DIAMETERS * dmax:.4g} ({MIN_BOX_DIAMETERS:g} largest diameters)")
         self.shell = min(want * dmax, fit)
         cut = dmax + self.shell
         self._box3 = np.ones(3)
