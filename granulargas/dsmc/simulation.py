@@ -114,8 +114,7 @@ class DSMC:
         given = [x is not None for x in (number_density, packing_fraction, volume)]
         if sum(given) != 1:
             raise ConfigError("DSMC needs exactly one of number_density, packing_fraction, volume")
-        unit = 4.0 / 3.0 * math.pi if d == 3 else math.pi
-        solid = float(unit * np.sum(rad**d))
+        solid = float(np.sum(theory.particle_volume(2.0 * rad, d)))
         if number_density is not None:
             value, name = float(number_density), "number_density"
             vol = n / value if value > 0 else math.nan

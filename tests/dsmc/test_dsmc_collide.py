@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from dsmc_factories import draw_normal_parts, pair_update
+from tests.dsmc.factories import draw_normal_parts, pair_update
 from granulargas.dsmc._random import seed_state
 
 G3 = np.array([0.3, -1.2, 0.7])

@@ -5,7 +5,7 @@ import itertools
 
 import numpy as np
 
-from dsmc_factories import make_dsmc
+from tests.dsmc.factories import make_dsmc
 from granulargas.dsmc._majorant import (
     N_CLASSES,
     build_histogram,

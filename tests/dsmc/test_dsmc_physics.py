@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.special import gamma
 
-from dsmc_factories import make_dsmc, maxwell, microcanonical_rate
+from tests.dsmc.factories import make_dsmc, maxwell, microcanonical_rate
 from granulargas import theory
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule

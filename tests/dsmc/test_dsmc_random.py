@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from dsmc_factories import draw_pairs, draw_u64, draw_uniforms
+from tests.dsmc.factories import draw_pairs, draw_u64, draw_uniforms
 from granulargas.dsmc._random import seed_state
 
 MASK = (1 << 64) - 1

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from dsmc_factories import make_dsmc, maxwell
+from tests.dsmc.factories import make_dsmc, maxwell
 from granulargas.contact import prefactor_from_damping, restitution_table
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule
