@@ -28,17 +28,20 @@ def hcs_samples(dim, eps, n, relax, snapshots, pairs, seed=1):
     v = np.random.default_rng(seed).standard_normal((n, dim))
     sim = DSMC(v, 0.5, 1.0, CollisionRule.constant(eps), packing_fraction=0.01, seed=seed)
     sim.run(np.inf, max_collisions=int(relax * n / 2))
-    q, a2 = [], []
+    q, q_err, a2 = [], [], []
     for k in range(snapshots):
         sim.run(np.inf, max_collisions=n)
-        q.append(collisional_moment_ratio(sim.velocities / math.sqrt(sim.temperature), eps, pairs=pairs,
-                                          seed=k)[0])
+        value, err = collisional_moment_ratio(sim.velocities / math.sqrt(sim.temperature), eps, pairs=pairs,
+                                              seed=k)
+        q.append(value)
+        q_err.append(err)
         a2.append(sim.sonine_a2)
-    q, a2 = np.array(q), np.array(a2)
+    q, q_err, a2 = np.array(q), np.array(q_err), np.array(a2)
     q_max, q_max_err = collisional_moment_ratio(np.random.default_rng(99).standard_normal((n, dim)), eps,
                                                 pairs=pairs * snapshots, seed=123)
-    return (q.mean(), q.std(ddof=1) / math.sqrt(snapshots), a2.mean(), a2.std(ddof=1) / math.sqrt(snapshots),
-            q_max, q_max_err)
+    # error of the mean Q: the larger of the snapshots' scatter and their Monte Carlo errors
+    q_mean_err = max(q.std(ddof=1), math.sqrt(np.mean(q_err**2))) / math.sqrt(snapshots)
+    return (q.mean(), q_mean_err, a2.mean(), a2.std(ddof=1) / math.sqrt(snapshots), q_max, q_max_err)
 
 
 def test_hcs_is_stationary_under_the_exact_moment_equation():
