@@ -3,11 +3,12 @@
 For each eps a DSMC gas of N smooth inelastic hard spheres (disks) relaxes into the HCS
 (``--relax`` collisions per particle), then a2 and a3 are averaged over ``--snapshots``
 snapshots one collision per particle apart; the error is the standard error of that mean
-from 20 batch means (successive snapshots are correlated: the printed lag-1
+from 10 batch means (successive snapshots are correlated: the printed lag-1
 autocorrelation of a2 says how much). Printed with them: the first Sonine approximation
 of van Noije & Ernst (1998) (``theory.sonine_a2``) and, as an independent check of the
 stationary state, the ratio Q of the exact moment equation (Q = 1 in the HCS; a
-Maxwellian gives Q - 1 ~ -a2), evaluated with numpy on ``--q-snapshots`` snapshots.
+Maxwellian gives Q - 1 ~ -a2), evaluated with numpy on the last ``--q-snapshots``
+snapshots (its error from their scatter).
 
     python scripts/dsmc_sonine_table.py              # N = 1e5, 200 snapshots, ~10 min on one core
     python scripts/dsmc_sonine_table.py --quick
@@ -31,7 +32,7 @@ from granulargas.engine import CollisionRule  # noqa: E402
 from tests.dsmc.hcs_reference import collisional_moment_ratio  # noqa: E402
 
 
-def batch_error(x, batches=20):
+def batch_error(x, batches=10):
     """Standard error of the mean of a correlated series from ``batches`` batch means."""
     m = len(x) // batches
     if m < 1:
@@ -47,8 +48,8 @@ def main(argv=None):
     ap.add_argument("--n", type=float, default=1e5)
     ap.add_argument("--relax", type=float, default=30.0)
     ap.add_argument("--snapshots", type=int, default=200)
-    ap.add_argument("--q-snapshots", type=int, default=4)
-    ap.add_argument("--q-pairs", type=float, default=2e6)
+    ap.add_argument("--q-snapshots", type=int, default=40)
+    ap.add_argument("--q-pairs", type=float, default=1e6)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
@@ -80,8 +81,9 @@ def main(argv=None):
             vne = float(theory.sonine_a2(eps, dim))
             lag = float(np.corrcoef(a2[:-1], a2[1:])[0, 1])
             e2, e3 = batch_error(a2), batch_error(a3)
-            # Monte Carlo error of the pair sums (the snapshots' own scatter is dominated by it)
-            eq = math.sqrt(np.mean(q_err**2) / len(q))
+            # scatter of the snapshots' Q: Monte Carlo error of the pair sums plus the sampling
+            # noise of each snapshot's N velocities
+            eq = q.std(ddof=1) / math.sqrt(len(q))
             print(f"{dim:>2} {eps:>5.2f} {a2.mean():>+9.5f} {e2:>8.5f} {a3.mean():>+9.5f} {e3:>8.5f} "
                   f"{vne:>+9.5f} {a2.mean() / vne:>7.3f} {lag:>6.2f} {q.mean():>8.5f} {eq:>7.5f} "
                   f"{q_max:>8.5f} {time.perf_counter() - t0:>5.0f}", flush=True)

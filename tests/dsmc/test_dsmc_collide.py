@@ -78,3 +78,31 @@ def test_pair_update_is_the_smooth_sphere_rule(dim, eps):
                   - mi * (rec[0, :dim] @ rec[0, :dim]) - mj * (rec[1, :dim] @ rec[1, :dim]))
     m_eff = mi * mj / (mi + mj)
     assert np.isclose(loss, 0.5 * (1 - eps**2) * m_eff * un**2, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("end", ["overlap", "force"])
+def test_viscoelastic_restitution_of_each_collision_is_the_engines(end):
+    """Two unlike particles (the only pair): from every collision's velocity change follow
+    g_n and eps; eps equals the restitution table at beta = k (R_eff g_n / m_eff^2)^(1/5)
+    (both contact ends), and the energy lost is (1 - eps^2) m_eff g_n^2 / 2."""
+    from granulargas.contact import restitution_table
+    from granulargas.dsmc import DSMC
+    from granulargas.engine import CollisionRule
+
+    table = restitution_table(3.0, end=end)
+    k = 0.3
+    radii, masses = np.array([0.5, 0.8]), np.array([1.0, 2.5])
+    r_eff, m_eff = radii.prod() / radii.sum(), masses.prod() / masses.sum()
+    sim = DSMC(np.array([[1.0, 0.2, -0.4], [-0.3, 0.1, 0.6]]), radii, masses,
+               CollisionRule.viscoelastic(k, table), volume=10.0, seed=3)
+    for _ in range(20):
+        v0, e0 = sim.velocities, sim.kinetic_energy
+        sim.run(np.inf, max_collisions=1)
+        dv = sim.velocities[0] - v0[0]
+        k_hat = -dv / np.linalg.norm(dv)  # v_i' = v_i - (1 + eps) m_j/M (g.k) k
+        gn = (v0[0] - v0[1]) @ k_hat
+        gn_after = (sim.velocities[0] - sim.velocities[1]) @ k_hat
+        eps = -gn_after / gn
+        beta = k * (r_eff * gn / m_eff**2) ** 0.2
+        assert eps == pytest.approx(float(table.restitution(beta)), abs=1e-12)
+        assert e0 - sim.kinetic_energy == pytest.approx(0.5 * (1 - eps**2) * m_eff * gn**2, rel=1e-9)
