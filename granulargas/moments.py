@@ -83,6 +83,27 @@ def energy_moments(v, dim, masses):
     return s1 * vmax * vmax / (dim * n), a2, a3
 
 
+@jit
+def kinetic_energy_momentum(v, dim, masses):
+    """(sum m v^2 / 2, p_x, p_y, p_z) of the velocities ``v[:, :dim]`` (p_z = 0 in 2D),
+    masses (N,) or one shared mass (1,); no temporary arrays."""
+    shared = masses.shape[0] == 1
+    e = 0.0
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    for i in range(v.shape[0]):
+        m = masses[0] if shared else masses[i]
+        w2 = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1]
+        p0 += m * v[i, 0]
+        p1 += m * v[i, 1]
+        if dim == 3:
+            w2 += v[i, 2] * v[i, 2]
+            p2 += m * v[i, 2]
+        e += m * w2
+    return 0.5 * e, p0, p1, p2
+
+
 def _arrays(velocities, masses):
     v = np.ascontiguousarray(velocities, dtype=np.float64)
     if v.ndim != 2 or v.shape[1] not in (2, 3):

@@ -88,3 +88,17 @@ def test_scale_invariance_far_from_unit_speeds():
         t_s, b2, b3 = energy_moments(np.ascontiguousarray(v * scale), 3, np.ones(1))
         assert t_s == pytest.approx(t * scale**2, rel=1e-12)
         assert b2 == pytest.approx(a2, rel=1e-12) and b3 == pytest.approx(a3, rel=1e-12)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_kinetic_energy_and_momentum(dim):
+    from granulargas.moments import kinetic_energy_momentum
+
+    rng = np.random.default_rng(5)
+    v = rng.standard_normal((300, dim))
+    m = rng.uniform(0.5, 2, 300)
+    e, *p = kinetic_energy_momentum(v, dim, m)
+    assert e == pytest.approx(0.5 * np.sum(m[:, None] * v * v), rel=1e-12)
+    assert np.allclose(p[:dim], (m[:, None] * v).sum(axis=0), rtol=1e-12, atol=1e-12)
+    e1 = kinetic_energy_momentum(v, dim, np.array([2.0]))[0]
+    assert e1 == pytest.approx(np.sum(v * v), rel=1e-12)

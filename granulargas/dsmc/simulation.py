@@ -19,7 +19,7 @@ from granulargas.dsmc._majorant import build_histogram, class_edge, new_histogra
 from granulargas.dsmc._random import STATE_WORDS, seed_state
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
-from granulargas.moments import energy_moments
+from granulargas.moments import energy_moments, kinetic_energy_momentum
 
 _INT_MAX = np.iinfo(np.int64).max
 
@@ -96,12 +96,13 @@ class DSMC:
             raise ConfigError(f"velocities: N = {n}, at most 2^31 - 1 particles")
         if not np.all(np.isfinite(vel)):
             raise ConfigError("velocities: non-finite values")
-        rad = np.array(np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)), order="C")
-        mas = np.array(np.broadcast_to(np.asarray(masses, dtype=np.float64), (n,)), order="C")
-        if not (np.all(rad > 0) and np.all(np.isfinite(rad))):
-            raise ConfigError("radii: every radius must be finite and > 0")
-        if not (np.all(mas > 0) and np.all(np.isfinite(mas))):
-            raise ConfigError("masses: every mass must be finite and > 0")
+        rad = np.asarray(radii, dtype=np.float64)
+        mas = np.asarray(masses, dtype=np.float64)
+        for name, arr in (("radii", rad), ("masses", mas)):
+            if arr.ndim > 1 or (arr.ndim == 1 and arr.shape[0] not in (1, n)):
+                raise ConfigError(f"{name}: shape {arr.shape}, expected a number or ({n},)")
+            if not (np.all(arr > 0) and np.all(np.isfinite(arr))):
+                raise ConfigError(f"{name}: every value must be finite and > 0")
         if not isinstance(rule, CollisionRule):
             raise TypeError("rule must be a granulargas.engine.CollisionRule")
         if rule.tc_time is not None:
@@ -114,7 +115,22 @@ class DSMC:
         given = [x is not None for x in (number_density, packing_fraction, volume)]
         if sum(given) != 1:
             raise ConfigError("DSMC needs exactly one of number_density, packing_fraction, volume")
-        solid = float(np.sum(theory.particle_volume(2.0 * rad, d)))
+        # identical particles keep no per-particle arrays (32 bytes per particle in 3D)
+        self._mono = bool(np.all(rad == rad.flat[0]) and np.all(mas == mas.flat[0]))
+        if self._mono:
+            r0, m0 = float(rad.flat[0]), float(mas.flat[0])
+            solid = n * float(theory.particle_volume(2.0 * r0, d))
+            sigma_max = 2.0 * r0
+            self._rad_k = self._mas_k = np.zeros(1)
+        else:
+            rad = np.ascontiguousarray(np.broadcast_to(rad, (n,)))
+            mas = np.ascontiguousarray(np.broadcast_to(mas, (n,)))
+            r0, m0 = float(rad[0]), float(mas[0])
+            solid = float(np.sum(theory.particle_volume(2.0 * rad, d)))
+            sigma_max = 2.0 * float(rad.max())
+            self._rad_k, self._mas_k = rad, mas
+        self._r0, self._m0 = r0, m0
+        self._mass_arg = np.array([m0]) if self._mono else mas  # for the moment kernels
         if number_density is not None:
             value, name = float(number_density), "number_density"
             vol = n / value if value > 0 else math.nan
@@ -139,11 +155,6 @@ class DSMC:
             raise ConfigError(f"chi = {chi}: must be finite and > 0")
         self.chi = chi
 
-        self._mono = bool(np.all(rad == rad[0]) and np.all(mas == mas[0]))
-        sigma_max = 2.0 * float(rad.max())
-        self._radii, self._masses = rad, mas
-        self._rad_k = rad if not self._mono else np.zeros(1)
-        self._mas_k = mas if not self._mono else np.zeros(1)
 
         kind, eps, _, pref, inv_h, coeffs = rule.kernel_arguments()
         self._kind, self._coeffs = kind, coeffs
@@ -152,8 +163,8 @@ class DSMC:
         fpar[_loop.F_PREFACTOR] = pref
         fpar[_loop.F_INV_H] = inv_h
         fpar[_loop.F_SIGMA_MAX_POW] = sigma_max ** (d - 1)
-        fpar[_loop.F_MASS] = mas[0]
-        fpar[_loop.F_RADIUS] = rad[0]
+        fpar[_loop.F_MASS] = m0
+        fpar[_loop.F_RADIUS] = r0
         self._fpar = fpar
 
         width = 4 if d == 3 else 2
@@ -175,7 +186,7 @@ class DSMC:
         iscal[_loop.I_PENDING_I] = iscal[_loop.I_PENDING_J] = -1
         scal[_loop.S_NEXT] = math.nan
         if state is None:
-            frame = np.sum(mas[:, None] * vel, axis=0) / np.sum(mas)
+            frame = vel.mean(axis=0) if self._mono else (mas @ vel) / mas.sum()
             rec[:, :d] -= frame
             rng = seed_state(seed)
         else:
@@ -297,11 +308,11 @@ class DSMC:
 
     @property
     def radii(self) -> np.ndarray:
-        return self._radii.copy()
+        return np.full(self.n, self._r0) if self._mono else self._rad_k.copy()
 
     @property
     def masses(self) -> np.ndarray:
-        return self._masses.copy()
+        return np.full(self.n, self._m0) if self._mono else self._mas_k.copy()
 
     @property
     def state(self) -> dict:
@@ -319,18 +330,17 @@ class DSMC:
 
     # ------------------------------------------------------------- observables
     def _moments(self):
-        return energy_moments(self._rec, self.dimension, self._masses if not self._mono else self._masses[:1])
+        return energy_moments(self._rec, self.dimension, self._mass_arg)
 
     @property
     def kinetic_energy(self) -> float:
         """Kinetic energy of the peculiar motion, sum m c^2 / 2."""
-        v = self._rec[:, : self.dimension]
-        return float(0.5 * np.sum(self._masses[:, None] * v * v))
+        return float(kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)[0])
 
     @property
     def momentum(self) -> np.ndarray:
         """Total momentum (d,) in the centre-of-mass frame: zero up to rounding."""
-        return np.sum(self._masses[:, None] * self._rec[:, : self.dimension], axis=0)
+        return np.array(kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)[1:1 + self.dimension])
 
     @property
     def temperature(self) -> float:
