@@ -75,7 +75,7 @@ class DSMC:
     ``time = until``; a run to 2t equals a run to t continued to 2t bit for bit.
     A homogeneous gas is Galilean invariant: :attr:`velocities` are peculiar
     velocities. Rounding makes their mean drift at ~1e-16 of their size; it is
-    subtracted again every 2N collisions (:func:`granulargas.dsmc._loop.recentre`),
+    subtracted again every 8N collisions (:func:`granulargas.dsmc._loop.recentre`),
     so a gas can cool by hundreds of orders of magnitude.
     Each particle collides at the Enskog frequency of the density (N - 1)/V of its
     partners, so the collision frequency is (N - 1)/N times Enskog's omega(n).
@@ -172,8 +172,8 @@ class DSMC:
         rec[:, :d] = vel
         self._rec = rec
         self._ring = np.zeros((2, _loop.RING), dtype=np.int64)
-        # the frame of the speed classes is reset to the centre of mass every 2 N collisions
-        self._recentre_every = 2 * n
+        # the rounding drift of the mean velocity is removed every 8 N collisions
+        self._recentre_every = 8 * n
 
         scal = np.zeros(_loop.N_SCAL)
         iscal = np.zeros(_loop.N_ISCAL, dtype=np.int64)

@@ -78,7 +78,7 @@ def test_bound_follows_the_gas_and_bounds_every_pair():
 def test_bound_keeps_up_with_a_gas_cooled_by_1e100():
     """Strongly inelastic gas cooled by 100 orders of magnitude: the velocities stay
     peculiar (the rounding drift of their mean, ~1e-16 of the initial speeds, is removed
-    every 2N collisions), so the gas keeps cooling and the acceptance stays that of a
+    every 8N collisions), so the gas keeps cooling and the acceptance stays that of a
     fresh gas."""
     sim = make_dsmc(n=2000, dim=2, rule=CollisionRule.constant(0.3), seed=6)
     sim.run(np.inf, max_collisions=20000)
