@@ -272,27 +272,26 @@ def loop_time(text: str) -> float:
 # --------------------------------------------------------------------------- head-on collisions
 
 
-def head_on_input(contact: DemContact, speed: float, timestep: float, steps: int,
-                  radii=(0.5, 0.5), masses=(1.0, 1.0)) -> str:
-    """LAMMPS input for a head-on collision of two spheres at relative speed ``speed``.
+def _two_spheres(contact: DemContact, normal_speed: float, tangential_speed: float, timestep: float,
+                 radii, masses, title: str) -> str:
+    """Setup of a two-sphere collision: touching at step 0 along x, zero total momentum.
 
-    Sphere 1 (atom type 1) and sphere 2 (type 2) touch at step 0 (zero
-    overlap) and approach along x with zero total momentum; eta_n0 is set per
-    pair of types from the pair's m_eff. After ``steps`` steps the script
-    prints ``GRANULARGAS_RESULT <g_after>``, the relative separation speed
-    (positive when receding).
+    Sphere 1 (type 1) at x = -r1, sphere 2 (type 2) at x = +r2; relative
+    velocity v1 - v2 = (normal_speed, tangential_speed, 0). eta_n0 is set per
+    pair of types from the pair's m_eff. Shrink-wrapped boundaries (no images).
     """
     (r1, r2), (m1, m2) = radii, masses
     span = 4.0 * (r1 + r2) + 1.0
     coeffs = "\n".join(contact.pair_coeff(i, j, mi * mj / (mi + mj))
                         for i, j, mi, mj in ((1, 1, m1, m1), (1, 2, m1, m2), (2, 2, m2, m2)))
+    boundary = "m p p" if tangential_speed == 0.0 else "m m m"
     return f"""\
-# head-on collision of two viscoelastic spheres (granulargas.dem.lammps.head_on_input)
+# {title}
 units lj
 atom_style sphere
 atom_modify map array
 dimension 3
-boundary m p p
+boundary {boundary}
 comm_modify vel yes
 region box block {-span} {span} {-span / 2} {span / 2} {-span / 2} {span / 2} units box
 create_box 2 box
@@ -303,19 +302,62 @@ set atom 2 diameter {2 * r2:.17g}
 set atom 1 mass {m1:.17g}
 set atom 2 mass {m2:.17g}
 velocity all set 0 0 0 units box
-set atom 1 vx {m2 / (m1 + m2) * speed:.17g}
-set atom 2 vx {-m1 / (m1 + m2) * speed:.17g}
+set atom 1 vx {m2 / (m1 + m2) * normal_speed:.17g}
+set atom 2 vx {-m1 / (m1 + m2) * normal_speed:.17g}
+set atom 1 vy {m2 / (m1 + m2) * tangential_speed:.17g}
+set atom 2 vy {-m1 / (m1 + m2) * tangential_speed:.17g}
 pair_style granular
 {coeffs}
 neighbor {0.2 * (r1 + r2)} bin
+neigh_modify delay 0 every 1 check yes
 timestep {timestep:.17g}
 fix integrate all nve/sphere
+"""
+
+
+def head_on_input(contact: DemContact, speed: float, timestep: float, steps: int,
+                  radii=(0.5, 0.5), masses=(1.0, 1.0)) -> str:
+    """LAMMPS input for a head-on collision of two spheres at relative speed ``speed``.
+
+    Sphere 1 (atom type 1) and sphere 2 (type 2) touch at step 0 (zero
+    overlap) and approach along x with zero total momentum; eta_n0 is set per
+    pair of types from the pair's m_eff. After ``steps`` steps the script
+    prints ``GRANULARGAS_RESULT <g_after>``, the relative separation speed
+    (positive when receding).
+    """
+    setup = _two_spheres(contact, speed, 0.0, timestep, radii, masses,
+                         "head-on collision of two viscoelastic spheres (granulargas.dem.lammps.head_on_input)")
+    return setup + f"""\
 variable g equal vx[2]-vx[1]
 thermo_style custom step v_g
 thermo_modify format float %.17g
 thermo {max(steps // 4, 1)}
 run {steps}
 print "{_RESULT} ${{g}}"
+"""
+
+
+def oblique_input(contact: DemContact, normal_speed: float, tangential_speed: float, timestep: float,
+                  steps: int, radii=(0.5, 0.5), masses=(1.0, 1.0)) -> str:
+    """LAMMPS input for an oblique collision: the relative motion at every step.
+
+    Set up as :func:`head_on_input` plus a tangential relative speed along y;
+    thermo prints, every step, the relative position x1 - x2 (``v_rx v_ry
+    v_rz``) and velocity v1 - v2 (``v_vx v_vy v_vz``) at full precision.
+    """
+    setup = _two_spheres(contact, normal_speed, tangential_speed, timestep, radii, masses,
+                         "oblique collision of two viscoelastic spheres (granulargas.dem.lammps.oblique_input)")
+    return setup + f"""\
+variable rx equal x[1]-x[2]
+variable ry equal y[1]-y[2]
+variable rz equal z[1]-z[2]
+variable vx equal vx[1]-vx[2]
+variable vy equal vy[1]-vy[2]
+variable vz equal vz[1]-vz[2]
+thermo_style custom step time v_rx v_ry v_rz v_vx v_vy v_vz
+thermo_modify format float %.17g
+thermo 1
+run {steps}
 """
 
 
@@ -343,6 +385,38 @@ def head_on_restitution(contact: DemContact, speed: float, steps_per_contact: in
     if match is None:
         raise LammpsError(f"LAMMPS log in {workdir} has no {_RESULT} line")
     return float(match.group(1)) / speed
+
+
+def oblique_trajectory(contact: DemContact, normal_speed: float, tangential_speed: float, timestep: float,
+                       steps: int, workdir: str | Path, radii=(0.5, 0.5), masses=(1.0, 1.0),
+                       lmp: str | None = None) -> dict[str, np.ndarray]:
+    """Run :func:`oblique_input`; return the relative motion at every step.
+
+    Returns
+    -------
+    dict
+        ``t`` (steps + 1,), ``r`` and ``v`` (steps + 1, 3): time, x1 - x2 and v1 - v2.
+    """
+    workdir = Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    inp = workdir / "in.oblique"
+    inp.write_text(oblique_input(contact, normal_speed, tangential_speed, timestep, steps, radii, masses))
+    tables = parse_thermo(run_lammps(inp, workdir, lmp=lmp))
+    if not tables or "v_rx" not in tables[0]:
+        raise LammpsError(f"LAMMPS log in {workdir} has no oblique-collision thermo table")
+    tab = tables[0]
+    return {"t": tab["Time"], "r": np.column_stack([tab["v_rx"], tab["v_ry"], tab["v_rz"]]),
+            "v": np.column_stack([tab["v_vx"], tab["v_vy"], tab["v_vz"]])}
+
+
+def stiffness_for_compression(delta: float, speed: float, radius_eff: float, mass_eff: float, distance: float,
+                              poisson_ratio: float = DEFAULT_POISSON) -> float:
+    """Young modulus Y whose compression scale (speed^2 / rho)^{2/5} is ``delta`` x ``distance``.
+
+    delta is the third parameter of the oblique contact (:mod:`granulargas.contact.oblique`).
+    """
+    rho = speed**2 / (delta * distance) ** 2.5
+    return rho * 3.0 * mass_eff * (1.0 - poisson_ratio**2) / (2.0 * math.sqrt(radius_eff))
 
 
 # --------------------------------------------------------------------------- a whole gas
