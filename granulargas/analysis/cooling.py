@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, special
 
-from granulargas import moments
+from granulargas import observables
 
 __all__ = [
     "temperature",
@@ -77,7 +77,7 @@ def sonine_polynomial(p, x, dim):
 
 def sonine_coefficients(velocities, masses=None):
     """Second and third Sonine coefficients of the velocity distribution
-    (the estimator of :mod:`granulargas.moments`, which the simulations' observables use).
+    (the estimator of :mod:`granulargas.observables`, which the simulations' observables use).
 
     Returns
     -------
@@ -87,7 +87,7 @@ def sonine_coefficients(velocities, masses=None):
     """
     v = np.asarray(velocities, dtype=float)
     m = None if masses is None else np.broadcast_to(np.asarray(masses, dtype=float), (v.shape[0],))
-    return moments.sonine_coefficients(v, m)
+    return observables.sonine_coefficients(v, m)
 
 
 def maxwell_sonine_pdf(u, dim, a2=0.0, a3=0.0, kind="component"):

@@ -19,7 +19,7 @@ from granulargas.dsmc._majorant import build_histogram, class_edge, new_histogra
 from granulargas.dsmc._random import STATE_WORDS, seed_state
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
-from granulargas.moments import energy_moments, kinetic_energy_momentum
+from granulargas.observables import energy_moments, kinetic_energy_momentum
 
 _INT_MAX = np.iinfo(np.int64).max
 
@@ -349,12 +349,12 @@ class DSMC:
 
     @property
     def sonine_a2(self) -> float:
-        """Second Sonine coefficient of the peculiar velocities (:mod:`granulargas.moments`)."""
+        """Second Sonine coefficient of the peculiar velocities (:mod:`granulargas.observables`)."""
         return float(self._moments()[1])
 
     @property
     def sonine_a3(self) -> float:
-        """Third Sonine coefficient of the peculiar velocities (:mod:`granulargas.moments`)."""
+        """Third Sonine coefficient of the peculiar velocities (:mod:`granulargas.observables`)."""
         return float(self._moments()[2])
 
     @property

@@ -11,7 +11,7 @@ from tests.dsmc.factories import make_dsmc, maxwell, microcanonical_rate
 from granulargas import theory
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule
-from granulargas.moments import finite_sample_sonine
+from granulargas.observables import finite_sample_sonine
 
 
 @pytest.mark.parametrize("dim", [2, 3])

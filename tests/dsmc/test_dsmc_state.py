@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from tests.dsmc.factories import make_dsmc, maxwell
+from granulargas import theory
 from granulargas.contact import prefactor_from_damping, restitution_table
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule
@@ -122,14 +123,14 @@ def test_density_arguments():
     v = maxwell(50, 3)
     n_from_phi = DSMC(v, 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.1)
     assert n_from_phi.number_density == pytest.approx(0.6 / math.pi * 0.1 * 10)  # 6 phi / pi
-    assert n_from_phi.chi == pytest.approx((1 - 0.05) / 0.9**3)
+    assert n_from_phi.chi == pytest.approx(float(theory.contact_value(0.1, 3)), rel=1e-14)
     by_n = DSMC(v, 0.5, 1.0, CollisionRule.elastic(), number_density=n_from_phi.number_density)
     assert by_n.packing_fraction == pytest.approx(0.1)
     by_v = DSMC(v, 0.5, 1.0, CollisionRule.elastic(), volume=50 / n_from_phi.number_density)
     assert by_v.packing_fraction == pytest.approx(0.1)
     two = DSMC(maxwell(50, 2), 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.2)
     assert two.number_density == pytest.approx(4 * 0.2 / math.pi)
-    assert two.chi == pytest.approx((1 - 7 * 0.2 / 16) / 0.8**2)
+    assert two.chi == pytest.approx(float(theory.contact_value(0.2, 2)), rel=1e-14)
     assert DSMC(v, 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.1, chi=1.0).chi == 1.0
 
 

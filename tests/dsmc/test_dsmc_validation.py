@@ -18,7 +18,7 @@ from granulargas.contact import prefactor_from_damping, restitution_table
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
-from granulargas.moments import energy_moments
+from granulargas.observables import energy_moments
 from granulargas.run.prepare import beta_bound
 from tests.dsmc.hcs_reference import collisional_moment_ratio
 

@@ -1,4 +1,4 @@
-"""Velocity moments of a particle sample: temperature and the Sonine coefficients a2, a3.
+"""Observables of a particle sample: kinetic energy, momentum, temperature, Sonine coefficients a2, a3.
 
 With c_i the peculiar velocity (velocity minus the mass-weighted mean) and
 e_i = m_i c_i^2, the temperature is T = <e>/d (k_B = 1) and

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from granulargas.analysis.cooling import temperature as numpy_temperature
-from granulargas.moments import (
+from granulargas.observables import (
     energy_moments,
     finite_sample_sonine,
     sonine_a2,
@@ -92,7 +92,7 @@ def test_scale_invariance_far_from_unit_speeds():
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_kinetic_energy_and_momentum(dim):
-    from granulargas.moments import kinetic_energy_momentum
+    from granulargas.observables import kinetic_energy_momentum
 
     rng = np.random.default_rng(5)
     v = rng.standard_normal((300, dim))
