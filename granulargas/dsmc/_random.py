@@ -14,8 +14,9 @@ stopped anywhere and continued bit for bit:
   which is what lets the loop prefetch the velocities of the pairs ahead.
 
 Bounded integers use Lemire's multiply-shift with rejection (Lemire 2019,
-"Fast random integer generation in an interval", ACM TOMS 45, 26): exactly
-uniform on 32-bit halves, the rejection taken with probability n / 2^32.
+"Fast random integer generation in an interval", ACM Trans. Model. Comput.
+Simul. 29, 3): exactly uniform on 32-bit halves, the rejection taken with
+probability n / 2^32.
 Uniform doubles are 53-bit multiples of 2^-53.
 """
 
