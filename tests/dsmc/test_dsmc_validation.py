@@ -53,10 +53,11 @@ def test_hcs_is_stationary_under_the_exact_moment_equation():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("dim", [2, 3])
-@pytest.mark.parametrize("eps", [0.9, 0.7, 0.5, 0.3])
+@pytest.mark.parametrize("eps", [0.9, 0.8, 0.5, 0.3])
 def test_hcs_stationarity_across_eps(dim, eps):
     """N = 1e5, 10 snapshots one collision per particle apart, 2e6 pairs each: Q = 1 within
-    4 standard errors (~1e-3), while a Maxwellian gives Q - 1 ~ -a2."""
+    4 standard errors (~2e-3), while a Maxwellian gives Q - 1 ~ -a2 (near eps = 0.7, where
+    a2 changes sign, the check cannot tell the HCS from a Maxwellian, so it is not run there)."""
     q, q_err, a2, a2_err, q_max, q_max_err = hcs_samples(dim, eps, 100_000, 20, 10, 2_000_000)
     print(f"d={dim} eps={eps}: Q = {q:.5f} +- {q_err:.5f}, a2 = {a2:.5f} +- {a2_err:.5f} "
           f"(van Noije-Ernst {theory.sonine_a2(eps, dim):.5f}), Maxwellian Q = {q_max:.5f}")
