@@ -81,8 +81,7 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
         w1, p1 = time.perf_counter(), time.process_time()
         wall.append((sim.collisions - c0) / (w1 - w0))
         cpu.append((sim.collisions - c0) / (p1 - p0))
-    state_bytes = sum(a.nbytes for a in sim._s.values() if hasattr(a, "nbytes"))
-    iscal = sim._s["iscal"]
+    state_bytes, expiries, stale = _internals(sim)
     return dict(
         n=n, packing=packing, dim=dim, rule=rule_name,
         rate_wall=statistics.median(wall), rate_cpu=statistics.median(cpu),
@@ -90,10 +89,28 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
         bytes_per_particle=state_bytes / n,
         peak_rss_per_particle=(_peak_rss_bytes() - rss0) / n,
         events_per_collision=sim.events / max(1, sim.collisions),
-        expiries_per_collision=float(iscal[4]) / max(1, sim.collisions),
-        stale_per_collision=float(iscal[5]) / max(1, sim.collisions),
+        expiries_per_collision=expiries / max(1, sim.collisions),
+        stale_per_collision=stale / max(1, sim.collisions),
         init_seconds=t_init, build_seconds=t_build, list_width=sim._nb_width,
     )
+
+
+def _internals(sim):
+    """(bytes of the engine state, list expiries, stale events) of the current build.
+
+    Reads the named records of ``granulargas.engine._state``; falls back to the
+    earlier layout (a dict of arrays with index-coded counters) so that
+    ``bench_ab.py`` can run this script against an older source tree.
+    """
+    engine = getattr(sim, "_engine", None)
+    if engine is not None:
+        from granulargas.engine._state import nbytes
+
+        c = engine.counters[0]
+        return nbytes(engine), float(c["expiries"]), float(c["stale"])
+    s = sim._s
+    return (sum(a.nbytes for a in s.values() if hasattr(a, "nbytes")), float(s["iscal"][4]),
+            float(s["iscal"][5]))
 
 
 def jit_times():
