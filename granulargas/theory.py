@@ -26,7 +26,12 @@ Contents, with the equations they implement:
 * the shear-instability length ``L_c`` from linearised hydrodynamics of the
   homogeneous cooling state (see :func:`instability_length`);
 * viscoelastic cooling ``T = T0 (1 + t/tau0)^(-5/3)`` with ``tau0`` derived below
-  (:func:`viscoelastic_tau0`).
+  (:func:`viscoelastic_tau0`);
+* the white-noise driven steady state (:func:`driven_sonine_a2`,
+  :func:`driven_temperature`, :func:`driving_interval`), and for viscoelastic
+  particles the effective constant restitution coefficient of Dubey, Bodrova, Puri &
+  Brilliantov (2013) (:func:`effective_restitution`,
+  :func:`viscoelastic_driven_temperature`).
 
 The viscoelastic pair constant
 ------------------------------
@@ -70,6 +75,11 @@ __all__ = [
     "viscoelastic_tau0",
     "viscoelastic_temperature",
     "viscoelastic_collisions",
+    "driven_sonine_a2",
+    "driven_temperature",
+    "driving_interval",
+    "effective_restitution",
+    "viscoelastic_driven_state",
 ]
 
 #: First and second coefficients of eps(beta) = 1 - C1 beta + C2 beta^2 (seed eq. 32).
@@ -411,3 +421,110 @@ def viscoelastic_collisions(t, tau0, omega0):
     ``s(t) = 6 omega0 tau0 [(1 + t/tau0)^(1/6) - 1]``.
     """
     return 6.0 * omega0 * tau0 * ((1.0 + np.asarray(t, dtype=float) / tau0) ** (1.0 / 6.0) - 1.0)
+
+
+# ---------------------------------------------------------------- driven gases
+def driven_sonine_a2(eps, dim=3):
+    """Second Sonine coefficient of the white-noise driven steady state (constant eps).
+
+    van Noije & Ernst, Granular Matter 1, 57 (1998), first Sonine approximation:
+    ``a2 = 16 (1 - eps)(1 - 2 eps^2) / [73 + 56 d - 3 eps (35 + 8 d) + 30 eps^2 (1 - eps)]``.
+
+    Derivation (the check of this form): with the collision moments
+    ``mu_p = -int c^p I(f, f)`` of the scaled distribution, to first order in a2
+    ``mu2 = A (1 - eps^2)(1 + 3 a2/16)`` and ``mu4 = A [(1 - eps^2)(d + 3/2 + eps^2) + a2 B]``.
+    The cooling state requires ``mu4 = (d + 2)(1 + a2) mu2``, which with the cooling-state
+    a2 of :func:`sonine_a2` fixes ``B``; the driving term ``(xi^2/2) nabla_c^2 f`` of
+    white noise gives instead ``mu4 = (d + 2) mu2`` (the c^2 and c^4 moments of the
+    Laplacian are 2 d and 4 (d + 2) <c^2>), and eliminating B yields the form above.
+    """
+    _check_dim(dim)
+    eps = np.asarray(eps, dtype=float)
+    num = 16.0 * (1.0 - eps) * (1.0 - 2.0 * eps**2)
+    den = 73.0 + 56.0 * dim - 3.0 * eps * (35.0 + 8.0 * dim) + 30.0 * eps**2 * (1.0 - eps)
+    out = num / den
+    return out[()] if out.ndim == 0 else out
+
+
+def driven_temperature(heating_rate, eps, n, dim=3, sigma=1.0, m=1.0, chi=None, a2=None):
+    """Steady temperature of a white-noise driven gas, ``zeta(T) T = H`` (constant eps).
+
+    With the Enskog cooling rate (:func:`enskog_cooling_rate`) ``zeta = Z0 sqrt(T)``:
+    ``T = (H / Z0)^(2/3)``. ``heating_rate`` H is dT/dt of the driving alone.
+
+    Parameters
+    ----------
+    a2 : float, optional
+        Second Sonine coefficient in zeta; default :func:`driven_sonine_a2`.
+    """
+    if a2 is None:
+        a2 = driven_sonine_a2(eps, dim)
+    z0 = enskog_cooling_rate(eps, n, 1.0, dim, sigma, m, chi, a2)
+    return (np.asarray(heating_rate, dtype=float) / z0) ** (2.0 / 3.0)
+
+
+def driving_interval(cooling_rate, fraction=0.01):
+    """Interval between white-noise kicks: ``dt_k = fraction / zeta``.
+
+    Between kicks the gas cools by ``zeta dt_k``; a kick adds as much. The steady
+    state (T and a2) is independent of dt_k to within the statistics of a long run
+    for ``zeta dt_k <= 0.02``, measured with ``scripts/driven_steady_state.py``;
+    the default keeps a safety factor of 2.
+    """
+    return fraction / cooling_rate
+
+
+def effective_restitution(prefactor, T, m=1.0, sigma=1.0, end="overlap"):
+    """Effective constant restitution coefficient of a viscoelastic gas at temperature T.
+
+    The constant eps_eff that gives the same Enskog cooling rate as the impact-speed
+    dependent eps(beta), beta = b g_n^(1/5) (:func:`pair_damping`), for a
+    Maxwellian gas (Dubey, Bodrova, Puri & Brilliantov, arXiv:1209.5326 (2013)):
+    collisions with normal speed g_n occur at a rate ~ g_n and remove
+    (1 - eps^2) m_eff g_n^2 / 2, and g_n along a fixed direction is Gaussian with
+    variance 2 T / m, so
+
+        1 - eps_eff^2 = int (1 - eps(b g^(1/5))^2) g^3 exp(-g^2 / (4 T/m)) dg
+                        / int g^3 exp(-g^2 / (4 T/m)) dg,
+
+    evaluated by adaptive quadrature (scipy) in u = g^2 / (4 T/m) with eps(beta) from the
+    engine's restitution table (:func:`granulargas.contact.restitution_table`, within 1e-8
+    of the contact ODE). To leading order in beta it is :func:`effective_inelasticity`.
+    """
+    from scipy.integrate import quad
+
+    from granulargas.contact import restitution_table
+
+    b = pair_damping(prefactor, sigma, m)
+    scale = 4.0 * float(T) / m
+    u_max = 200.0  # u e^-u < 1e-84 beyond
+    table = restitution_table(max(b * (scale * u_max) ** 0.1 * 1.01, 1e-3), end=end)
+
+    def lost(u):
+        eps = float(table.restitution(b * (scale * u) ** 0.1))
+        return u * math.exp(-u) * (1.0 - eps * eps)
+
+    loss = quad(lost, 0.0, u_max, epsabs=1e-13, epsrel=1e-11, limit=200, points=[1.0, 10.0])[0]
+    return math.sqrt(1.0 - loss)  # int u exp(-u) du = 1
+
+
+def viscoelastic_driven_state(heating_rate, prefactor, n, dim=3, sigma=1.0, m=1.0, chi=None,
+                              end="overlap"):
+    """Steady temperature and a2 of a white-noise driven viscoelastic gas.
+
+    The effective-restitution model of Dubey, Bodrova, Puri & Brilliantov (2013): at the
+    steady temperature T the gas behaves as one of constant eps_eff(T)
+    (:func:`effective_restitution`), so T solves ``zeta(eps_eff(T), T) T = H`` with the
+    Enskog rate and a2 = :func:`driven_sonine_a2` (eps_eff(T)) in it; a2 is that value
+    at the solution. Returns (T, a2, eps_eff).
+    """
+    t = float(driven_temperature(heating_rate, 1.0 - effective_inelasticity(
+        pair_damping(prefactor, sigma, m), 1.0, m) / 2.0, n, dim, sigma, m, chi))
+    # fixed point T -> T_ss(eps_eff(T)): a contraction (eps_eff depends on T^(1/10))
+    for _ in range(100):
+        e = effective_restitution(prefactor, t, m, sigma, end)
+        t_new = float(driven_temperature(heating_rate, e, n, dim, sigma, m, chi))
+        if abs(t_new - t) <= 1e-13 * t:
+            break
+        t = t_new
+    return t_new, float(driven_sonine_a2(e, dim)), e

@@ -52,3 +52,29 @@ def hermite_table(func, beta_max=25.0, n=4000):
     from types import SimpleNamespace
 
     return SimpleNamespace(inv_h=1.0 / h, coeffs=np.ascontiguousarray(coeffs), beta_max=beta_max)
+
+
+def walled_state(n, packing, dimension, walls, seed=0, radii=0.5, temperature=1.0):
+    """A random state in a box with flat walls on the axes ``walls`` (no sphere overlapping one).
+
+    Positions are placed as in a periodic box whose wall axes are shorter by the largest
+    diameter, then shifted by the largest radius: every sphere lies within [R, L - R].
+    Returns (kwargs for Simulation, boundary tuple).
+    """
+    from granulargas.engine.initial import (box_for_packing, maxwell_velocities,
+                                            random_positions)
+
+    rng = np.random.default_rng(seed)
+    rad = np.array(np.broadcast_to(np.asarray(radii, float), (n,)))
+    box = box_for_packing(rad, packing, dimension)
+    inner = box.copy()
+    rmax = rad.max()
+    inner[list(walls)] -= 2 * rmax
+    # the placement's cell grid needs 3 cells of one diameter per side
+    assert inner.min() >= 3.15 * 2 * rmax, f"box {box} too small for a walled random state"
+    pos = random_positions(rad, inner, rng=rng)
+    pos[:, list(walls)] += rmax
+    masses = (2 * rad) ** dimension
+    vel = maxwell_velocities(masses, dimension, temperature, rng=rng)
+    boundary = tuple("wall" if a in walls else "periodic" for a in range(dimension))
+    return dict(positions=pos, velocities=vel, radii=rad, masses=masses, box=box), boundary
