@@ -9,8 +9,8 @@ prints every rate and, per size, the medians and B/A.
 
 Usage::
 
-    git worktree add /tmp/old 3bf177e            # the version to compare with
-    python scripts/bench_ab.py /tmp/old . --sizes 1e4 1e5 1e6 --rounds 3
+    git worktree add /tmp/base main              # the tree to compare with
+    python scripts/bench_ab.py /tmp/base . --sizes 1e4 1e5 1e6 --rounds 3
 """
 
 from __future__ import annotations

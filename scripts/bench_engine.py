@@ -42,7 +42,7 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
     import numpy as np
 
     from granulargas.engine import CollisionRule, Simulation
-    from granulargas.engine.initial import random_state
+    from granulargas.initial import random_state
 
     # compile (from cache) before measuring memory
     warm = random_state(64, 0.2, dim, seed=0)
@@ -117,7 +117,7 @@ def jit_times():
     """(first compile s, cached load s), each in a fresh process."""
     code = ("import time; t=time.perf_counter(); "
             "from granulargas.engine import Simulation, CollisionRule; "
-            "from granulargas.engine.initial import random_state; "
+            "from granulargas.initial import random_state; "
             "st=random_state(64, 0.2, 3, seed=0); "
             "Simulation(**st.as_kwargs(), rule=CollisionRule.elastic()).run(0.5); "
             "print(time.perf_counter()-t)")

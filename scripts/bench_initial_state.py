@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 from granulargas.errors import UserError
 
 DEFAULT = ["1e6:0.1:3", "1e6:0.3:3", "1e6:0.45:3", "1e6:0.7:2"]

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 from granulargas.errors import UserError
 
 

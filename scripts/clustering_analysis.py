@@ -1,9 +1,10 @@
-"""Structure of a cooling granular gas over time (issue 6): clusters, S(k), shear modes.
+"""Structure of a cooling granular gas over time: clusters, S(k), shear modes.
 
 For a run's H5MD file (2D or 3D; 3D shows a slab and projections) writes
 
 * ``<prefix>_t<k>.png`` for chosen times: particles coloured by speed, the
-  coarse-grained packing fraction, the vorticity of the coarse-grained flow,
+  coarse-grained packing fraction, the vorticity of the flow smoothed over a
+  Gaussian that holds ~200 particles (finer cells show thermal noise only),
   S(k) (small k included, ideal gas = 1) and the flow's energy spectrum E(k);
 * ``<prefix>_series.png``: time series of the peak of S(k) and S at the smallest
   wavenumber, the largest-cluster fraction, T(t) with Haff's (or the viscoelastic)
@@ -43,14 +44,62 @@ def _plt():
 def current_instability_length(info: RunInfo, T: float) -> float:
     """L_c at temperature T: constant restitution -> independent of T; viscoelastic
     -> with the effective restitution at T, which grows towards 1 as the gas cools."""
-    n = info.number_density
-    if info.model == "constant" and info.restitution is not None:
-        return float(th.instability_length(info.restitution, n, info.dimension, info.diameter))
-    if info.model == "viscoelastic" and info.prefactor is not None:
-        b = th.pair_damping(info.prefactor, info.diameter, info.mass)
-        e2 = 1.0 - float(th.effective_inelasticity(b, T, info.mass))
-        return float(th.instability_length(math.sqrt(max(e2, 0.0)), n, info.dimension, info.diameter, a2=0.0))
-    return math.inf
+    return info.gas(T).instability_length()
+
+
+def smoothing_length(info: RunInfo, particles: float = 200.0) -> float:
+    """Width of the Gaussian that holds ``particles`` particles at the mean number density."""
+    n = info.particles / float(np.prod(info.box))
+    if info.dimension == 2:
+        return math.sqrt(particles / (2.0 * math.pi * n))
+    return (particles / ((2.0 * math.pi) ** 1.5 * n)) ** (1.0 / 3.0)
+
+
+def vorticity_noise(info: RunInfo, ell: float) -> float:
+    """RMS vorticity (in sqrt(T)/sigma) that thermal noise alone gives after the smoothing.
+
+    For uncorrelated particles with velocity variance T/m per component at number
+    density n, the Gaussian-smoothed velocity has the noise spectrum
+    (T/m)/n |K(k)|^2, K = exp(-k^2 ell^2 / 2); integrating k^2 |K|^2 over the
+    wavevectors gives <w^2> = (T/m) / (4 pi n ell^4) in 2D and
+    (T/m) / (8 pi^(3/2) n ell^5) in 3D (before the z average)."""
+    n = info.particles / float(np.prod(info.box))
+    if info.dimension == 2:
+        return 1.0 / math.sqrt(4.0 * math.pi * n * ell**4 * info.mass)
+    return 1.0 / math.sqrt(8.0 * math.pi**1.5 * n * ell**5 * info.mass)
+
+
+def smoothed_vorticity(pos, vel, masses, box, info: RunInfo):
+    """Vorticity of the mass-weighted velocity field smoothed by a Gaussian.
+
+    Mass and momentum are binned on a grid of about ell/2 per cell and both
+    smoothed with the same Gaussian of width ell (:func:`smoothing_length`); the
+    velocity is u = p / rho. Its curl is taken from the spectral derivatives of the
+    smooth fields, curl u = (rho curl p - grad rho x p) / rho^2, so that no
+    discontinuity enters a Fourier transform. Cells whose smoothed density is below
+    5 % of the mean are masked (NaN). Returns (ell, vorticity: the scalar in 2D,
+    the z component in 3D)."""
+    ell = smoothing_length(info)
+    d = info.dimension
+    bins = int(min(256 if d == 2 else 64, max(16, round(float(box.min()) / (0.5 * ell)))))
+    u, mass = flow.velocity_field(pos, vel, box, bins, masses, remove_mean=True)
+    ks = np.meshgrid(*[2.0 * np.pi * np.fft.fftfreq(bins, d=L / bins) for L in box], indexing="ij")
+    kernel = np.exp(-0.5 * sum(k * k for k in ks) * ell * ell)
+
+    def smooth(f, axis=None):  # Gaussian-smoothed f, or its derivative along axis
+        fk = np.fft.fftn(f) * kernel
+        if axis is not None:
+            fk = fk * 1j * ks[axis]
+        return np.real(np.fft.ifftn(fk))
+
+    mom = [u[..., a] * mass for a in range(d)]
+    rho = smooth(mass)
+    px, py = smooth(mom[0]), smooth(mom[1])
+    # z component of curl(p / rho) (the only one in 2D)
+    w = (rho * (smooth(mom[1], 0) - smooth(mom[0], 1)) - (smooth(mass, 0) * py - smooth(mass, 1) * px))
+    low = rho < 0.05 * mass.mean()
+    w = np.where(low, np.nan, w / np.where(low, 1.0, rho) ** 2)
+    return ell, w
 
 
 def grid_cells(info: RunInfo, cell: float) -> int:
@@ -86,7 +135,7 @@ def figure_snapshot(snap, info, cells, k_max, path, theory_law):
     plt = _plt()
     pos, vel, box = snap.positions, snap.velocities, snap.box
     T = temperature(vel, snap.masses)
-    fig, ax = plt.subplots(1, 5, figsize=(21, 4.4), gridspec_kw={"width_ratios": [1, 1, 1, 1.05, 1.05]})
+    fig, ax = plt.subplots(1, 5, figsize=(21, 4.6), gridspec_kw={"width_ratios": [1, 1, 1, 1.05, 1.05]})
     sel = _slab(snap, info)
     speed = np.linalg.norm(vel[sel] - vel.mean(axis=0), axis=1) / math.sqrt(T)
     n = sel.size
@@ -101,17 +150,21 @@ def figure_snapshot(snap, info, cells, k_max, path, theory_law):
                       vmax=max(3 * info.packing_fraction, float(np.percentile(rho, 99.5))))
     fig.colorbar(im, ax=ax[1], fraction=0.046, label="local packing fraction")
     ax[1].set_title(f"density ({cells} cells per side{', z-averaged' if info.dimension == 3 else ''})", fontsize=9)
-    # vorticity on a coarser grid (~40 particles per cell) so that the thermal noise
-    # of the cell velocities does not hide the shear modes
-    vcells = min(cells, max(4, int((info.particles / 40.0) ** (1.0 / info.dimension))))
-    u, _ = flow.velocity_field(pos, vel, box, vcells, snap.masses)
-    w = flow.vorticity(u, box)
+    # vorticity of the flow smoothed over a Gaussian of width ell that holds ~200
+    # particles at the mean density: cell averages over a few dozen particles are
+    # dominated by thermal noise, which the derivative amplifies
+    ell, w = smoothed_vorticity(pos, vel, snap.masses, box, info)
+    w = w / math.sqrt(T)  # in units of sqrt(T)/sigma
     if info.dimension == 3:
-        w = w[..., 2].mean(axis=2)
-    wmax = float(np.percentile(np.abs(w), 99)) or 1.0
-    im = ax[2].imshow(w.T, origin="lower", extent=(0, box[0], 0, box[1]), cmap="RdBu_r", vmin=-wmax, vmax=wmax)
-    fig.colorbar(im, ax=ax[2], fraction=0.046, label="vorticity" + (" $\\omega_z$" if info.dimension == 3 else ""))
-    ax[2].set_title(f"vorticity of the coarse-grained flow ({vcells} cells per side)", fontsize=9)
+        w = np.nanmean(w, axis=2)  # omega_z averaged over z
+    wmax = float(np.nanpercentile(np.abs(w), 99)) or 1.0
+    cmap = plt.get_cmap("RdBu_r").copy()
+    cmap.set_bad("0.85")
+    im = ax[2].imshow(w.T, origin="lower", extent=(0, box[0], 0, box[1]), cmap=cmap, vmin=-wmax, vmax=wmax)
+    fig.colorbar(im, ax=ax[2], fraction=0.046,
+                 label="vorticity" + (" $\\omega_z$" if info.dimension == 3 else "") + " [$\\sqrt{T}/\\sigma$]")
+    ax[2].set_title(f"vorticity of the flow smoothed over {ell:.3g} $\\sigma$ (thermal noise alone:\n"
+                    f"rms {vorticity_noise(info, ell):.2g}; grey: below 5 % of the mean density)", fontsize=9)
     for a in ax[:3]:
         a.set_aspect("equal")
         a.set(xlim=(0, box[0]), ylim=(0, box[1]))
@@ -125,6 +178,8 @@ def figure_snapshot(snap, info, cells, k_max, path, theory_law):
     ax[3].set(xlabel="$k\\sigma$", ylabel="$S(k)$")
     ax[3].legend(fontsize=8)
     ax[3].set_title("static structure factor", fontsize=9)
+    vcells = min(cells, max(4, int((info.particles / 40.0) ** (1.0 / info.dimension))))
+    u, _ = flow.velocity_field(pos, vel, box, vcells, snap.masses)
     ku, E = flow.energy_spectrum(u, box)
     ax[4].loglog(ku, E / T, "o-", ms=2.5)
     if math.isfinite(lc):

@@ -34,10 +34,10 @@ import numpy as np
 from scipy.optimize import brentq
 
 from granulargas import theory
-from granulargas import validity as V
+from granulargas.run import validity as V
 from granulargas.contact import restitution_table
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 from granulargas.errors import InelasticCollapseError
 
 
@@ -112,14 +112,14 @@ def main(argv=None):
 
     # 3. viscoelastic with the same initial cooling rate
     gas = V.Gas(dimension=2, packing_fraction=eta, density=dens, sigma=1.0, mass=1.0, temperature=1.0,
-                model="viscoelastic", prefactor=1.0, damping=1.0)
+                model="viscoelastic", prefactor=1.0)
     from dataclasses import replace
 
     def mismatch(lb):
-        return V.effective_inelasticity(replace(gas, damping=math.exp(lb)), 1.0) - (1 - eps**2)
+        return V.effective_inelasticity(replace(gas, prefactor=math.exp(lb)), 1.0) - (1 - eps**2)
 
     b = math.exp(brentq(mismatch, math.log(1e-3), math.log(5.0)))
-    gas = replace(gas, damping=b, prefactor=b)
+    gas = replace(gas, prefactor=b)  # reduced units: k = b = damping for unit particles
     table = restitution_table(b * (2 * math.sqrt(2 * n)) ** 0.2 * 1.01)
     sim = Simulation(**st.as_kwargs(), rule=CollisionRule.viscoelastic(prefactor=b, table=table))
     visco, e3, w3 = record(sim, t_run, 1.0, budget)

@@ -11,6 +11,12 @@ Two studies:
     relative deviation from the event-driven run; prints the wall times and
     their ratio; writes ``results.json`` in the work directory.
 
+``python scripts/compare_lammps.py CONFIG --ensemble 8 [--set system.particles=2000] [--end-time 30]``
+    The same comparison over seeds 1..8 at the first contact-time fraction: the
+    mean and standard error over seeds of T_LAMMPS / T_granulargas - 1 at a few
+    times and averaged over the second half of the run (single runs from one
+    initial state decorrelate, so only the mean tests for a systematic difference).
+
 ``python scripts/compare_lammps.py --head-on``
     eps(beta) of LAMMPS head-on collisions (limit_damping on / off) against
     :func:`granulargas.contact.restitution` (``force`` / ``overlap`` end),
@@ -49,7 +55,7 @@ def run_granulargas(config, overrides: dict, workdir: Path, repeats: int):
     """Run the config ``repeats`` times; return (observables, wall times, compile time, summary)."""
     from granulargas.io.config import parse_config
     from granulargas.io.h5md import read_observables
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     # compile (and load the numba cache) on a tiny copy of the config
     t0 = time.perf_counter()
@@ -80,7 +86,7 @@ def seed_spread(config, overrides: dict, workdir: Path, seeds: int, t_ref, T_ref
     LAMMPS and granulargas from fluctuations alone."""
     from granulargas.io.config import parse_config
     from granulargas.io.h5md import read_observables
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     devs = []
     for k in range(1, seeds + 1):
@@ -95,8 +101,8 @@ def seed_spread(config, overrides: dict, workdir: Path, seeds: int, t_ref, T_ref
 
 
 def run_dem(config, workdir: Path, fraction: float, steps_per_contact: int, end_time: float, reuse: bool):
-    from granulargas.io.export import export_lammps
-    from granulargas.io.lammps import loop_time, read_thermo, run_lammps
+    from granulargas.dem.export import export_lammps
+    from granulargas.dem.lammps import loop_time, read_thermo, run_lammps
 
     d = workdir / f"lammps_f{fraction:g}"
     ex = export_lammps(config, d, contact_fraction=fraction, steps_per_contact=steps_per_contact, end_time=end_time)
@@ -117,8 +123,8 @@ def run_dem(config, workdir: Path, fraction: float, steps_per_contact: int, end_
 def cooling(args):
     from granulargas import theory
     from granulargas.io.config import load_config
-    from granulargas.io.lammps import find_lmp
-    from granulargas.io.run_command import parse_override
+    from granulargas.dem.lammps import find_lmp
+    from granulargas.cli._args import parse_override
 
     overrides = dict(parse_override(t) for t in args.set)
     if args.end_time is not None:
@@ -173,8 +179,44 @@ def cooling(args):
     print(f"figure {args.figure}; results {workdir / 'results.json'}")
 
 
+def ensemble(args):
+    from granulargas.io.config import load_config
+    from granulargas.dem.lammps import find_lmp
+    from granulargas.cli._args import parse_override
+
+    if find_lmp() is None:
+        sys.exit("LAMMPS (lmp) not found: the ensemble needs it (apt-get install lammps)")
+    base = dict(parse_override(t) for t in args.set)
+    if args.end_time is not None:
+        base["run.end_time"] = args.end_time
+    f = args.fractions[0]
+    devs = []
+    for seed in range(1, args.ensemble + 1):
+        overrides = {**base, "system.seed": seed}
+        config = load_config(args.config, overrides)
+        workdir = Path(args.workdir) / "ensemble" / f"seed{seed}"
+        workdir.mkdir(parents=True, exist_ok=True)
+        obs, _, _, _ = run_granulargas(config, overrides, workdir, 1)
+        _, t, T = obs["temperature"]
+        _, th, _, _ = run_dem(config, workdir, f, args.steps_per_contact, config.run.end_time, args.reuse)
+        devs.append(np.interp(t, th["Time"], th["c_granT"]) / T - 1.0)
+        print(f"seed {seed}: T_LAMMPS/T_granulargas - 1 at t_end = {100 * devs[-1][-1]:+.2f} %", flush=True)
+    d = 100 * np.array(devs)
+    n = len(d)
+    s = config.system
+    print(f"N = {s.particles}, {s.dimension}D, packing {s.packing_fraction:g}, t_c = {f:g} t_free, "
+          f"{args.steps_per_contact} steps per contact, {n} seeds: mean +- standard error of T_LAMMPS/T_ED - 1 [%]")
+    t_end = float(t[-1])
+    for x in (0.1, 0.2, 0.5, 1.0):
+        v = np.array([np.interp(x * t_end, t, row) for row in d])
+        print(f"  t = {x * t_end:8.4g}: {v.mean():+.2f} +- {v.std(ddof=1) / np.sqrt(n):.2f}  (single seeds: sd {v.std(ddof=1):.2f})")
+    late = t >= 0.5 * t_end
+    v = d[:, late].mean(axis=1)
+    print(f"  mean over t >= {0.5 * t_end:g}: {v.mean():+.2f} +- {v.std(ddof=1) / np.sqrt(n):.2f}")
+
+
 def _prefactor(config):
-    from granulargas.io.setup import reduced_prefactor
+    from granulargas.run.prepare import reduced_prefactor
 
     return reduced_prefactor(config)
 
@@ -185,10 +227,10 @@ def plot_cooling(path, config, t_ed, T_ed, ed_wall, dem, tau0, spread=None):
     plt = _plt()
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.3))
     s = config.system
-    ax.loglog(t_ed[1:], T_ed[1:], "-", color="C0", lw=2.5, label=f"granulargas (event-driven), {ed_wall:.3g} s")
+    ax.loglog(t_ed[1:], T_ed[1:], "-", color="C0", lw=2.5, label="granulargas (event-driven)")
     styles = ["--", ":", "-."]
     for (f, ex, th, wall), ls, c in zip(dem, styles, ["C3", "C2", "C4"]):
-        lab = f"LAMMPS, $t_c$ = {f:g} $t_{{free}}$ (Y = {ex.contact.young_modulus:.2g}), {wall:.3g} s"
+        lab = f"LAMMPS, $t_c$ = {f:g} $t_{{free}}$ (Y = {ex.contact.young_modulus:.2g})"
         ax.loglog(th["Time"][1:], th["c_granT"][1:], ls, color=c, lw=1.8, label=lab)
         T_l = np.interp(t_ed, th["Time"], th["c_granT"])
         ax2.plot(t_ed, (T_l / T_ed - 1.0) * 100, ls, color=c,
@@ -222,7 +264,7 @@ def plot_cooling(path, config, t_ed, T_ed, ed_wall, dem, tau0, spread=None):
 
 def head_on(args):
     from granulargas.contact import restitution
-    from granulargas.io.lammps import DemContact, find_lmp, head_on_restitution
+    from granulargas.dem.lammps import DemContact, find_lmp, head_on_restitution
 
     if find_lmp() is None:
         sys.exit("LAMMPS (lmp) not found: the head-on study needs it (apt-get install lammps)")
@@ -261,9 +303,13 @@ def head_on(args):
     ax.set_ylabel(r"coefficient of restitution $\varepsilon$")
     ax.set_title("two spheres head-on: LAMMPS hertz/material + viscoelastic", fontsize=10)
     ax.legend(fontsize=8)
+    # colour = end of contact, as in the left panel; line style and marker = beta
+    # (markers other than the left panel's, which mark the end there)
+    colour = {"force": "C3", "overlap": "C0"}
+    style = {0.1: ("--", "^", "none"), 1.0: ("-", "D", None)}
     for (beta, end), err in conv.items():
-        ls = "-" if end == "force" else "--"
-        ax2.loglog(steps, np.maximum(err, 1e-12), ls, marker="o", ms=4,
+        ls, mk, mfc = style[beta]
+        ax2.loglog(steps, np.maximum(err, 1e-12), ls, marker=mk, ms=5, color=colour[end], mfc=mfc,
                    label=fr"$\beta$ = {beta:g}, '{end}' end")
     ax2.loglog(steps, 0.05 / steps, "k:", lw=1, label="first order ($\\propto \\Delta t$)")
     ax2.set_xlabel(r"steps per contact $t_c/\Delta t$")
@@ -291,11 +337,15 @@ def main(argv=None):
     p.add_argument("--workdir", default="runs/compare_lammps")
     p.add_argument("--reuse", action="store_true", help="reuse finished LAMMPS runs in the work directory")
     p.add_argument("--figure", default=str(ROOT / "docs" / "figures" / "lammps_cooling.png"))
+    p.add_argument("--ensemble", type=int, default=0, metavar="SEEDS",
+                   help="mean LAMMPS/granulargas difference over seeds 1..SEEDS (first fraction) instead")
     p.add_argument("--head-on", action="store_true", help="the two-particle study instead")
     p.add_argument("--figure-head-on", default=str(ROOT / "docs" / "figures" / "lammps_restitution.png"))
     args = p.parse_args(argv)
     if args.head_on:
         head_on(args)
+    elif args.ensemble:
+        ensemble(args)
     else:
         cooling(args)
 

@@ -19,7 +19,7 @@ isolation (loops over 1e6 beta drawn from the run's range).
 
 Cooling-curve error = largest relative deviation of T(t) from the reference
 (the 128-interval table of the same contact end) over the run:
-predicted by kinetic theory (:func:`granulargas.validity.viscoelastic_cooling`
+predicted by kinetic theory (:func:`granulargas.run.validity.viscoelastic_cooling`
 with the candidate eps) and measured with engine runs (mean over seeds of the
 per-seed ratio, same initial states; +- standard error).
 
@@ -43,7 +43,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from granulargas import theory
-from granulargas import validity as V
+from granulargas.run import validity as V
 from granulargas._numba import jit
 from granulargas.contact import restitution_table
 from granulargas.contact.lookup import table_lookup, table_lookup_many
@@ -51,7 +51,7 @@ from granulargas.contact.ode import solve_many
 from granulargas.contact.pade import A_PADE, C1
 from granulargas.contact.series import restitution_coefficients
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 
 
 @dataclass(frozen=True)
@@ -218,7 +218,7 @@ def main(argv=None):
         n, seeds, t_end, sizes, orders = 300, 2, 10.0, [4, 128], {"overlap": [1, 2], "force": [4]}
     timing = dict(n=500, collisions=20_000, repeats=1) if args.quick else {}
     wall0 = time.perf_counter()
-    # rigorous beta bound of the runs (io.setup): g_n <= 2 sqrt(2 E / m), R_eff <= 1/2, m_eff >= 1/2
+    # rigorous beta bound of the runs (run.prepare): g_n <= 2 sqrt(2 E / m), R_eff <= 1/2, m_eff >= 1/2
     g_max = 2.0 * math.sqrt(2.0 * 1.5 * n * 1.05)
     beta_max = b * (2 * 0.5 / 1.0) ** 0.2 * g_max**0.2
     times = np.linspace(0, t_end, 41)[1:]
@@ -268,7 +268,7 @@ def main(argv=None):
     # engine: compile once (not timed), then references
     engine_runs(max(n, 300), b, ref["overlap"], 1, 0.5, np.array([0.5]))
     gas = V.Gas(dimension=3, packing_fraction=0.1, density=theory.number_density(0.1, 3), sigma=1.0, mass=1.0,
-                temperature=1.0, model="viscoelastic", prefactor=b, damping=b)
+                temperature=1.0, model="viscoelastic", prefactor=b)
     T_ref, cost_ref, pred_ref = {}, {}, {}
     for end in ("overlap", "force"):
         T_ref[end], _ = engine_runs(n, b, ref[end], seeds, t_end, times)

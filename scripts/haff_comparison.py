@@ -1,4 +1,4 @@
-"""Cooling of granular gases against kinetic theory (issue 5), several seeds per case.
+"""Cooling of granular gases against kinetic theory, several seeds per case.
 
 Runs (or, with --reuse, reads) three kinds of cooling runs and compares them with
 :mod:`granulargas.theory`:
@@ -59,7 +59,7 @@ observables_interval = {dt}
 
 def run_case(outdir, name, dim, n, eta, seed, collision, end, dt, snapshots, first, reuse):
     from granulargas.io.config import parse_config
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     path = Path(outdir) / f"{name}_seed{seed}.h5"
     if reuse and path.exists():
@@ -210,7 +210,7 @@ def a2_scan(outdir, seeds, reuse, eps_values=(0.3, 0.5, 0.7, 0.9)):
     """HCS a2 (3D, packing 0.05, box 0.5 L_c, snapshots every 30/39 tau0 after 2 tau0)."""
     from granulargas.analysis.run import sonine_history
     from granulargas.io.config import parse_config
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     eta = 0.05
     n = th.number_density(eta, 3)

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 
 EPS_MACH = np.finfo(float).eps
 

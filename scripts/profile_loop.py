@@ -31,7 +31,7 @@ def profile(n, packing, walls=False, seed=1):
     import numpy as np
 
     from granulargas.engine import CollisionRule, Simulation, _loop, _probe
-    from granulargas.engine.initial import random_state
+    from granulargas.initial import random_state
 
     st = random_state(n, packing, 3, seed=seed)
     kw = st.as_kwargs()

@@ -2,7 +2,7 @@
 
 For a cooling 3D gas (packing 0.1) and several dampings, runs the viscoelastic
 rule and the constant eps that ``granulargas advise`` recommends (same config,
-same seeds, through :func:`granulargas.io.runner.run_config`), and compares the
+same seeds, through :func:`granulargas.run.runner.run_config`), and compares the
 measured largest relative error of the seed-averaged T(t) with the advice's
 prediction, and the cost (wall time) of both.
 
@@ -25,11 +25,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from granulargas.advise import advise, DEFAULT_TOLERANCE
+from granulargas.run.advise import advise, DEFAULT_TOLERANCE
 from granulargas.io.config import parse_config
 from granulargas.io.h5md import read_observables
-from granulargas.io.runner import run_config
-from granulargas import validity as V
+from granulargas.run.runner import run_config
+from granulargas.run import validity as V
 
 BASE = """
 [system]
@@ -93,7 +93,7 @@ def main(argv=None):
             k = int(np.argmax(np.abs(mean)))
             gas = V.gas_from_config(cfg)
             curve = V.viscoelastic_cooling(gas)
-            from granulargas.advise import _haff
+            from granulargas.run.advise import _haff
             predicted = _haff(gas, adv.eps_best, t) / curve.temperature_at(t) - 1.0
             rows.append(dict(b=b, eps=adv.eps_best, pred=adv.error, meas=abs(mean[k]), sem=sem[k], t=t,
                              curve=mean, curve_sem=sem, curve_pred=predicted,

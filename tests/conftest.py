@@ -1,6 +1,8 @@
-"""Shared pytest configuration.
+"""Shared pytest configuration and fixtures.
 
-The default run skips tests marked ``slow``; ``-m slow`` selects them.
+The default run skips tests marked ``slow``; ``-m slow`` selects them. The
+tests are a package (``tests``): helpers are imported as ``tests.<area>.<module>``
+(e.g. :mod:`tests.engine.factories`, :mod:`tests.contact.truths`).
 """
 
 import pytest
@@ -13,3 +15,11 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if "slow" in item.keywords:
             item.add_marker(skip_slow)
+
+
+@pytest.fixture
+def cache_dir(tmp_path, monkeypatch):
+    """A fresh, private restitution-table cache directory."""
+    d = tmp_path / "cache"
+    monkeypatch.setenv("GRANULARGAS_CACHE_DIR", str(d))
+    return d

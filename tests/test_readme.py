@@ -18,6 +18,8 @@ def test_readme_opens_with_exactly_two_commands():
     assert len(cmds) == 2
     assert cmds[0].startswith("pip install ") and "granulargas run configs/" in cmds[0]
     assert cmds[1].startswith("pip install ") and "pytest" in cmds[1]
+    # the test command installs the docs extra, so CI builds the documentation (tests/test_docs.py)
+    assert "docs" in cmds[1].split("&&")[0]
 
 
 def test_ci_runs_the_readme_test_command():

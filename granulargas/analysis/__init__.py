@@ -9,5 +9,5 @@
 * :mod:`~granulargas.analysis.flow` -- coarse-grained velocity, vorticity, energy spectrum;
 * :mod:`~granulargas.analysis.run` -- an H5MD file against kinetic theory
   (:func:`~granulargas.analysis.run.analyze_cooling`), frame by frame;
-* :mod:`~granulargas.analysis.cli` -- ``granulargas analyze FILE``.
+* ``granulargas analyze FILE`` is :mod:`granulargas.cli.analyze`.
 """

@@ -1,6 +1,6 @@
 """Aggregating a sweep: averages over seeds and parameter scans.
 
-A sweep (:mod:`granulargas.sweep`) leaves ``index.json`` beside its H5MD files,
+A sweep (:mod:`granulargas.run.sweep`) leaves ``index.json`` beside its H5MD files,
 one entry per run with its varied parameters. This module groups the finished
 runs by every varied parameter except the seed, and for each group gives
 

@@ -6,6 +6,7 @@ import numpy as np
 
 
 def _plt():
+    # matplotlib is imported when a figure is drawn: `import granulargas.analysis.plots` stays cheap
     import matplotlib
 
     matplotlib.use("Agg", force=False)

@@ -27,6 +27,8 @@ from granulargas.analysis.cooling import (
     sonine_coefficients,
 )
 from granulargas.errors import InputFileError
+from granulargas.io.h5md import iter_snapshots, load_snapshot, read_observables, read_parameters
+from granulargas.theory.gas import Gas
 
 __all__ = [
     "RunInfo",
@@ -88,12 +90,11 @@ class RunInfo:
     model: str
     restitution: float | None
     prefactor: float | None
+    contact_end: str = "overlap"
     parameters: dict = field(repr=False, default_factory=dict)
 
     @classmethod
     def from_file(cls, path) -> "RunInfo":
-        from granulargas.io.h5md import load_snapshot, read_parameters
-
         params = read_parameters(path)
         snap = load_snapshot(path, 0)
         coll = params.get("collision", {}) or {}
@@ -110,6 +111,7 @@ class RunInfo:
             model=model,
             restitution=_float_or_none(coll.get("restitution")),
             prefactor=_float_or_none(coll.get("prefactor")),
+            contact_end=str(coll.get("contact_end", "overlap")),
             parameters=params,
         )
 
@@ -125,6 +127,13 @@ class RunInfo:
     def packing_fraction(self) -> float:
         return float(theory.packing_fraction(self.number_density, self.dimension, self.diameter))
 
+    def gas(self, T0: float) -> Gas:
+        """The run as a homogeneous gas of identical particles at temperature ``T0``."""
+        model = self.model if self.model in ("elastic", "constant", "viscoelastic") else "elastic"
+        return Gas(dimension=self.dimension, packing_fraction=self.packing_fraction, density=self.number_density,
+                   sigma=self.diameter, mass=self.mass, temperature=float(T0), model=model,
+                   restitution=self.restitution, prefactor=self.prefactor, end=self.contact_end)
+
     def prediction(self, T0: float) -> Prediction:
         """Kinetic theory for this run starting at temperature ``T0`` (at t = 0)."""
         d, n, s, m = self.dimension, self.number_density, self.diameter, self.mass
@@ -134,13 +143,12 @@ class RunInfo:
             eps = self.restitution
             a2 = float(theory.sonine_a2(eps, d))
             tau0 = float(theory.haff_tau0(eps, n, T0, d, s, m, a2=a2))
-            lc = float(theory.instability_length(eps, n, d, s, a2=a2)) if eps < 1 else math.inf
+            lc = self.gas(T0).instability_length()
             return Prediction("haff", T0, tau0, 2.0, a2, omega0, ell, lc)
         if self.model == "viscoelastic" and self.prefactor is not None:
             tau0 = float(theory.viscoelastic_tau0(self.prefactor, n, T0, d, s, m))
-            # instability length with the effective restitution at T0 (it grows as T falls)
-            e_eff = 1.0 - float(theory.effective_inelasticity(theory.pair_damping(self.prefactor, s, m), T0, m))
-            lc = float(theory.instability_length(math.sqrt(max(e_eff, 0.0)), n, d, s, a2=0.0))
+            # instability length at T0 (it grows as T falls)
+            lc = self.gas(T0).instability_length()
             tau2 = float(theory.viscoelastic_tau0(self.prefactor, n, T0, d, s, m, order=2))
             return Prediction("viscoelastic", T0, tau0, 5.0 / 3.0, 0.0, omega0, ell, lc, tau2)
         return Prediction("elastic", T0, math.inf, 0.0, 0.0, omega0, ell, math.inf)
@@ -166,8 +174,6 @@ class CoolingHistory:
 
 def cooling_history(path, particles: int | None = None) -> CoolingHistory:
     """Temperature and collision count against time from ``observables/``."""
-    from granulargas.io.h5md import read_observables
-
     obs = read_observables(path)
     if "temperature" not in obs:
         raise InputFileError(f"{path}: no observables/temperature in the file")
@@ -178,8 +184,6 @@ def cooling_history(path, particles: int | None = None) -> CoolingHistory:
     T, coll, ke = np.asarray(T, float)[idx], np.asarray(coll)[idx], np.asarray(ke, float)[idx]
     ok = np.isfinite(T)
     if particles is None:
-        from granulargas.io.h5md import load_snapshot
-
         particles = load_snapshot(path, 0).radii.shape[0]
     cpp = collisions_per_particle(np.where(coll >= 0, coll, np.nan), particles)
     return CoolingHistory(t[ok], T[ok], coll[ok], cpp[ok], ke[ok])
@@ -195,8 +199,6 @@ def snapshot_series(path, func: Callable, every: int = 1, indices=None) -> Itera
     indices : sequence of int, optional
         Only these frame indices (overrides ``every``).
     """
-    from granulargas.io.h5md import iter_snapshots, load_snapshot
-
     if indices is not None:
         for k in indices:
             snap = load_snapshot(path, int(k))

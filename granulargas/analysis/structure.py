@@ -28,6 +28,8 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
+from granulargas.theory import particle_volume
+
 __all__ = [
     "wrap",
     "structure_factor_vectors",
@@ -197,7 +199,7 @@ def density_field(positions, box, bins, radii=None, quantity="packing"):
     weights = None
     if quantity == "packing":
         r = np.broadcast_to(np.asarray(0.5 if radii is None else radii, dtype=float), (n,))
-        weights = math.pi * r**2 if d == 2 else 4.0 / 3.0 * math.pi * r**3
+        weights = particle_volume(2.0 * r, d)
     elif quantity not in ("number", "count"):
         raise ValueError(f"quantity must be 'packing', 'number' or 'count', got {quantity!r}")
     field, _ = np.histogramdd(pos, bins=bins, range=[(0.0, L) for L in box], weights=weights)

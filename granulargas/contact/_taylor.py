@@ -1,11 +1,11 @@
 """Compiled high-order Taylor integrator of the regularised contact equation.
 
-The rescaled contact equation (physics notes, from seed eq. 2)
+The rescaled contact equation (Schwager & Pöschel (1997), eq. (2), rescaled)
 
     x'' + beta sqrt(x) x' + x^{3/2} = 0,   x(0) = 0, x'(0) = 1,
 
 has sqrt(x) at the start (and, for the ``overlap`` end, at the end of contact):
-derivatives of x(t) of order >= 3 diverge there (seed, below eq. 8). With
+derivatives of x(t) of order >= 3 diverge there (Schwager & Pöschel (1997), below eq. (8)). With
 
     w = sqrt(x),   p = x' = dx/dt,   dt = w ds
 
@@ -21,7 +21,7 @@ integrate with steps chosen from the size of the last coefficients
 solution itself, so the end of contact is located as a root of that polynomial
 (safeguarded Newton) with no interpolation error:
 
-* ``overlap`` (seed eq. 4): w = 0 with p < 0,
+* ``overlap`` (Schwager & Pöschel (1997), eq. (4)): w = 0 with p < 0,
 * ``force`` (Schwager & Poeschel 2008): x + beta x' = 0, i.e. w^2 + beta p = 0.
 
 The same recurrences carry the sensitivities d/dbeta of (w, p, t), which give

@@ -13,6 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from granulargas.contact.ode import end_code, solve_many
+from granulargas.contact.pade import restitution_pade
+from granulargas.contact.series import duration_series, restitution_coefficients, restitution_series
+from granulargas.contact.table import restitution_table
 
 METHODS = ("ode", "series", "pade", "table")
 
@@ -22,8 +25,6 @@ def _shape_back(beta, values):
 
 
 def _table_for(beta, end):
-    from granulargas.contact.table import restitution_table
-
     b = np.asarray(beta, dtype=float)
     return restitution_table(max(float(np.max(b)) if b.size else 1.0, 1e-6) * 1.0001, end=end)
 
@@ -37,10 +38,10 @@ def restitution(beta, method: str = "ode", end: str = "overlap", order: int | No
         Dimensionless damping (3/2) A rho^{2/5} g^{1/5}, >= 0.
     method : {"ode", "series", "pade", "table"}
     end : {"overlap", "force"}
-        End of contact: x = 0 (seed eq. 4) or vanishing repulsive force.
+        End of contact: x = 0 (Schwager & Pöschel (1997), eq. (4)) or vanishing repulsive force.
     order : int, optional
         Series order (method="series"): highest power of beta ("overlap") or of
-        sqrt(beta) ("force"). Default 2 for "overlap" (seed eq. 31), 4 for "force".
+        sqrt(beta) ("force"). Default 2 for "overlap" (Schwager & Pöschel (1997), eq. (31)), 4 for "force".
 
     Returns
     -------
@@ -53,12 +54,8 @@ def restitution(beta, method: str = "ode", end: str = "overlap", order: int | No
     if method == "table":
         return _table_for(b, end).restitution(beta)
     if method == "series":
-        from granulargas.contact.series import restitution_series
-
         return _shape_back(beta, restitution_series(b, end=end, order=order))
     if method == "pade":
-        from granulargas.contact.pade import restitution_pade
-
         return _shape_back(beta, restitution_pade(b, end=end))
     raise ValueError(f"method must be one of {METHODS}, got {method!r}")
 
@@ -76,8 +73,6 @@ def duration(beta, method: str = "ode", end: str = "overlap", order: int | None 
     if method == "table":
         return _table_for(b, end).duration(beta)
     if method == "series":
-        from granulargas.contact.series import duration_series
-
         return _shape_back(beta, duration_series(b, end=end, order=order))
     if method == "pade":
         raise ValueError("no Pade approximant for the duration; use method='ode', 'series' or 'table'")
@@ -90,6 +85,4 @@ def series_coefficients(order: int, end: str = "overlap"):
     ``end="overlap"``: eps = sum_k c_k beta^k. ``end="force"``: eps = sum_k c_k u^k with
     u = sqrt(beta) (c_1 = c_3 = 0; odd powers from u^5 on).
     """
-    from granulargas.contact.series import restitution_coefficients
-
     return restitution_coefficients(order, end=end)

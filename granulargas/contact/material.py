@@ -1,6 +1,6 @@
 """From material constants to the dimensionless damping beta, and the model's validity range.
 
-Seed eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)). The rescaled contact
+Schwager & Pöschel (1997), eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)). The rescaled contact
 equation depends on the pair and the impact speed g only through
 
     beta = (3/2) A rho^{2/5} g^{1/5} = k (R_eff g / m_eff^2)^{1/5},
@@ -9,7 +9,7 @@ equation depends on the pair and the impact speed g only through
 so a run needs one material prefactor k and, per pair, b_ij = k (R_eff/m_eff^2)^{1/5}
 with beta = b_ij g^{1/5}. Physical durations are t_c = tau_c(beta) rho^{-2/5} g^{-1/5}.
 
-Validity (Brilliantov et al. 1996; physics notes): the viscoelastic force is a
+Validity (Brilliantov, Spahn, Hertzsch & Pöschel 1996): the viscoelastic force is a
 quasi-static theory. It needs the dissipative time A well below the collision
 time, which with A / t_c = (2/3) beta / tau_c(beta) means beta well below ~3 (we
 warn above ``BETA_VALID_MAX`` = 1), and impact speeds far below the speed of sound
@@ -42,7 +42,7 @@ def effective(a_i, a_j):
 
 
 def rho_from_material(young_modulus, poisson_ratio, radius_eff, mass_eff):
-    """Seed eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)), in SI (m^{-1/2} s^{-2})."""
+    """Schwager & Pöschel (1997), eq. (3): rho = 2 Y sqrt(R_eff) / (3 m_eff (1 - nu^2)), in SI (m^{-1/2} s^{-2})."""
     _positive("young_modulus", young_modulus)
     if not (-1.0 < poisson_ratio < 0.5):
         raise ValueError(f"poisson_ratio must lie in (-1, 0.5), got {poisson_ratio}")
@@ -97,11 +97,30 @@ def prefactor_from_damping(damping: float, radius: float = 0.5, mass: float = 1.
     return damping / ((0.5 * radius) / (0.5 * mass) ** 2) ** 0.2
 
 
+def damping_from_prefactor(prefactor: float, radius: float = 0.5, mass: float = 1.0) -> float:
+    """The config's ``damping`` for prefactor k: beta at g = 1 for two reference particles.
+
+    Inverse of :func:`prefactor_from_damping`: ``damping = k (R_eff_ref / m_eff_ref^2)^{1/5}``
+    (= :func:`pair_constant` of two reference particles; equal to k in reduced units).
+    """
+    return float(pair_constant(prefactor, radius, radius, mass, mass))
+
+
 def pair_constant(prefactor, radius_i, radius_j, mass_i, mass_j):
-    """b_ij = k (R_eff / m_eff^2)^{1/5}, so that beta = b_ij g^{1/5} (vectorised)."""
+    """b_ij = k (R_eff / m_eff^2)^{1/5}, so that beta = b_ij g^{1/5} (vectorised).
+
+    The one place where the pair prefactor k becomes a pair's damping: the
+    engine's kernel computes the same b_ij per collision. For two reference
+    particles b is the config's ``damping`` (:func:`damping_from_prefactor`).
+    """
     r_eff = effective(radius_i, radius_j)
     m_eff = effective(mass_i, mass_j)
     return prefactor * (r_eff / m_eff ** 2) ** 0.2
+
+
+def dissipation_time_from_prefactor(prefactor: float, young_modulus: float, poisson_ratio: float) -> float:
+    """A such that :func:`prefactor_from_material` gives k: A = (2/3) k / (2 Y / (3 (1 - nu^2)))^{2/5}."""
+    return (2.0 / 3.0) * prefactor / (2.0 * young_modulus / (3.0 * (1.0 - poisson_ratio ** 2))) ** 0.4
 
 
 def beta_from_material(young_modulus, poisson_ratio, dissipation_time, radius_eff, mass_eff, impact_speed):

@@ -1,14 +1,14 @@
 """Direct integration of the viscoelastic contact: eps(beta) and tau_c(beta).
 
-The contact of two viscoelastic spheres (seed eq. 2) in the rescaled units of the
-physics notes (time rho^{-2/5} g^{-1/5}, length g times that) reads
+The contact of two viscoelastic spheres (Schwager & Pöschel (1997), eq. (2)) in
+rescaled units (time rho^{-2/5} g^{-1/5}, length g times that) reads
 
     x'' + beta sqrt(x) x' + x^{3/2} = 0,   x(0) = 0,  x'(0) = 1.
 
-The coefficient of restitution is eps = -x'(tau_c) (seed eq. 4) and tau_c the
+The coefficient of restitution is eps = -x'(tau_c) (Schwager & Pöschel (1997), eq. (4)) and tau_c the
 dimensionless duration, for two definitions of the end of contact:
 
-* ``"overlap"``: x returns to 0 (seed eq. 4);
+* ``"overlap"``: x returns to 0;
 * ``"force"``: the repulsive force first vanishes, x + beta x' = 0
   (Schwager & Poeschel, PRE 78, 051304 (2008)).
 
@@ -37,8 +37,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
 
-from granulargas.contact import _taylor
+from granulargas.contact import _taylor, _taylor_np
 
 ENDS = ("overlap", "force")
 
@@ -99,8 +101,6 @@ def solve_many(beta, end="overlap", order=_taylor.ORDER, tol=_taylor.TOLERANCE, 
         raise ValueError("beta must be >= 0 (and not nan)")
     code = end_code(end)
     if backend == "numpy":
-        from granulargas.contact import _taylor_np
-
         out = _taylor_np.solve_many(betas, code, int(order), float(tol))
         if np.isnan(out).any():
             raise RuntimeError(f"Taylor contact integrator (numpy) failed for some beta in {betas}")
@@ -155,10 +155,6 @@ def solve_contact_scipy(beta: float, end: str = "overlap", method: str = "DOP853
     -------
     (eps, tau_c) : tuple of float
     """
-    from scipy.integrate import solve_ivp
-
-    from scipy.optimize import brentq
-
     beta = float(beta)
     end_code(end)
 
@@ -202,8 +198,6 @@ def trajectory(beta: float, end: str = "overlap", n: int = 400, rtol: float = 1e
     t, x, v : ndarray (n,)
         Dimensionless time, compression and compression rate from impact to the end.
     """
-    from scipy.integrate import solve_ivp
-
     s_end = solve_many(beta, end)[0, 4]
     s = np.linspace(0.0, s_end, n)
     sol = solve_ivp(_rhs, (0.0, s_end), [0.0, 1.0, 0.0], method="DOP853", rtol=rtol, atol=1e-14,

@@ -1,6 +1,6 @@
 """Compact Pade approximant of eps(beta) (Mueller & Poeschel, PRE 84, 021302 (2011)).
 
-In u = sqrt(beta) (physics notes):
+In u = sqrt(beta):
 
     eps ~ (1 + a u) / (1 + a u + C1 u^2 + a C1 u^3 + (2/5) C1^2 u^4),   a = 2 / (3 C1^2),
 

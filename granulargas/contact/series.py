@@ -1,7 +1,7 @@
 """Power series of eps(beta) and tau_c(beta) to high order, and their radius of convergence.
 
-Method (our choice for issue 2; the seed's own second-order route is in
-:mod:`granulargas.contact.seed_route`). In the regularised variables of
+Method (the second-order perturbation route of Schwager & Pöschel (1997) is in
+:mod:`granulargas.contact.perturbation`). In the regularised variables of
 :mod:`granulargas.contact.ode` (w = sqrt(x), dt = w ds) the contact is the
 polynomial system w' = p/2, p' = -beta w^2 p - w^4, t' = w, analytic in s and
 beta. We
@@ -36,6 +36,7 @@ import math
 import warnings
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from granulargas.contact import _series_kernel
 from granulargas.contact.ode import end_code, solve_many
@@ -189,8 +190,6 @@ def radius_of_convergence(end: str = "overlap") -> float:
     """
     end_code(end)
     if end == "overlap":
-        from scipy.optimize import minimize_scalar
-
         res = minimize_scalar(lambda b: -b * solve_many(b, "overlap")[0, 0] ** 0.2, bounds=(1.0, 20.0),
                               method="bounded", options={"xatol": 1e-10})
         return float(-res.fun)
@@ -239,7 +238,7 @@ def restitution_series(beta, end: str = "overlap", order: int | None = None, on_
     ----------
     order : int, optional
         Highest power kept, of beta ("overlap") or sqrt(beta) ("force");
-        default 2 / 4 (the seed's eq. 31).
+        default 2 / 4 (Schwager & Pöschel (1997), eq. (31)).
     on_divergence : {"warn", "raise", "ignore"}
         What to do when some beta lies beyond the radius of convergence.
     """
@@ -250,7 +249,7 @@ def restitution_series(beta, end: str = "overlap", order: int | None = None, on_
 
 
 def duration_series(beta, end: str = "overlap", order: int | None = None, on_divergence: str = "warn"):
-    """Truncated series of tau_c (vectorised); order as in :func:`restitution_series` (default 1 / 2: seed eq. 33)."""
+    """Truncated series of tau_c (vectorised); order as in :func:`restitution_series` (default 1 / 2: Schwager & Pöschel (1997), eq. (33))."""
     end_code(end)
     order = {"overlap": 1, "force": 2}[end] if order is None else int(order)
     _check_radius(beta, end, on_divergence)

@@ -11,7 +11,7 @@ beta-derivatives (sensitivity equations); on each interval the table holds the
 cubic Hermite polynomial in the local variable t = s/h - k matching values and
 s-derivatives (d/ds = 2 s d/dbeta) at both nodes, so the interpolant is C^1.
 
-Why s = sqrt(beta): the ``force`` end is a series in sqrt(beta) (physics notes),
+Why s = sqrt(beta): the ``force`` end is a series in sqrt(beta) (:mod:`granulargas.contact.series`),
 and the overlap end, a series in beta, is smooth in s too; at s = 0 the ODE is the
 elastic (Hertz) problem and is solved exactly like any other node, so no special
 small-beta branch is needed (the series is only used to test the first interval).
@@ -184,34 +184,47 @@ def _key_parameters(end: str, intervals_per_unit: int) -> dict:
     }
 
 
-def _cache_file(key_params: dict) -> Path:
+def _cache_file(key_params: dict, kind: str = "restitution") -> Path:
     digest = hashlib.sha256(json.dumps(key_params, sort_keys=True).encode()).hexdigest()[:16]
-    return cache_dir() / f"restitution-{key_params['end']}-{digest}.npz"
+    return cache_dir() / f"{kind}-{key_params['end']}-{digest}.npz"
 
 
-def _load(path: Path, key_params: dict, n: int):
+def load_cached(path: Path, key_params: dict) -> dict | None:
+    """Arrays of a cached table file, or None if missing, unreadable or built with other parameters."""
     try:
         with np.load(path, allow_pickle=False) as data:
-            stored = json.loads(str(data["key"]))
-            if stored != key_params or data["coeffs"].shape[0] < n:
+            if json.loads(str(data["key"])) != key_params:
                 return None
-            return (np.ascontiguousarray(data["coeffs"][:n]), np.ascontiguousarray(data["duration_coeffs"][:n]),
-                    np.asarray(data["err_eps"][:n]), np.asarray(data["err_tau"][:n]))
+            return {name: np.asarray(data[name]) for name in data.files if name != "key"}
     except (OSError, KeyError, ValueError):
         return None
 
 
-def _save(path: Path, key_params: dict, c_eps, c_tau, err_eps, err_tau) -> None:
+def save_cached(path: Path, key_params: dict, **arrays) -> None:
+    """Write a table file atomically (concurrent builders never see half a file); warn if impossible."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp.npz")
         os.close(fd)
-        np.savez(tmp, key=json.dumps(key_params, sort_keys=True), coeffs=c_eps, duration_coeffs=c_tau,
-                 err_eps=err_eps, err_tau=err_tau)
-        os.replace(tmp, path)  # atomic: concurrent builders never see half a file
+        np.savez(tmp, key=json.dumps(key_params, sort_keys=True), **arrays)
+        os.replace(tmp, path)
     except OSError as exc:
-        warnings.warn(f"could not cache the restitution table in {path.parent}: {exc}", RuntimeWarning,
-                      stacklevel=3)
+        warnings.warn(f"could not cache the table in {path.parent}: {exc}", RuntimeWarning, stacklevel=3)
+
+
+def _load(path: Path, key_params: dict, n: int):
+    data = load_cached(path, key_params)
+    if data is None or "coeffs" not in data or data["coeffs"].shape[0] < n:
+        return None
+    try:
+        return (np.ascontiguousarray(data["coeffs"][:n]), np.ascontiguousarray(data["duration_coeffs"][:n]),
+                np.asarray(data["err_eps"][:n]), np.asarray(data["err_tau"][:n]))
+    except KeyError:
+        return None
+
+
+def _save(path: Path, key_params: dict, c_eps, c_tau, err_eps, err_tau) -> None:
+    save_cached(path, key_params, coeffs=c_eps, duration_coeffs=c_tau, err_eps=err_eps, err_tau=err_tau)
 
 
 def restitution_table(beta_max: float, end: str = "overlap",

@@ -18,7 +18,7 @@ with eps from the same rule at R_eff = R_i, m_eff = m_i; the wall receives the
 normal momentum (1 + eps) m_i |v_n| and the energy lost is (1 - eps^2) m_i v_n^2 / 2.
 
 eps is 1 (elastic), a constant, or the viscoelastic eps(beta) with
-beta = k (R_eff g_n / m_eff^2)^(1/5) (ARCHITECTURE.md, pair prefactor), read
+beta = k (R_eff g_n / m_eff^2)^(1/5) (Schwager & Pöschel (1997), eq. (3); ARCHITECTURE.md), read
 from the tabulated spline :func:`granulargas.contact.lookup.table_lookup`.
 TC model (Luding & McNamara 1998): if a particle collided less than
 ``tc_time`` ago the collision is elastic.

@@ -37,6 +37,11 @@ _INT_MAX = np.iinfo(np.int64).max
 #: boundary conditions of an axis
 BOUNDARIES = ("periodic", "wall")
 
+#: Smallest box side in largest diameters: 3 cells per side (so that the 27
+#: neighbour cells are distinct), each one diameter wide plus a neighbour-list
+#: shell of at least 0.05 diameters: 3 x 1.05.
+MIN_BOX_DIAMETERS = 3.15
+
 
 def default_shell(packing: float) -> float:
     """Neighbour-list shell width in units of the largest diameter.
@@ -250,12 +255,12 @@ class Simulation:
             raise ConfigError(f"shell = {want}: must be > 0")
         # at least 3 cells per side so that the 27 neighbour cells are distinct
         fit = float(bx.min()) / 3.0 - dmax
-        if fit < 0.05 * dmax:
+        if float(bx.min()) < MIN_BOX_DIAMETERS * dmax:
             short = [f"{'xyz'[a]} ({self.boundary[a]})" for a in range(d)
-                     if bx[a] < 3.15 * dmax]
+                     if bx[a] < MIN_BOX_DIAMETERS * dmax]
             raise ConfigError(f"box = {bx.tolist()}: too small for the cell grid, each side must be "
-                              f">= {3.15 * dmax:.4g} (3.15 largest diameters); too short: "
-                              f"{', '.join(short)}")
+                              f">= {MIN_BOX_DIAMETERS * dmax:.4g} ({MIN_BOX_DIAMETERS:g} largest "
+                              f"diameters); too short: {', '.join(short)}")
         self.shell = min(want * dmax, fit)
         cut = dmax + self.shell
         box3 = np.ones(3)

@@ -12,7 +12,7 @@ Units (reduced): lengths in the reference particle diameter, masses in the
 reference particle mass, energies in the initial temperature T0 (k_B = 1), so
 time in sigma sqrt(m/T0). The material route (``[collision.material]``) gives
 the reference particle's SI diameter and density and the SI velocity unit
-``speed_unit`` (= sqrt(T0/m) for temperature 1); :mod:`granulargas.io.setup`
+``speed_unit`` (= sqrt(T0/m) for temperature 1); :mod:`granulargas.run.prepare`
 converts it once to the reduced pair prefactor k (ARCHITECTURE.md).
 """
 
@@ -70,7 +70,7 @@ class InitialConfig:
 
 @dataclass(frozen=True)
 class MaterialConfig:
-    """``[collision.material]`` (SI): the viscoelastic contact of seed eq. (2).
+    """``[collision.material]`` (SI): the viscoelastic contact of Schwager & Pöschel (1997), eq. (2).
 
     young_modulus (Pa), poisson_ratio, dissipation_time A (s), diameter (m) and
     density (kg/m^3) of the reference particle, speed_unit (m/s): the reduced
@@ -86,7 +86,14 @@ class MaterialConfig:
 
 @dataclass(frozen=True)
 class CollisionConfig:
-    """``[collision]``: the coefficient of restitution model."""
+    """``[collision]``: the coefficient of restitution model.
+
+    ``tc_time`` (constant model only): TC model of Luding & McNamara (1998), a
+    collision within ``tc_time`` of either particle's previous one is elastic.
+    It is a positive time; without the key (None) the TC model is off.
+    ``damping``: beta at normal impact speed g = 1 for two reference particles
+    (diameter 1, mass 1); :func:`granulargas.run.prepare.reduced_prefactor`
+    turns it (or ``[collision.material]``) into the pair prefactor k."""
 
     model: str = "viscoelastic"
     restitution: float | None = None
@@ -376,7 +383,10 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
     restitution = r.number("restitution", None, low=0.0, high=1.0, what="in (0, 1]")
     damping = r.number("damping", None, low=0.0, low_open=False, what="a number >= 0")
     contact_end = r.string("contact_end", "overlap", allowed=CONTACT_ENDS)
-    tc_time = r.number("tc_time", None, low=0.0, low_open=False, what="a number >= 0 (TC-model time)")
+    # > 0, as CollisionRule.constant asserts: tc_time = 0 would make no collision elastic (the
+    # TC model off) while still tracking and writing last-collision times; leave the key out instead
+    tc_time = r.number("tc_time", None, low=0.0, low_open=True,
+                       what="a number > 0 (TC-model time; leave tc_time out for no TC model)")
     material = None
     if "material" in r.table:
         m = _Reader(source, "collision.material", r.pop("material"), overridden)

@@ -1,6 +1,6 @@
 """The sweep index file (``index.json``): one entry per run of a sweep.
 
-Written by :mod:`granulargas.sweep` (atomically, after every finished run) and
+Written by :mod:`granulargas.run.sweep` (atomically, after every finished run) and
 read by :mod:`granulargas.analysis.ensemble`. Each entry holds ``name``, ``file``
 (absolute path of the run's H5MD file), ``parameters`` (varied dotted keys ->
 value) and ``status`` (``pending``, ``done`` or ``failed``, with ``error``).

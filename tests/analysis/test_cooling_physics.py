@@ -1,4 +1,4 @@
-"""Issue 5's physics tests: simulated cooling against kinetic theory (granulargas.theory).
+"""Physics tests: simulated cooling against kinetic theory (granulargas.theory).
 
 Default-run versions are sized for CI (N = 1000, a few seconds each after the
 numba compile); the ``slow`` versions use more particles and several seeds.
@@ -36,7 +36,7 @@ observables_interval = {dt}
 
 def _run(tmp_path, dim, n, eta, seed, collision, end, dt):
     from granulargas.io.config import parse_config
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     path = tmp_path / f"run_{dim}_{n}_{seed}.h5"
     text = CONFIG.format(dim=dim, n=n, eta=eta, seed=seed, collision=collision, end=end, dt=dt, file=path)
@@ -99,7 +99,7 @@ def test_viscoelastic_cooling_3d_small_damping(tmp_path):
 @pytest.mark.slow
 def test_haff_law_3d_large_several_seeds(tmp_path):
     # packing 0.05: N = 8000, L = 0.77 L_c; packing 0.1: N = 1000, L = 0.61 L_c, where the
-    # measured tau0 sits 1-2 % above Enskog + a2 (see the README, "Cooling"), hence 6 seeds.
+    # measured tau0 sits 1-2 % above Enskog + a2 (docs/validation.md, denser gases), hence 6 seeds.
     for eta, n, seeds in ((0.05, 8000, [11, 12, 13]), (0.1, 1000, [11, 12, 13, 14, 15, 16])):
         dev, expo = _haff(tmp_path, 3, n, eta, seeds=seeds, span=100.0).T
         assert abs(dev.mean()) < 0.02, (eta, dev)
@@ -122,7 +122,7 @@ def test_sonine_a2_of_the_hcs_matches_van_noije_ernst(tmp_path):
     # than the snapshots' own scatter / sqrt(snapshots) says.
     from granulargas.analysis.run import sonine_history
     from granulargas.io.config import parse_config
-    from granulargas.io.runner import run_config
+    from granulargas.run.runner import run_config
 
     eps, eta = 0.9, 0.05
     n = th.number_density(eta, 3)

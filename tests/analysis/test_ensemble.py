@@ -7,7 +7,7 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.analysis.ensemble import SweepResults
-from granulargas.sweep import load_sweep, run_sweep
+from granulargas.run.sweep import load_sweep, run_sweep
 
 BASE = """\
 [system]

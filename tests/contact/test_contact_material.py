@@ -1,4 +1,4 @@
-"""Material constants -> beta (seed eq. 3), prefactors, validity range."""
+"""Material constants -> beta (Schwager & Pöschel (1997), eq. (3)), prefactors, validity range."""
 
 import math
 import warnings

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from granulargas.contact import ode
-from contact_truths import C1, C2, HERTZ_DURATION
+from tests.contact.truths import C1, C2, HERTZ_DURATION
 
 BETAS = [1e-7, 1e-4, 1e-3, 1e-2, 0.1, 0.3, 1.0, 2.0, 5.0, 10.0]
 
@@ -33,7 +33,7 @@ def test_slope_at_zero_is_minus_c1(end):
 
 
 def test_first_order_duration_is_seed_eq_33():
-    # seed eq. 33: tau_c = Theta_c^0 (1 + C1 beta / 10) + O(beta^2)
+    # Schwager & Pöschel (1997), eq. (33): tau_c = Theta_c^0 (1 + C1 beta / 10) + O(beta^2)
     sol = ode.solve_contact(0.0, "overlap")
     assert sol.duration_derivative == pytest.approx(HERTZ_DURATION * C1 / 10, rel=1e-12)
 

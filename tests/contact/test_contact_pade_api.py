@@ -6,7 +6,7 @@ import pytest
 
 from granulargas.contact import duration, ode, restitution, restitution_table
 from granulargas.contact.pade import restitution_pade
-from contact_truths import C1, C2, HERTZ_DURATION
+from tests.contact.truths import C1, C2, HERTZ_DURATION
 
 
 def test_duration_zero_is_hertz():

@@ -7,7 +7,7 @@ import pytest
 
 from granulargas.contact import ode, restitution, series, series_coefficients
 from granulargas.contact.series import SeriesDivergenceWarning
-from contact_truths import C1, C2, HERTZ_DURATION
+from tests.contact.truths import C1, C2, HERTZ_DURATION
 
 
 def test_overlap_coefficients_start_with_closed_forms():

@@ -1,8 +1,8 @@
-"""Engine test configuration: the factories live in engine_factories.py."""
+"""Engine test configuration: the factories live in :mod:`tests.engine.factories`."""
 
 import pytest
 
-from engine_factories import make_sim
+from tests.engine.factories import make_sim
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.errors import ConfigError, TableRangeError
 
-from engine_factories import two_spheres
+from tests.engine.factories import two_spheres
 
 C_LIN = 0.05  # eps = 1 - C_LIN beta stays > 0.7 over the sampled range
 

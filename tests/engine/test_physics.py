@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 from granulargas.engine.invariants import check
 from granulargas.errors import InelasticCollapseError
 
-from engine_factories import hermite_table, make_sim, pade_eps
+from tests.engine.factories import hermite_table, make_sim, pade_eps
 
 
 def chi(eta, d):

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 
-from engine_factories import make_sim, next_engine_collision
-from engine_reference import next_collision, run_reference
+from tests.engine.factories import make_sim, next_engine_collision
+from tests.engine.reference import next_collision, run_reference
 
 CASES = [
     dict(n=24, packing=0.2, dimension=3, seed=1),

@@ -19,7 +19,7 @@ import pytest
 from granulargas import theory
 from granulargas.contact import restitution_table
 from granulargas.engine import CollisionRule, Simulation
-from granulargas.engine.initial import random_state
+from granulargas.initial import random_state
 from granulargas.errors import SimulationError, TableRangeError
 
 
@@ -153,11 +153,10 @@ def test_tiny_damping_dissipates_as_kinetic_theory_says():
 @pytest.mark.parametrize("dimension", [2, 3])
 def test_large_damping_keeps_conservation_laws(dimension):
     # beta ~ 10..20: eps ~ 1e-4 (far outside the model's validity, warned by
-    # granulargas.validity), yet the engine must stay consistent. In 2D some
+    # granulargas.run.validity), yet the engine must stay consistent. In 2D some
     # states instead stop with "endless rapid re-collisions" (100 re-collisions
-    # within 1e-10 collision times): of seeds 0-39 of this call, 9 with the former
-    # placement on a nearly full lattice, 5 with the lattice gas of initial.py
-    # (seed 4 among them); 3D: none. The seed picks a state that runs through.
+    # within 1e-10 collision times): 5 of seeds 0-39 of this call (seed 4 among
+    # them); 3D: none. The seed picks a state that runs through.
     st = state(n=150, packing=0.15, dimension=dimension, seed=6)
     table = restitution_table(35.0)
     sim = sim_from(st, CollisionRule.viscoelastic(prefactor=10.0, table=table))

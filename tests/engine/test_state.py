@@ -7,7 +7,7 @@ from granulargas.engine import CollisionRule, Simulation
 from granulargas.engine.invariants import check
 from granulargas.errors import ConfigError
 
-from engine_factories import hermite_table, make_sim, pade_eps
+from tests.engine.factories import hermite_table, make_sim, pade_eps
 
 RULES = [CollisionRule.elastic(), CollisionRule.constant(0.8, tc_time=1e-3),
          CollisionRule.viscoelastic(0.4, hermite_table(pade_eps))]
@@ -98,8 +98,7 @@ def test_neighbour_lists_grow_when_full():
     """Lists cut to their current fullest length overflow during the run, grow, and
     the trajectory is bit-identical to an undisturbed run."""
     # whether a list outgrows the fullest initial one by t = 2 depends on the state:
-    # about half of the seeds do (seeds 0-19: 10 with the lattice-gas placement of
-    # initial.py, 11 with the former, nearly full lattice); seed 0 does
+    # about half of the seeds do (10 of seeds 0-19); seed 0 does
     ref = make_sim(n=300, packing=0.45, seed=0, shell=1.0)
     sim = make_sim(n=300, packing=0.45, seed=0, shell=1.0)
     sim._nb_width = 4  # overflow in the first build

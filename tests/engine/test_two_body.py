@@ -7,7 +7,7 @@ import pytest
 
 from granulargas.engine import CollisionRule
 
-from engine_factories import two_spheres
+from tests.engine.factories import two_spheres
 
 
 @pytest.mark.parametrize("d", [2, 3])

@@ -11,8 +11,8 @@ from granulargas.engine import CollisionRule, Simulation
 from granulargas.engine.invariants import check
 from granulargas.errors import ConfigError
 
-from engine_factories import hermite_table, pade_eps, walled_state
-from engine_reference import next_event, restitution as ref_eps, run_reference
+from tests.engine.factories import hermite_table, pade_eps, walled_state
+from tests.engine.reference import next_event, restitution as ref_eps, run_reference
 
 RULES = {
     "elastic": CollisionRule.elastic(),

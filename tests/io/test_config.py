@@ -165,3 +165,26 @@ def test_example_configs_validate():
         first = f.read_text().lstrip().splitlines()[0]
         assert first.startswith("#"), f"{f.name} lacks a header comment"
         assert c.output.file.startswith("runs/")
+
+
+CONSTANT = FULL.replace('damping = 0.05\ncontact_end = "overlap"', 'model = "constant"\nrestitution = 0.8').replace(
+    'model = "viscoelastic"\n', "")
+
+
+@pytest.mark.parametrize("tc_time", [0.0, -1.0])
+def test_tc_time_must_be_positive(tc_time):
+    # one meaning: a positive TC-model time; without the key the TC model is off
+    with pytest.raises(ConfigError, match=rf"^override: collision\.tc_time = {tc_time:g}: must be a number > 0"):
+        parse_config(CONSTANT, overrides={"collision.tc_time": tc_time})
+
+
+def test_smallest_positive_tc_time_is_accepted_by_config_and_engine():
+    from granulargas.engine import CollisionRule
+
+    tiny = 5e-324
+    cfg = parse_config(CONSTANT, overrides={"collision.tc_time": tiny})
+    assert cfg.collision.tc_time == tiny
+    assert CollisionRule.constant(0.8, tc_time=tiny).tc_time == tiny
+    assert parse_config(CONSTANT).collision.tc_time is None
+    with pytest.raises(ConfigError, match="must be > 0"):
+        CollisionRule.constant(0.8, tc_time=0.0)

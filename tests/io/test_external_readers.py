@@ -5,7 +5,7 @@ import pytest
 
 from granulargas.io.config import load_config
 from granulargas.io.h5md import iter_snapshots, read_observables
-from granulargas.io.runner import run_config
+from granulargas.run.runner import run_config
 
 
 @pytest.fixture(scope="module")

@@ -1,0 +1,67 @@
+"""A run config as a LAMMPS run: same initial state, same contact law.
+
+:func:`export_lammps` (``granulargas export lammps CONFIG [-o DIR]``) writes a
+LAMMPS data file and input script that start from the same initial state as
+``granulargas run CONFIG`` (same seed, same particles, built by
+:func:`granulargas.run.prepare.initial_state`) with the same contact law
+(:mod:`granulargas.dem.lammps`: hertz/material + damping viscoelastic, a
+stiffness whose contact time is a stated fraction of the mean free time).
+"""
+
+from __future__ import annotations
+
+from granulargas.dem import lammps
+from granulargas.errors import ConfigError
+from granulargas.run.prepare import initial_state, reduced_prefactor
+from granulargas.run.schedule import DEFAULT_OBSERVABLE_SAMPLES
+
+
+def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_per_contact: int = 50,
+                  end_time: float | None = None, poisson_ratio: float | None = None, name: str = "granulargas"):
+    """Write LAMMPS data + input for a run config (same initial state as ``granulargas run``).
+
+    Parameters
+    ----------
+    config : RunConfig
+        A viscoelastic (or elastic) config.
+    directory : path
+        Output directory for ``data.<name>``, ``in.<name>``, ``granulargas_lammps.json``.
+    contact_fraction, steps_per_contact :
+        See :func:`granulargas.dem.lammps.write_lammps_gas`.
+    end_time : float, optional
+        Simulated time (default: the config's ``run.end_time``).
+    poisson_ratio : float, optional
+        Default: the config's material value, else 0.3 (only Y / (1 - nu^2) matters).
+
+    Returns
+    -------
+    granulargas.dem.lammps.LammpsExport
+    """
+    c = config.collision
+    if c.model == "constant":
+        raise ConfigError(
+            f"{config.source}: collision.model = \"constant\": LAMMPS export needs the viscoelastic "
+            "(or elastic) contact law"
+        )
+    end_time = config.run.end_time if end_time is None else end_time
+    if end_time is None:
+        raise ConfigError(f"{config.source}: run.end_time is not set: LAMMPS runs for a fixed time (use --end-time)")
+    if c.model == "elastic":
+        prefactor, end = 0.0, "overlap"
+    else:
+        prefactor, end = reduced_prefactor(config), c.contact_end
+    if poisson_ratio is None:
+        poisson_ratio = c.material.poisson_ratio if c.material is not None else lammps.DEFAULT_POISSON
+    state = initial_state(config)
+    if config.initial.from_file:
+        end_time = end_time - state.time
+        if end_time <= 0:
+            raise ConfigError(f"{config.source}: run.end_time = {end_time + state.time}: restart file is already at "
+                              f"t = {state.time}")
+    interval = config.output.observables_interval or end_time / DEFAULT_OBSERVABLE_SAMPLES
+    return lammps.write_lammps_gas(
+        directory, state.positions, state.velocities, state.radii, state.masses, state.box, prefactor,
+        end=end, end_time=end_time, thermo_interval=interval, contact_fraction=contact_fraction,
+        steps_per_contact=steps_per_contact, poisson_ratio=poisson_ratio, name=name, source=config.source,
+        time_origin=state.time,
+    )

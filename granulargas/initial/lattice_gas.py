@@ -1,0 +1,339 @@
+"""Initial states: random non-overlapping placement and Maxwell-Boltzmann velocities.
+
+Placement (fast for 10^6 particles, packing fractions up to ~0.54 in 3D and
+~0.76 in 2D, polydisperse too; at 0.55 / 0.78-0.80 the growth of step 2 gets
+stuck for some seeds and raises ConfigError):
+
+1. a lattice (FCC in 3D, triangular in 2D, per-axis cell counts chosen to fit
+   any box shape) with at least M = round(N / (1 - S0)) sites and the largest
+   nearest-neighbour distance, S0 = :func:`fluid_s0` (see below); the few sites
+   beyond M that the cell counts give are dropped evenly in space (one at
+   random in each of equal runs of a Z-order (Morton) numbering of the cells,
+   so that they add almost no long-wavelength fluctuation of their own);
+2. N of the M sites chosen at random, radii assigned at random; if the lattice
+   distance is below the largest diameter (polydisperse or very dense systems),
+   all radii start scaled down and grow between Monte Carlo sweeps to the
+   largest size without overlap until they reach full size;
+3. hard-sphere Monte Carlo sweeps (random displacements rejected on overlap,
+   step adapted to ~40 % acceptance) destroy the lattice order.
+
+Long-wavelength density fluctuations. The sweeps move each particle by a
+fraction of a diameter: they relax the structure at short range, but a density
+mode of wavevector k relaxes only at the rate of collective diffusion, ~D k^2,
+so the modes of the largest wavelengths keep the amplitude the placement gave
+them. N particles on N of M sites chosen at random are a lattice gas with
+(hypergeometric) random occupation; its static structure factor
+``S(k) = |sum_j exp(i k.r_j)|^2 / N`` is, for every k that is not a
+reciprocal-lattice vector (every k of the box below the Bragg peaks),
+
+    S(k) = 1 - (N - 1)/(M - 1) = 1 - N/M + O(1/N).
+
+M = N / (1 - S0) makes this S0 = S_eq(k -> 0) = n T kappa_T, the value of the
+equilibrium hard-sphere (hard-disk) fluid at the same packing fraction eta,
+from the compressibility equation ``S0 = 1 / d(eta Z)/d eta`` with
+
+* 3D, Carnahan-Starling ``Z = (1 + eta + eta^2 - eta^3)/(1 - eta)^3``:
+  ``S0 = (1 - eta)^4 / (1 + 4 eta + 4 eta^2 - 4 eta^3 + eta^4)``;
+* 2D, Henderson ``Z = (1 + eta^2/8)/(1 - eta)^2``:
+  ``S0 = (1 - eta)^3 / (1 + eta + 3 eta^2/8 - eta^3/8)``
+
+(3D eta = 0.1: 0.457, 0.3: 0.098, 0.45: 0.028; 2D eta = 0.25: 0.332,
+0.7: 0.015; both 1 - 2^d eta + O(eta^2)). A lattice filled to the last site
+(M = N) would give S(k) ~ 0.005-0.01 at k = 2 pi/L for 10^5 particles instead
+of ~0.3: a nearly hyperuniform start, seeding a clustering instability with
+far too little initial amplitude.
+
+Approximations and limits: polydisperse radii use this monodisperse S0 at the
+total packing fraction; the equilibrium S(k) rises above S0 as k^2 (Percus-
+Yevick, 3D: +1 % at k sigma = 0.33, +3 % at 0.6); below eta = 0.017 (3D) /
+0.033 (2D) M is capped at 8 N (memory), so S = 7/8 instead of S0 in (7/8, 1).
+In small boxes (a few thousand particles) S at k = 2 pi/L comes out above S0 by
+~0.01-0.03, from two effects that fall off with the box size: the dropped extra
+sites (up to 10-20 % of M when the cell counts are small), and the sweeps at
+reduced radii of the growth route (eta > 0.25), which relax towards the larger
+S0 of that lower packing at the rate D k^2.
+
+Velocities: Gaussian components with variance T/m_i, total momentum removed,
+then rescaled so that the granular temperature m<c^2>/d is exactly T.
+Everything is drawn from ``numpy.random.default_rng(seed)``: a seed gives
+the same state on every machine.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+
+from granulargas import theory
+from granulargas.errors import ConfigError
+from granulargas.initial import _montecarlo as mc
+from granulargas.initial.state import InitialState
+
+
+def box_for_packing(radii, packing, dimension, aspect=None):
+    """Box sides (d,) giving packing fraction ``packing`` (aspect: relative side lengths)."""
+    diameters = 2.0 * np.asarray(radii, dtype=np.float64)
+    volume = float(np.sum(theory.particle_volume(diameters, dimension))) / packing
+    aspect = np.ones(dimension) if aspect is None else np.asarray(aspect, dtype=np.float64)
+    return aspect * (volume / float(np.prod(aspect))) ** (1.0 / dimension)
+
+
+# lowest occupancy N/M of the lattice: M <= 8 N (memory at very low packing)
+_MIN_OCCUPANCY = 1.0 / 8.0
+
+
+def fluid_s0(packing, dimension):
+    """Structure factor S(k -> 0) of the equilibrium hard-sphere (3D) / hard-disk (2D) fluid.
+
+    Compressibility route ``S0 = 1 / d(eta Z)/d eta`` with the Carnahan-Starling
+    (3D) and Henderson (2D) compressibility factors Z (module docstring).
+    """
+    eta = float(packing)
+    if dimension == 3:
+        return (1.0 - eta) ** 4 / (1.0 + 4.0 * eta + 4.0 * eta**2 - 4.0 * eta**3 + eta**4)
+    return (1.0 - eta) ** 3 / (1.0 + eta + 3.0 * eta**2 / 8.0 - eta**3 / 8.0)
+
+
+def _morton(cells):
+    """Z-order (Morton) codes of integer cell coordinates (M, d), < 2^21 per axis."""
+    code = np.zeros(len(cells), dtype=np.int64)
+    d = cells.shape[1]
+    for bit in range(int(cells.max()).bit_length()):
+        for axis in range(d):
+            code |= ((cells[:, axis] >> bit) & 1) << (bit * d + axis)
+    return code
+
+
+def _lattice(n, box):
+    """Sites (M >= n, d) of an FCC (3D) / triangular (2D) lattice filling ``box``, the
+    nearest-neighbour distance, and the site indices in Z-order of their cells (runs
+    of consecutive entries are compact in space)."""
+    d = len(box)
+    basis = (np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]]) if d == 3
+             else np.array([[0, 0], [0.5, 0.5]]))
+    per_cell = len(basis)
+    volume = float(np.prod(box))
+    shape = np.array([1.0, math.sqrt(3.0)]) if d == 2 else np.ones(3)
+    a_ideal = (volume * per_cell / n / float(np.prod(shape))) ** (1.0 / d)
+    best, best_counts = -1.0, None
+    base = np.floor(box / (a_ideal * shape)).astype(int)
+    for offs in itertools.product(range(-1, 3), repeat=d):
+        counts = np.maximum(1, base + np.array(offs))
+        if per_cell * int(np.prod(counts)) < n:
+            continue
+        a = box / counts
+        if d == 3:
+            dist = min(a.min(), *(math.hypot(a[p], a[q]) / 2 for p, q in ((0, 1), (0, 2), (1, 2))))
+        else:
+            dist = min(a.min(), math.hypot(a[0], a[1]) / 2)
+        if dist > best:
+            best, best_counts = dist, counts
+    counts = best_counts
+    a = box / counts
+    grids = np.meshgrid(*[np.arange(c) for c in counts], indexing="ij")
+    cells = np.stack([g.ravel() for g in grids], axis=1)
+    sites = (cells[:, None, :] + basis[None, :, :]).reshape(-1, d) * a
+    z_order = (np.argsort(_morton(cells))[:, None] * per_cell + np.arange(per_cell)).ravel()
+    return sites, best, z_order
+
+
+def _spread_out(m_keep, order, rng):
+    """Sorted ``m_keep`` entries of ``order``: of len(order) - m_keep equal runs of
+    consecutive entries, one entry each (at random) is dropped."""
+    m = len(order)
+    r = m - m_keep
+    keep = np.ones(m, dtype=np.bool_)
+    if r > 0:
+        edges = np.arange(r + 1, dtype=np.int64) * m // r
+        keep[edges[:-1] + (rng.random(r) * np.diff(edges)).astype(np.int64)] = False
+    return np.sort(order[keep])
+
+
+def random_positions(radii, box, seed=0, sweeps=None, rng=None):
+    """Random non-overlapping positions (N, d) in [0, L) for spheres/disks of ``radii``,
+    with the long-wavelength density fluctuations of the equilibrium fluid (module docstring).
+
+    Parameters
+    ----------
+    radii : array (N,)
+    box : array (d,)
+    seed : int
+    sweeps : int, optional
+        Monte Carlo sweeps after lattice placement (default 20, 6 beyond 10^5 particles).
+
+    Raises
+    ------
+    ConfigError
+        If the packing is too high for the lattice to hold the largest particles.
+    """
+    rng = np.random.default_rng(seed) if rng is None else rng
+    radii = np.asarray(radii, dtype=np.float64)
+    box = np.asarray(box, dtype=np.float64)
+    n, d = len(radii), len(box)
+    eta = float(np.sum(theory.particle_volume(2.0 * radii, d))) / float(np.prod(box))
+    # M sites for N particles: S(k) = 1 - N/M = S0 at long wavelengths (docstring)
+    m_sites = max(n, round(n / max(_MIN_OCCUPANCY, 1.0 - fluid_s0(eta, d))))
+    sites, dist, z_order = _lattice(m_sites, box)
+    dmax = 2.0 * float(radii.max())
+    # M sites kept, the extra ones dropped evenly in space; N of them at random,
+    # in lattice (memory ~ space) order for fast sweeps; particle ids are
+    # shuffled at the end
+    kept = _spread_out(m_sites, z_order, rng)
+    chosen = np.sort(kept[rng.permutation(m_sites)[:n]])
+    pos = sites[chosen]
+    ids = rng.permutation(n)
+    radii = radii[ids]  # radii[k] belongs to the particle placed at site k
+    r3 = np.zeros((n, 3))
+    r3[:, :d] = pos
+    box3 = np.ones(3)
+    box3[:d] = box
+    ncell = np.ones(3, dtype=np.int64)
+    ncell[:d] = np.maximum(1, np.floor(box / dmax)).astype(np.int64)
+    head = np.empty(int(np.prod(ncell)), dtype=np.int32)
+    nxt = np.empty(n, dtype=np.int32)
+    prv = np.empty(n, dtype=np.int32)
+    cof = np.empty(n, dtype=np.int32)
+    mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
+    if sweeps is None:
+        sweeps = 20 if n <= 100_000 else 6
+    disp = np.zeros((n, 3))
+    state = {"step": 0.1 * dmax}
+
+    def do_sweep(rad):
+        disp[:, :d] = rng.uniform(-1.0, 1.0, size=(n, d))
+        acc = mc.sweep(r3, rad, box3, ncell, head, nxt, prv, cof, state["step"], disp) / n
+        state["step"] = min(0.5 * float(box.min()), state["step"] * min(2.0, max(0.5, acc / 0.4)))
+
+    # Dense systems (and lattices too tight for the largest particles) start
+    # diluted, radii scaled by lam so that the packing is <= 0.25 and the sweeps
+    # melt the lattice; then the radii grow in steps of a few per cent, the
+    # overlaps each step creates are pushed apart (Gauss-Seidel descent on the
+    # overlaps, :func:`_montecarlo.push_some`), and a hard-sphere sweep follows.
+    lam = min(1.0, dist / dmax * (1.0 - 1e-9), (0.25 / eta) ** (1.0 / d))
+    if lam < 1.0:
+        for _ in range(int(sweeps)):
+            do_sweep(radii * lam)
+    buf = np.empty(max(64, 40 * n), dtype=np.int64)
+    uniq = np.empty(n, dtype=np.int64)
+    seen = np.zeros(n, dtype=np.bool_)
+    grow = 0.05
+    while lam < 1.0:
+        if grow < 1e-4:
+            raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
+                              f"radii (reached {lam:.4f} of the target size)")
+        saved = r3.copy()
+        trial = min(1.0, lam * (1.0 + grow))
+        rad = radii * trial
+        idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
+        for it in range(600):
+            if len(idx) == 0:
+                break
+            if it % 100 == 99:  # jammed spots: let the hard-sphere surroundings make room
+                disp[:, :d] = rng.uniform(-1.0, 1.0, size=(n, d))
+                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, disp)
+                idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
+                continue
+            kick = rng.uniform(0.5, 1.5, size=len(idx))
+            m = mc.push_some(idx, r3, rad, box3, ncell, head, nxt, prv, cof, kick, buf)
+            idx = np.sort(uniq[: mc.distinct(buf, m, seen, uniq)])  # = np.unique(buf[:m])
+        if len(idx):  # stuck: undo, grow more gently
+            r3[:] = saved
+            mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
+            grow *= 0.5
+            continue
+        grow = min(0.05, grow * 1.5)
+        lam = trial
+        rad = radii * lam
+        do_sweep(rad)
+    for _ in range(int(sweeps)):
+        do_sweep(radii)
+    out = np.empty((n, d))
+    out[ids] = r3[:, :d]
+    return out
+
+
+def maxwell_velocities(masses, dimension, temperature=1.0, seed=0, rng=None):
+    """Maxwell-Boltzmann velocities (N, d): zero total momentum, temperature exactly T."""
+    rng = np.random.default_rng(seed) if rng is None else rng
+    masses = np.asarray(masses, dtype=np.float64)
+    n = len(masses)
+    v = rng.standard_normal((n, dimension)) * np.sqrt(temperature / masses)[:, None]
+    v -= np.sum(masses[:, None] * v, axis=0) / np.sum(masses)
+    t_now = float(np.sum(masses[:, None] * v * v)) / (dimension * n)
+    if temperature > 0 and t_now > 0:
+        v *= math.sqrt(temperature / t_now)
+    else:
+        v[:] = 0.0
+    return v
+
+
+#: smallest wall axis in largest diameters: the placement box is one diameter shorter
+#: than the wall axis and needs the engine's 3.15 (three cells) itself
+MIN_WALL_AXIS_DIAMETERS = 4.15
+
+
+def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, masses=None,
+                 aspect=None, sweeps=None, rng=None, boundary=None) -> InitialState:
+    """A random homogeneous initial state: box, positions, velocities (in this order from one generator).
+
+    Parameters
+    ----------
+    n : int
+        Number of particles.
+    packing : float
+        Packing fraction (3D: sum of sphere volumes / V; 2D: disk areas / A), V the
+        whole box also between walls.
+    dimension : {2, 3}
+    temperature : float
+        Granular temperature T (k_B = 1).
+    seed : int
+    radii : float or array (N,)
+        Radii in units of the reference diameter (default 0.5: monodisperse).
+    masses : float or array (N,), optional
+        Default: (2 R)^d, i.e. the density of the reference particle (mass 1, diameter 1).
+    aspect : sequence of d floats, optional
+        Relative box side lengths (default cubic/square).
+    sweeps : int, optional
+        Monte Carlo sweeps (see :func:`random_positions`).
+    rng : numpy.random.Generator, optional
+        Generator to draw from instead of ``default_rng(seed)`` (a config run draws
+        its polydisperse radii from it first).
+    boundary : sequence of d str, optional
+        "periodic" or "wall" per axis (default all periodic). On a wall axis of length
+        L the positions are placed as on a periodic axis of length L - 2 R_max and
+        shifted by R_max: no sphere overlaps a wall (every centre lies within
+        [R_max, L - R_max]); the density next to the walls relaxes to its steady
+        profile within a few collision times. A wall axis must be at least
+        ``MIN_WALL_AXIS_DIAMETERS`` largest diameters long.
+    """
+    if dimension not in (2, 3):
+        raise ConfigError(f"dimension = {dimension}: allowed values are 2 and 3")
+    n = int(n)
+    if n < 2:
+        raise ConfigError(f"number of particles = {n}: need at least 2")
+    if not 0.0 < packing < (0.74 if dimension == 3 else 0.9):
+        raise ConfigError(f"packing fraction = {packing}: allowed range is (0, {0.74 if dimension == 3 else 0.9})")
+    walls = [] if boundary is None else [a for a in range(dimension) if boundary[a] == "wall"]
+    rng = np.random.default_rng(seed) if rng is None else rng
+    radii = np.array(np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)))
+    if np.any(radii <= 0):
+        raise ConfigError("radii: must be > 0")
+    masses = (2.0 * radii) ** dimension if masses is None else np.array(
+        np.broadcast_to(np.asarray(masses, dtype=np.float64), (n,)))
+    box = box_for_packing(radii, packing, dimension, aspect)
+    placement = box.copy()
+    rmax = float(radii.max())
+    for a in walls:
+        if box[a] < MIN_WALL_AXIS_DIAMETERS * 2.0 * rmax:
+            raise ConfigError(f"wall axis {'xyz'[a]}: length {box[a]:.4g} is too short for the particles: "
+                              f"it must be >= {MIN_WALL_AXIS_DIAMETERS:g} largest diameters "
+                              f"(= {MIN_WALL_AXIS_DIAMETERS * 2.0 * rmax:.4g}); use more particles or a "
+                              f"lower packing fraction")
+        placement[a] -= 2.0 * rmax
+    pos = random_positions(radii, placement, sweeps=sweeps, rng=rng)
+    pos[:, walls] += rmax
+    vel = maxwell_velocities(masses, dimension, temperature, rng=rng)
+    bnd = None if boundary is None else tuple(boundary)
+    return InitialState(pos, vel, radii, masses, box, boundary=bnd)

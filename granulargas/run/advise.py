@@ -1,0 +1,222 @@
+"""Is a constant restitution good enough for this config? (``granulargas advise CONFIG``)
+
+A viscoelastic gas sees a whole range of eps: fast impacts at the start of a
+cooling run are more inelastic than slow ones at the end (eps -> 1 as g -> 0).
+From the config alone (T0, damping or material, density, run length) the
+advice predicts, with kinetic theory and no simulation
+(:mod:`granulargas.run.validity` explains each step):
+
+1. the temperature range of the run, from the viscoelastic cooling law solved
+   with the exact eps(beta) (a quadrature in ln T);
+2. the spread of eps over the thermal impact speeds (central 90 % of collisions)
+   from the hottest to the coldest moment of the run;
+3. the best constant eps: the one whose Haff law ``T0 / (1 + t/tau0)^2``
+   (Enskog rate with the van Noije-Ernst a2 of that eps) stays closest to the
+   viscoelastic T(t) over the run, in the minimax sense, and that largest
+   relative deviation ``max_t |T_const(t) / T_visco(t) - 1|``;
+4. the verdict: a constant eps will do if that deviation is within the
+   tolerance (default 2 %, ``--tolerance``);
+5. whether the box is longer than the shear-instability length of the gas at
+   T0 (:meth:`granulargas.theory.gas.Gas.instability_length`; a viscoelastic
+   gas's grows as it cools, so clusters seeded early dissolve later; the
+   homogeneous prediction then fails for both rules).
+
+For a constant-eps config the advice reports the config ``damping`` (beta at
+g = 1 for two reference particles) whose viscoelastic gas cools at the same
+initial rate and how far its T(t) would drift from Haff's law
+over the run, plus the inelastic-collapse risk.
+
+The prediction assumes a homogeneous gas with a Maxwellian velocity
+distribution (the viscoelastic a2 is of order beta and left out); it is checked
+against real runs in ``scripts/rule_choice.py`` (docs/choosing-a-model.md).
+
+Runner API: :func:`summary_line` ``(config, tolerance=DEFAULT_TOLERANCE) -> str | None``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from granulargas import theory
+from granulargas.contact.material import damping_from_prefactor
+from granulargas.run import validity as V
+from granulargas.run.prepare import mean_particle
+
+__all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant"]
+
+#: default tolerance on the relative error of T(t)
+DEFAULT_TOLERANCE = 0.02
+
+
+@dataclass
+class Advice:
+    """The advice for one config (numbers; :meth:`lines` formats them).
+
+    Attributes
+    ----------
+    model : str
+    tolerance : float
+    t_end, T_end : float
+        Predicted run end time and final temperature.
+    spread : dict or None
+        :func:`granulargas.run.validity.restitution_spread` over the run.
+    eps_best : float or None
+        Best constant eps (viscoelastic config) or the config's eps.
+    error : float or None
+        Predicted largest relative error of T(t) of the constant eps vs the
+        viscoelastic law over the run.
+    damping_equivalent : float or None
+        Constant config: the config ``damping`` (reference particles) whose viscoelastic
+        gas has the same initial cooling rate.
+    constant_ok : bool or None
+    box, instability_length : float
+        Box edge and the shear-instability length at T0.
+    notes : list of str
+    """
+
+    model: str
+    tolerance: float
+    t_end: float
+    T_end: float
+    spread: dict | None = None
+    eps_best: float | None = None
+    error: float | None = None
+    damping_equivalent: float | None = None
+    constant_ok: bool | None = None
+    box: float = math.nan
+    instability_length: float = math.nan
+    notes: tuple = ()
+
+    def lines(self) -> list[str]:
+        out = [f"run          T {1:g} -> {self.T_end:.3g} T0 by t = {self.t_end:.4g} (kinetic theory)"]
+        if self.model == "elastic":
+            out.append("advice       elastic collisions: nothing to choose")
+        if self.spread is not None:
+            sp = self.spread
+            out.append(f"eps spread   {sp['eps_min']:.4f} .. {sp['eps_max']:.4f} (beta {sp['beta_max']:.3g} .. "
+                       f"{sp['beta_min']:.3g}) over thermal impacts, start to end")
+        if self.model == "viscoelastic" and self.eps_best is not None:
+            verdict = "a constant eps will do" if self.constant_ok else "keep the viscoelastic rule"
+            out.append(f"best const.  eps = {self.eps_best:.4f}: T(t) off by up to {100 * self.error:.2g} % "
+                       f"(tolerance {100 * self.tolerance:g} %) -> {verdict}")
+        if self.model == "constant" and self.damping_equivalent is not None:
+            out.append(f"equivalent   damping = {self.damping_equivalent:.4g} cools at the same initial rate; "
+                       f"its T(t) departs from Haff's by up to {100 * self.error:.2g} % over this run")
+        if math.isfinite(self.instability_length):
+            rel = "above" if self.box > self.instability_length else "below"
+            out.append(f"clustering   box {self.box:.4g} is {rel} the shear-instability length "
+                       f"{self.instability_length:.4g} (homogeneous cooling {'un' if rel == 'above' else ''}stable)")
+        out += [f"note         {n}" for n in self.notes]
+        return out
+
+
+def _haff(gas: V.Gas, eps: float, t):
+    """Haff's law for constant eps (Enskog rate, van Noije-Ernst a2)."""
+    tau0 = theory.haff_tau0(eps, gas.density, gas.temperature, gas.dimension, gas.sigma, gas.mass)
+    return theory.haff_temperature(t, gas.temperature, tau0)
+
+
+def constant_error(gas: V.Gas, eps: float, curve: V.CoolingCurve, t_end: float) -> float:
+    """``max_t |T_const(t) / T_visco(t) - 1|`` over ``0 <= t <= t_end``."""
+    t = curve.time[curve.time <= t_end]
+    t = np.append(t, t_end)
+    return float(np.max(np.abs(_haff(gas, eps, t) / curve.temperature_at(t) - 1.0)))
+
+
+def best_constant(gas: V.Gas, curve: V.CoolingCurve, t_end: float):
+    """(eps, error): the constant eps minimising :func:`constant_error`."""
+    # search in q = 1 - eps^2 on a log grid, then refine
+    q_ref = float(V.effective_inelasticity(gas, gas.temperature))
+    qs = q_ref * np.geomspace(0.05, 1.5, 80)
+    qs = qs[qs < 1.0]
+    errs = [constant_error(gas, math.sqrt(1 - q), curve, t_end) for q in qs]
+    k = int(np.argmin(errs))
+    lo, hi = qs[max(k - 1, 0)], qs[min(k + 1, len(qs) - 1)]
+    res = minimize_scalar(lambda q: constant_error(gas, math.sqrt(1 - q), curve, t_end), bounds=(lo, hi),
+                          method="bounded", options={"xatol": 1e-7 * q_ref})
+    q = float(res.x) if res.fun <= errs[k] else float(qs[k])
+    return math.sqrt(1.0 - q), min(float(res.fun), float(errs[k]))
+
+
+def _box(config) -> float:
+    """Box edge of the config's gas (particles of the mean diameter)."""
+    s = config.system
+    sigma, _ = mean_particle(config)
+    return (s.particles * float(theory.particle_volume(sigma, s.dimension)) / s.packing_fraction) ** (1.0 / s.dimension)
+
+
+def _equivalent_prefactor(gas: V.Gas, eps: float) -> float:
+    """Prefactor k whose viscoelastic gas has (1 - eps^2)_eff(T0) = 1 - eps^2."""
+    target = 1.0 - eps**2
+
+    def f(log_k):
+        g = replace(gas, model="viscoelastic", prefactor=math.exp(log_k))
+        return V.effective_inelasticity(g, gas.temperature) - target
+
+    # bracket in the pair constant b of the gas's particles: b = k (R_eff / m_eff^2)^(1/5)
+    scale = replace(gas, model="viscoelastic", prefactor=1.0).pair_constant
+    return math.exp(brentq(f, math.log(1e-8 / scale), math.log(20.0 / scale), xtol=1e-10))
+
+
+def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
+    """Advice on the collision rule for a config (module doc)."""
+    gas = V.gas_from_config(config)
+    t_end, T_end = V.run_temperature_range(gas)
+    adv = Advice(gas.model, tolerance, t_end, T_end / gas.temperature, box=_box(config))
+    notes = []
+    if gas.model == "viscoelastic" and gas.pair_constant > 0:
+        curve = V.viscoelastic_cooling(gas)
+        t_end, T_end = V.run_temperature_range(gas, curve)
+        adv.t_end, adv.T_end = t_end, T_end / gas.temperature
+        adv.spread = V.restitution_spread(gas, gas.temperature, T_end)
+        adv.eps_best, adv.error = best_constant(gas, curve, t_end)
+        adv.constant_ok = adv.error <= tolerance
+        adv.instability_length = gas.instability_length()
+        if adv.constant_ok:
+            notes.append(f'use [collision] model = "constant", restitution = {adv.eps_best:.4f} '
+                         "(cost per collision is nearly the same; the gain is a closed-form reference, Haff's law)")
+    elif gas.model == "viscoelastic":
+        adv.constant_ok = True
+        adv.eps_best, adv.error = 1.0, 0.0
+        notes.append("damping = 0: the collisions are elastic; use model = \"elastic\"")
+    elif gas.model == "constant" and gas.restitution < 1.0:
+        eps = gas.restitution
+        k = _equivalent_prefactor(gas, eps)
+        ve = replace(gas, model="viscoelastic", prefactor=k)
+        curve = V.viscoelastic_cooling(ve)
+        t_ve, _ = V.run_temperature_range(replace(ve, end_time=t_end, collisions_per_particle=None), curve)
+        adv.damping_equivalent = damping_from_prefactor(k)
+        adv.eps_best = eps
+        adv.error = constant_error(ve, eps, curve, t_end)
+        adv.constant_ok = adv.error <= tolerance
+        adv.instability_length = gas.instability_length()
+        if gas.tc_time is None and (eps <= 0.7 or (gas.dimension == 2 and gas.packing_fraction >= 0.3)):
+            notes.append(f"eps = {eps:g} without tc_time: dense or strongly inelastic regions can collapse "
+                         "(InelasticCollapseError); set [collision] tc_time (TC model) or use the viscoelastic "
+                         "rule (scripts/collapse_demo.py)")
+    adv.notes = tuple(notes)
+    return adv
+
+
+def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
+    """One line for the run summary: the eps spread and whether a constant eps would do.
+
+    Returns None for elastic runs.
+    """
+    adv = advise(config, tolerance)
+    if adv.model == "elastic" or adv.eps_best is None:
+        return None
+    if adv.model == "viscoelastic" and adv.spread is not None:
+        sp = adv.spread
+        verdict = "would do" if adv.constant_ok else "would not do"
+        return (f"advice       eps {sp['eps_min']:.3f}..{sp['eps_max']:.3f} over the run; best constant "
+                f"eps = {adv.eps_best:.4f} {verdict} (T(t) off by {100 * adv.error:.2g} %, "
+                f"tolerance {100 * tolerance:g} %)")
+    if adv.model == "constant":
+        return (f"advice       constant eps = {adv.eps_best:g} ~ damping {adv.damping_equivalent:.3g}; a viscoelastic "
+                f"gas would differ by up to {100 * adv.error:.2g} % in T(t) over this run")
+    return None

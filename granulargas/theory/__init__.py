@@ -1,0 +1,24 @@
+"""Kinetic theory of granular gases: the yardstick the simulator is measured against.
+
+Knows nothing of the engine or of files; uses :mod:`granulargas.contact` for the
+exact eps(beta). The closed forms are importable from here (``from granulargas
+import theory; theory.haff_tau0(...)``):
+
+* :mod:`~granulargas.theory.enskog` -- particle volume, packing fraction, chi, EOS,
+  a2, Enskog collision frequency and cooling rate, Haff's law, shear viscosity,
+  the shear-instability length (constant restitution);
+* :mod:`~granulargas.theory.viscoelastic` -- viscoelastic cooling at leading order
+  in the damping (``T ~ t^(-5/3)``), C1, C2;
+* :mod:`~granulargas.theory.gas` -- a homogeneous gas with the exact eps(beta):
+  impact speeds, the spread of eps, the cooling curve, the instability length of
+  a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there);
+* :mod:`~granulargas.theory.driven` -- the white-noise driven steady state
+  (temperature, a2, kick interval; viscoelastic: effective restitution).
+"""
+
+from granulargas.theory import driven, enskog, gas, viscoelastic  # noqa: F401
+from granulargas.theory.driven import *  # noqa: F401,F403
+from granulargas.theory.enskog import *  # noqa: F401,F403
+from granulargas.theory.viscoelastic import *  # noqa: F401,F403
+
+__all__ = enskog.__all__ + viscoelastic.__all__ + driven.__all__

@@ -1,0 +1,138 @@
+"""Run-level validity checks against independent numbers: Monte Carlo impact speeds,
+closed-form cooling laws (theory), Hertz's contact duration, Haff in collisions."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.special import gamma
+
+from granulargas import theory
+from granulargas.run import validity as V
+from granulargas.errors import ConfigError
+from granulargas.io.config import parse_config
+
+HERTZ_TAU = 3.2180654  # (4/5)(5/4)^(2/5) B(2/5, 1/2), the Hertz duration
+
+
+def config(collision, run="end_time = 100.0", system="dimension = 3\nparticles = 2000\npacking_fraction = 0.1"):
+    return parse_config(f"[system]\n{system}\n[collision]\n{collision}\n[run]\n{run}\n", source="test.toml")
+
+
+def test_impact_speed_quantiles_match_monte_carlo():
+    # collisions sample the normal relative speed g with weight g (collision kernel)
+    rng = np.random.default_rng(3)
+    T, m = 0.7, 2.0
+    v1, v2 = rng.normal(0, math.sqrt(T / m), (2, 400_000, 3))
+    g = v1[:, 0] - v2[:, 0]  # normal component along a fixed direction
+    g, w = g[g > 0], g[g > 0]
+    order = np.argsort(g)
+    cdf = np.cumsum(w[order]) / w.sum()
+    for q in (0.05, 0.5, 0.95):
+        mc = g[order][np.searchsorted(cdf, q)]
+        assert V.impact_speed_quantile(q, T, m) == pytest.approx(mc, rel=0.01)
+
+
+def test_effective_inelasticity_matches_series_average():
+    # theory.effective_inelasticity(order=2) is the analytic kernel average of the
+    # two-term series; the difference is O(b^3)
+    for b in (1e-3, 1e-2):
+        gas = V.gas_from_config(config(f'model = "viscoelastic"\ndamping = {b}'))
+        for T in (1.0, 1e-3):
+            ours = V.effective_inelasticity(gas, T)
+            ref = theory.effective_inelasticity(b, T, order=2)
+            beta = b * (4 * T) ** 0.1
+            assert abs(ours / ref - 1) < 3 * beta**2
+
+
+def test_viscoelastic_cooling_reduces_to_five_thirds_law():
+    b = 1e-3
+    gas = V.gas_from_config(config(f'model = "viscoelastic"\ndamping = {b}'))
+    curve = V.viscoelastic_cooling(gas, t_min_ratio=1e-6)
+    tau0 = theory.viscoelastic_tau0(b, gas.density, 1.0, 3)
+    t = np.geomspace(0.1, 0.9, 20) * curve.time[-1]
+    ref = theory.viscoelastic_temperature(t, 1.0, tau0)
+    # relative corrections are O(beta) at thermal speed
+    assert np.max(np.abs(curve.temperature_at(t) / ref - 1)) < 0.01
+    # and the collision count follows theory.viscoelastic_collisions
+    s_ref = theory.viscoelastic_collisions(t, tau0, gas.collision_frequency)
+    s = np.interp(t, curve.time, curve.collisions)
+    assert np.max(np.abs(s / s_ref - 1)) < 0.01
+
+
+def test_restitution_spread_brackets_thermal_eps():
+    from granulargas.contact import restitution
+
+    gas = V.gas_from_config(config('model = "viscoelastic"\ndamping = 0.1'))
+    sp = V.restitution_spread(gas, 1.0, 0.01)
+    g_typ = math.sqrt(math.pi * 1.0)  # mean collision impact speed at T = 1, m = 1
+    assert sp["eps_min"] < restitution(0.1 * g_typ**0.2) < sp["eps_max"]
+    assert sp["eps_max"] == pytest.approx(float(restitution(sp["beta_min"])), abs=1e-9)
+    assert sp["spread"] > 0
+
+
+def test_haff_run_end_matches_theory():
+    cfg = config('model = "constant"\nrestitution = 0.8', run="end_time = 50.0")
+    gas = V.gas_from_config(cfg)
+    tau0 = theory.haff_tau0(0.8, gas.density, 1.0, 3)
+    t_end, T_end = V.run_temperature_range(gas)
+    assert t_end == 50.0
+    assert T_end == pytest.approx(theory.haff_temperature(50.0, 1.0, tau0), rel=1e-12)
+    cfg = config('model = "constant"\nrestitution = 0.8', run="collisions_per_particle = 30")
+    _, T_end = V.run_temperature_range(V.gas_from_config(cfg))
+    assert T_end == pytest.approx(theory.temperature_vs_collisions(30, 0.8, 3), rel=1e-9)
+
+
+def test_contact_time_ratio_elastic_limit_is_hertz():
+    # A -> 0: t_c = tau_Hertz rho^(-2/5) g^(-1/5), averaged over the Rayleigh law of g:
+    # <g^(-1/5)> = (2 s^2)^(-1/10) Gamma(9/10), s^2 = 2T/m
+    Y, nu, d, dens, u = 1e8, 0.3, 0.01, 2000.0, 2.0
+    cfg = config(f'model = "viscoelastic"\n[collision.material]\nyoung_modulus = {Y}\npoisson_ratio = {nu}\n'
+                 f"dissipation_time = 1e-15\ndiameter = {d}\ndensity = {dens}\nspeed_unit = {u}")
+    gas = V.gas_from_config(cfg)
+    M = dens * math.pi * d**3 / 6
+    rho = 2 * Y * math.sqrt(d / 4) / (3 * (M / 2) * (1 - nu**2))
+    mean_g = (2 * 2.0) ** -0.1 * gamma(0.9) * u**-0.2  # T = m = 1 reduced, g in m/s
+    t_c = HERTZ_TAU * rho**-0.4 * mean_g / (d / u)
+    assert V.contact_time_ratio(cfg) == pytest.approx(t_c * gas.collision_frequency, rel=1e-6)
+    # the ratio grows as T^(2/5)
+    assert V.contact_time_ratio(cfg, 1e-5) == pytest.approx(V.contact_time_ratio(cfg) * 1e-2, rel=1e-4)
+
+
+def test_contact_time_ratio_warning_threshold():
+    base = 'model = "constant"\nrestitution = 0.9\ntc_time = {}'
+    gas = V.gas_from_config(config(base.format(1.0)))
+    tc_warn = V.TC_RATIO_WARN / gas.collision_frequency
+    low = V.check_run(config(base.format(0.5 * tc_warn)))
+    high = V.check_run(config(base.format(2.0 * tc_warn)))
+    assert low.tc_ratio == pytest.approx(0.5 * V.TC_RATIO_WARN)
+    assert not low.warnings
+    assert len(high.warnings) == 1 and "mean free time" in high.warnings[0]
+    # damping route: not determined, no warning, said so
+    rv = V.check_run(config('model = "viscoelastic"\ndamping = 0.1'))
+    assert rv.tc_ratio is None and any("not determined" in ln for ln in rv.lines())
+
+
+def test_large_beta_is_flagged():
+    rv = V.check_run(config('model = "viscoelastic"\ndamping = 2.0'))
+    assert rv.spread["beta_max"] > 1
+    assert any("beta" in w for w in rv.warnings)
+    assert not V.check_run(config('model = "viscoelastic"\ndamping = 0.1')).warnings
+
+
+def test_velocity_underflow_is_refused():
+    ok = config('model = "constant"\nrestitution = 0.5', run="collisions_per_particle = 100")
+    assert not V.raise_if_invalid(ok).errors
+    # (1 - eps^2)(1 + 3 a2/16) s / d ~ 0.25 s: 1e-250 after ~2300 collisions per particle
+    bad = config('model = "constant"\nrestitution = 0.5', run="collisions_per_particle = 5000")
+    with pytest.raises(ConfigError, match="run.collisions_per_particle.*underflow"):
+        V.raise_if_invalid(bad)
+    # viscoelastic gases slow their cooling: no underflow even for absurd lengths
+    assert not V.check_run(config('model = "viscoelastic"\ndamping = 0.1', run="end_time = 1e12")).errors
+
+
+def test_summary_lines_are_single_lines():
+    for coll in ('model = "elastic"', 'model = "constant"\nrestitution = 0.9',
+                 'model = "viscoelastic"\ndamping = 0.05'):
+        lines = V.summary_lines(config(coll))
+        assert lines and all("\n" not in ln for ln in lines)
