@@ -1,8 +1,18 @@
-"""Figures for one run (matplotlib, Agg backend; imported lazily by the CLI)."""
+"""Figures of ``granulargas analyze --plot`` (matplotlib, Agg backend; imported lazily by the CLI).
+
+One figure per kind of run (:data:`PLOTS`, dispatched by :func:`plot_analysis`) and
+one for a sweep (:func:`plot_sweep`). Each says in its title what it shows and
+names the theory in the legend; axes never use an offset (small drifts are drawn
+in units of a stated power of ten).
+"""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+__all__ = ["PLOTS", "plot_analysis", "plot_cooling", "plot_elastic", "plot_sweep"]
 
 
 def _plt():
@@ -15,8 +25,28 @@ def _plt():
     return plt
 
 
+def _no_offset(ax):
+    fmt = ax.yaxis.get_major_formatter()
+    if hasattr(fmt, "set_useOffset"):
+        fmt.set_useOffset(False)
+    if hasattr(fmt, "set_scientific"):
+        fmt.set_scientific(False)
+
+
+def _title(info, what):
+    name = info.path.rsplit("/", 1)[-1]
+    extra = ""
+    if info.model == "constant" and info.restitution is not None:
+        extra = f", $\\varepsilon$ = {info.restitution:g}"
+    elif info.model == "viscoelastic" and info.prefactor is not None:
+        extra = f", k = {info.prefactor:.3g}"
+    eta = info.solid_fraction if math.isfinite(info.solid_fraction) else info.packing_fraction
+    return (f"{what}\n{name}: {info.model}{extra}, {info.dimension}D, N = {info.particles}, $\\eta$ = {eta:.3g}"
+            + ("" if info.monodisperse else "; polydisperse, theory for particles of the mean diameter"))
+
+
 def plot_cooling(analysis, path):
-    """T/T0 against t/tau0 (log-log) with theory, ratio to theory, and a2(t).
+    """T/T0 against t (log-log) with the kinetic theory, T/T_theory, and a2(t).
 
     Parameters
     ----------
@@ -25,39 +55,227 @@ def plot_cooling(analysis, path):
         PNG to write.
     """
     plt = _plt()
-    h, p = analysis.history, analysis.prediction
-    t = h.time - analysis.t_offset
-    tau = p.tau0 if np.isfinite(p.tau0) else 1.0
-    fig, axes = plt.subplots(3, 1, figsize=(6.4, 8.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.3, 1.3]})
-    x = t / tau
-    pos = x > 0
+    a, h, p = analysis, analysis.history, analysis.prediction
+    t = a.time
+    pos = t > 0
+    fig, axes = plt.subplots(3, 1, figsize=(7.0, 9.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.4, 1.4]})
     ax = axes[0]
-    ax.loglog(x[pos], h.temperature[pos] / p.T0, ".", ms=3, label="simulation")
-    xs = np.geomspace(max(x[pos].min(), 1e-3), x.max(), 200)
-    ax.loglog(xs, p.temperature(xs * tau) / p.T0, "k-", lw=1, label=f"theory ({p.law}, $\\tau_0$={p.tau0:.4g})")
-    if analysis.fit_free is not None:
-        f = analysis.fit_free
-        ax.loglog(xs, f(xs * tau) / p.T0, "r--", lw=1, label=f"fit: $\\tau_0$={f.tau0:.4g}, exponent {-f.exponent:.3f}")
+    ax.loglog(t[pos], h.temperature[pos] / p.T0, ".", ms=3, color="C0", label="simulation")
+    ts = np.geomspace(t[pos].min(), t.max(), 300) if np.any(pos) else t
+    if a.theory is not None:
+        ax.loglog(ts, a.theory.temperature_at(ts) / p.T0, "k-", lw=1.2,
+                  label="kinetic theory: Enskog-Boltzmann, " + ("exact $\\varepsilon(g)$" if a.info.model ==
+                                                                 "viscoelastic" else "constant $\\varepsilon$")
+                  + ", $a_2(t)$")
+    law = ("Haff $(1+t/\\tau_0)^{-2}$, van Noije-Ernst $a_2$" if p.law == "haff"
+           else "leading order in the damping, $(1+t/\\tau_0)^{-5/3}$")
+    ax.loglog(ts, p.temperature(ts) / p.T0, "--", color="0.55", lw=1, label=f"closed form: {law}, $\\tau_0$ = {p.tau0:.4g}")
+    if a.fit_free is not None:
+        f = a.fit_free
+        ax.loglog(ts, f(ts) / p.T0, ":", color="C3", lw=1.2,
+                  label=f"fit $T_0(1+t/\\tau_0)^{{-p}}$: $\\tau_0$ = {f.tau0:.4g}, p = {f.exponent:.3f}")
     ax.set_ylabel("$T/T_0$")
-    ax.legend(fontsize=8)
-    ax.set_title(f"{analysis.info.path}: {analysis.info.model}, d={analysis.info.dimension}, "
-                 f"N={analysis.info.particles}, $\\eta$={analysis.info.packing_fraction:.3g}", fontsize=8)
+    ax.legend(fontsize=7.5, loc="lower left")
+    ax.set_title(_title(a.info, "Cooling: temperature against time, simulation and kinetic theory"), fontsize=9)
+
     ax = axes[1]
-    ax.semilogx(x[pos], h.temperature[pos] / p.temperature(t[pos]), ".", ms=3)
+    r = a.ratio
+    ax.axhspan(0.98, 1.02, color="0.9", label="$\\pm$2 %")
+    ax.semilogx(t[pos], r[pos], ".", ms=3, color="C0")
     ax.axhline(1.0, color="k", lw=0.8)
-    ax.set_ylabel("$T/T_{theory}$")
+    lo, hi = np.nanmin(r[pos]) if np.any(pos) else 1.0, np.nanmax(r[pos]) if np.any(pos) else 1.0
+    span = max(hi - 1.0, 1.0 - lo, 0.03) * 1.15
+    ax.set_ylim(1.0 - span, 1.0 + span)
+    _no_offset(ax)
+    ax.set_ylabel("$T/T_\\mathrm{theory}$")
+    ax.text(0.01, 0.95, f"last 10 % of t: {a.T_ratio_final:.4f};  last decade: {a.T_ratio_last_decade:.4f}",
+            transform=ax.transAxes, fontsize=8, va="top")
+    ax.legend(fontsize=7.5, loc="upper right")
+
     ax = axes[2]
-    ts, a2, a3 = analysis.sonine
-    if ts.size:
-        m = ts > 0
-        ax.semilogx(ts[m] / tau, a2[m], "o-", ms=3, label="$a_2$")
-        ax.semilogx(ts[m] / tau, a3[m], "s-", ms=3, label="$a_3$")
-        if p.law == "haff":
-            ax.axhline(p.a2, color="k", lw=0.8, ls="--", label="$a_2$ van Noije-Ernst")
-        ax.legend(fontsize=8)
+    ts_, a2, a3 = a.sonine
+    if ts_.size:
+        m = ts_ > 0
+        d, N = a.info.dimension, a.info.particles
+        err = math.sqrt(8.0 / (d * (d + 2) * N))
+        ax.errorbar(ts_[m], a2[m], yerr=err, fmt="o", ms=3, color="C0", capsize=2,
+                    label=f"$a_2$ of the snapshots ($\\pm$ sampling error, N = {N})")
+        ax.plot(ts_[m], a3[m], "s", ms=3, color="C2", alpha=0.6, label="$a_3$ of the snapshots")
+    if a.theory is not None and np.any(pos):
+        ax.plot(ts, a.theory.a2_at(ts), "k-", lw=1.2, label="$a_2(t)$, kinetic theory")
+    if p.law == "haff":
+        ax.axhline(p.a2, color="0.55", lw=1, ls="--", label="$a_2$ van Noije-Ernst")
     ax.axhline(0.0, color="0.7", lw=0.5)
+    ax.set_xscale("log")
+    _no_offset(ax)
     ax.set_ylabel("Sonine coefficients")
-    ax.set_xlabel("$t/\\tau_0$ (theory)")
+    ax.margins(y=0.45)  # room above the points for the legend
+    ax.legend(fontsize=7, loc="upper center", ncol=2, framealpha=0.85)
+    ax.set_xlabel("time t  [$\\sigma\\,(m/T_0)^{1/2}$]" + (f", since the first sample at {a.t_offset:.4g}"
+                                                          if a.t_offset else ""))
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def _scaled(values):
+    """(values / 10^k, k) with k the exponent of the largest magnitude (k = 0 if all zero)."""
+    v = np.asarray(values, dtype=float)
+    top = np.nanmax(np.abs(v)) if v.size else 0.0
+    if not np.isfinite(top) or top == 0.0:
+        return v, 0
+    k = int(math.floor(math.log10(top)))
+    return v / 10.0**k, k
+
+
+def plot_elastic(analysis, path):
+    """Energy drift, Z against the equation of state, collision frequency against Enskog.
+
+    Parameters
+    ----------
+    analysis : granulargas.analysis.elastic.ElasticAnalysis
+    path : str or Path
+    """
+    plt = _plt()
+    a, info = analysis, analysis.info
+    s = a.summary()
+    fig, axes = plt.subplots(3, 1, figsize=(7.0, 8.5), sharex=True)
+    t = a.time
+
+    ax = axes[0]
+    drift, k = _scaled(a.energy_drift)
+    ax.plot(t, drift, "-", color="C0", lw=1)
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    top = max(float(np.nanmax(np.abs(drift))), 1.0) if drift.size else 1.0
+    ax.set_ylim(-1.2 * top, 1.2 * top)
+    _no_offset(ax)
+    unit = f"  [$10^{{{k}}}$]" if k else ""
+    ax.set_ylabel(f"$(E-E_0)/E_0${unit}", fontsize=9)
+    ax.text(0.01, 0.95, "kinetic energy drift (round-off only)" if s["energy_drift_max"] < 1e-9 else
+            "kinetic energy drift", transform=ax.transAxes, fontsize=8, va="top")
+    ax.set_title(_title(info, "Elastic gas: energy conservation, pressure and collision frequency"), fontsize=9)
+
+    ax = axes[1]
+    tz, z = a.Z_windows
+    if tz.size:
+        ax.plot(tz, z, "o", ms=3, color="C0", label=f"simulation, windows (mean {s['Z']:.4f} $\\pm$ {s['Z_error']:.2g})")
+        if s["Z"] is not None and s["Z_error"] is not None:
+            ax.axhspan(s["Z"] - s["Z_error"], s["Z"] + s["Z_error"], color="C0", alpha=0.2, lw=0)
+    ax.axhline(s["Z_theory"], color="k", lw=1.2, label=f"{s['Z_theory_name']}: {s['Z_theory']:.4f}")
+    ax.axhline(s["Z_reference"], color="0.55", lw=1, ls="--", label=f"{s['Z_reference_name']}: {s['Z_reference']:.4f}")
+    vals = np.concatenate([z, [s["Z_theory"], s["Z_reference"]]]) if tz.size else np.array([s["Z_theory"]])
+    pad = max(0.01 * s["Z_theory"], 1.2 * float(np.max(np.abs(vals - s["Z_theory"]))))
+    ax.set_ylim(s["Z_theory"] - pad, s["Z_theory"] + pad)
+    _no_offset(ax)
+    ax.set_ylabel("$Z = P/(nT)$")
+    ax.legend(fontsize=7.5, loc="lower right", framealpha=0.7)
+
+    ax = axes[2]
+    tw, om = a.collision_windows
+    th = s["collision_frequency_theory"]
+    if tw.size:
+        ax.plot(tw, om, "o", ms=3, color="C0",
+                label=f"simulation (mean {s['collision_frequency']:.5g} $\\pm$ {s['collision_frequency_error']:.2g})")
+        if s["collision_frequency_error"] is not None:
+            ax.axhspan(s["collision_frequency"] - s["collision_frequency_error"],
+                       s["collision_frequency"] + s["collision_frequency_error"], color="C0", alpha=0.2, lw=0)
+    ax.axhline(th, color="k", lw=1.2, label=f"Enskog ($\\chi$ of {s['Z_theory_name']}): {th:.5g}")
+    vals = np.concatenate([om, [th]]) if tw.size else np.array([th])
+    pad = max(0.01 * th, 1.2 * float(np.max(np.abs(vals - th))))
+    ax.set_ylim(th - pad, th + pad)
+    _no_offset(ax)
+    ax.set_ylabel("collisions per particle\nper unit time", fontsize=9)
+    ax.legend(fontsize=7.5, loc="lower right", framealpha=0.7)
+    ax.set_xlabel(f"time t  [$\\sigma\\,(m/T_0)^{{1/2}}$]; averages from t = {a.t_equilibrated:.3g}")
+    for ax in axes[1:]:
+        ax.axvline(a.t_equilibrated, color="0.8", lw=0.8, ls=":")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+#: kind -> figure function ``f(analysis, path)``
+PLOTS = {"cooling": plot_cooling, "elastic": plot_elastic}
+
+
+def plot_analysis(analysis, path):
+    """The figure of an analysis' kind (:data:`PLOTS`)."""
+    return PLOTS[analysis.kind](analysis, path)
+
+
+def _numeric(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def plot_sweep(results, summaries, path):
+    """The fitted quantity against the swept parameter (mean +- standard error over seeds,
+    theory beside it) and, for cooling sweeps, T/T_theory against time with its seed band.
+
+    Parameters
+    ----------
+    results : granulargas.analysis.ensemble.SweepResults
+    summaries : list of granulargas.analysis.ensemble.GroupSummary
+    path : str or Path
+    """
+    plt = _plt()
+    if not summaries:
+        raise ValueError("no finished runs to plot")
+    q = summaries[0].quantity
+    cooling = summaries[0].kind == "cooling"
+    numeric = [k for k in results.varied if all(_numeric(g.parameters.get(k)) for g in summaries)]
+    x_key = numeric[0] if numeric else None
+    others = [k for k in results.varied if k != x_key]
+    fig, axes = plt.subplots(2 if cooling else 1, 1, figsize=(7.0, 8.0 if cooling else 4.8), squeeze=False)
+    ax = axes[0, 0]
+    series: dict = {}
+    for i, g in enumerate(summaries):
+        label = ", ".join(f"{k} = {g.parameters.get(k)}" for k in others)
+        series.setdefault(label, []).append((g.parameters.get(x_key, i) if x_key else i, g))
+    for j, (label, pts) in enumerate(series.items()):
+        pts.sort(key=lambda p: p[0])
+        x = np.array([p[0] for p in pts], dtype=float)
+        y = np.array([p[1].value for p in pts])
+        e = np.array([p[1].error if math.isfinite(p[1].error) else 0.0 for p in pts])
+        th = np.array([p[1].theory for p in pts])
+        seeds = pts[0][1].seeds
+        ax.errorbar(x, y, yerr=e, fmt="o", color=f"C{j}", capsize=3,
+                    label=f"simulation, mean $\\pm$ s.e. over {seeds} seed{'s' if seeds != 1 else ''}"
+                    + (f" ({label})" if label else ""))
+        ax.plot(x, th, "-", color=f"C{j}" if label else "k", lw=1, marker="x", ms=5,
+                label="kinetic theory" + (f" ({label})" if label else ""))
+        for xi, p in zip(x, pts):
+            g = p[1]
+            if math.isfinite(g.value) and math.isfinite(g.theory) and g.theory:
+                ax.annotate(f"{100 * (g.value / g.theory - 1):+.1f} %", (xi, g.value), textcoords="offset points",
+                            xytext=(6, -10), fontsize=7, color=f"C{j}")
+    ax.set_xlabel(x_key or "parameter set")
+    ax.set_ylabel("$\\tau_0$ of $T_0(1+t/\\tau_0)^{-p}$" if q == "tau0" else "$Z = P/(nT)$")
+    _no_offset(ax)
+    ax.legend(fontsize=7.5, title="percentages: simulation vs theory", title_fontsize=7)
+    what = "fitted cooling time $\\tau_0$" if q == "tau0" else "compressibility factor Z"
+    ax.set_title(f"Sweep {results.path.name}: {what} against {x_key or 'parameter set'}\n"
+                 f"theory: {summaries[0].theory_name}", fontsize=8.5)
+    if cooling:
+        ax = axes[1, 0]
+        ax.axhspan(0.98, 1.02, color="0.92", label="$\\pm$2 %")
+        for j, g in enumerate(summaries):
+            if g.ratio_time.size == 0:
+                continue
+            m = g.ratio_time > 0
+            t, r, e = g.ratio_time[m], g.ratio_mean[m], g.ratio_error[m]
+            label = ", ".join(f"{k} = {v}" for k, v in g.parameters.items()) or f"set {j}"
+            ax.plot(t, r, "-", color=f"C{j}", lw=1, label=label)
+            if np.all(np.isfinite(e)):
+                ax.fill_between(t, r - e, r + e, color=f"C{j}", alpha=0.25, lw=0)
+        ax.axhline(1.0, color="k", lw=0.8)
+        ax.set_xscale("log")
+        _no_offset(ax)
+        ax.set_xlabel("time since the first sample  [$\\sigma\\,(m/T_0)^{1/2}$]")
+        ax.set_ylabel("$T/T_\\mathrm{theory}$ (mean $\\pm$ s.e. over seeds)")
+        ax.set_title("temperature over kinetic theory, seeds averaged (band: standard error)", fontsize=8.5)
+        ax.legend(fontsize=7.5)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

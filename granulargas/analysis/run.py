@@ -1,14 +1,27 @@
-"""File-level analysis of one run: the H5MD file -> cooling history, theory, fits.
+"""File-level analysis of one run: the H5MD file -> histories, theory, fits.
 
 Everything goes through the readers of :mod:`granulargas.io.h5md`
 (``read_observables``, ``iter_snapshots``, ``load_snapshot``,
 ``read_parameters``) and reads snapshots one frame at a time, so files with
 10^6 particles and many frames are fine.
 
-The theory for a run (:meth:`RunInfo.prediction`) uses the run's number density
-``N / V``, dimension, and collision model from ``parameters/collision``; it is the
-theory of identical particles, so for a polydisperse run the mean diameter and
-mass are used and :attr:`RunInfo.monodisperse` is False.
+A run is one of the kinds of :func:`run_kind`: ``"elastic"`` (energy conserved:
+:mod:`granulargas.analysis.elastic`) or ``"cooling"`` (constant or viscoelastic
+restitution, this module's :func:`analyze_cooling`);
+:func:`granulargas.analysis.kinds.analyze_file` dispatches on it.
+
+Cooling runs are compared with the kinetic theory of
+:mod:`granulargas.theory.gas` (temperature and a2 together, with the exact
+eps(g) of the run's contact law; :attr:`CoolingAnalysis.theory`), started at the
+first sample's temperature. The closed-form laws (Haff's ``T0/(1+t/tau0)^2`` with
+the van Noije-Ernst a2, the leading-order viscoelastic ``T0 (1+t/tau0)^(-5/3)``)
+stay as references (:class:`Prediction`) and give the exponents of the fits.
+Both the run and the theory curve are fitted with the same law on the same
+samples, so fitted tau0 and exponent compare like with like.
+
+The theory is that of identical particles: for a polydisperse run the mean
+diameter and the mass of a particle of that diameter are used and
+:attr:`RunInfo.monodisperse` is False (the report says so).
 """
 
 from __future__ import annotations
@@ -28,18 +41,26 @@ from granulargas.analysis.cooling import (
 )
 from granulargas.errors import InputFileError
 from granulargas.io.h5md import iter_snapshots, load_snapshot, read_observables, read_parameters
-from granulargas.theory.gas import Gas
+from granulargas.theory.gas import CoolingCurve, Gas, cooling_curve, pressure_factor
 
 __all__ = [
     "RunInfo",
+    "run_kind",
     "Prediction",
     "CoolingHistory",
     "cooling_history",
+    "PressureSamples",
+    "pressure_samples",
     "sonine_history",
     "snapshot_series",
     "CoolingAnalysis",
     "analyze_cooling",
+    "theory_name",
+    "FINAL_FRACTION",
 ]
+
+#: T_ratio_final averages T / T_theory over this last fraction of the observation time span
+FINAL_FRACTION = 0.1
 
 
 @dataclass(frozen=True)
@@ -92,6 +113,7 @@ class RunInfo:
     prefactor: float | None
     contact_end: str = "overlap"
     parameters: dict = field(repr=False, default_factory=dict)
+    solid_fraction: float = math.nan  # sum of the particle volumes over the box volume
 
     @classmethod
     def from_file(cls, path) -> "RunInfo":
@@ -106,13 +128,15 @@ class RunInfo:
             particles=int(radii.shape[0]),
             box=np.asarray(snap.box, dtype=float),
             diameter=float(2.0 * radii.mean()),
-            mass=float(masses.mean()),
+            mass=_mean_particle_mass(radii, masses, int(snap.box.shape[0])),
             monodisperse=bool(np.ptp(radii) == 0 and np.ptp(masses) == 0),
             model=model,
             restitution=_float_or_none(coll.get("restitution")),
             prefactor=_float_or_none(coll.get("prefactor")),
             contact_end=str(coll.get("contact_end", "overlap")),
             parameters=params,
+            solid_fraction=float(np.sum(theory.particle_volume(2.0 * radii, int(snap.box.shape[0])))
+                                 / float(np.prod(snap.box))),
         )
 
     @property
@@ -125,7 +149,14 @@ class RunInfo:
 
     @property
     def packing_fraction(self) -> float:
+        """Packing fraction of the theory's gas: identical particles of the mean diameter at
+        the run's number density (the run's own, :attr:`solid_fraction`, if monodisperse)."""
         return float(theory.packing_fraction(self.number_density, self.dimension, self.diameter))
+
+    @property
+    def kind(self) -> str:
+        """:func:`run_kind` of this run."""
+        return run_kind(self)
 
     def gas(self, T0: float) -> Gas:
         """The run as a homogeneous gas of identical particles at temperature ``T0``."""
@@ -154,6 +185,38 @@ class RunInfo:
         return Prediction("elastic", T0, math.inf, 0.0, 0.0, omega0, ell, math.inf)
 
 
+def _mean_particle_mass(radii, masses, dim) -> float:
+    """Mass of a particle of the mean diameter, as :func:`granulargas.run.prepare.mean_particle`
+    gives it for the config: the common mass, or (masses proportional to the particle volumes,
+    a material density) the density times the volume of the mean diameter; else the mean mass."""
+    if np.ptp(masses) == 0:
+        return float(masses[0])
+    vol = theory.particle_volume(2.0 * radii, dim)
+    rho = masses / vol
+    if np.ptp(rho) <= 1e-9 * rho.mean():
+        return float(rho.mean() * theory.particle_volume(2.0 * radii.mean(), dim))
+    return float(masses.mean())
+
+
+def run_kind(info: RunInfo) -> str:
+    """``"elastic"`` (energy conserved: eps = 1 or damping 0) or ``"cooling"``."""
+    if info.model == "constant" and info.restitution is not None and info.restitution < 1.0:
+        return "cooling"
+    if info.model == "viscoelastic" and info.prefactor:
+        return "cooling"
+    return "elastic"
+
+
+def theory_name(info: RunInfo) -> str:
+    """What the kinetic theory compared with a run is (reports, JSON, legends)."""
+    d = info.dimension
+    eos = theory.eos_name(d)
+    if info.kind == "elastic":
+        return f"Enskog, {eos} equation of state"
+    law = "exact eps(g)" if info.model == "viscoelastic" else "constant eps"
+    return f"Enskog-Boltzmann, {law}, first Sonine a2(t); chi from {eos}"
+
+
 def _float_or_none(v):
     try:
         return None if v is None else float(v)
@@ -170,23 +233,72 @@ class CoolingHistory:
     collisions: np.ndarray
     collisions_per_particle: np.ndarray
     kinetic_energy: np.ndarray
+    pressure: np.ndarray | None = None  # mean over the interval since the previous non-NaN sample
 
 
 def cooling_history(path, particles: int | None = None) -> CoolingHistory:
-    """Temperature and collision count against time from ``observables/``."""
+    """Temperature, collision count, kinetic energy and pressure against time from ``observables/``."""
     obs = read_observables(path)
     if "temperature" not in obs:
         raise InputFileError(f"{path}: no observables/temperature in the file")
     _, t, T = obs["temperature"]
-    coll = obs.get("collisions", (None, t, np.full(t.shape, -1)))[2]
-    ke = obs.get("kinetic_energy", (None, t, np.full(t.shape, np.nan)))[2]
+    n = t.shape[0]
+
+    def column(name, fill, dtype=float):
+        value = obs.get(name, (None, t, np.full(n, fill)))[2]
+        return np.asarray(value, dtype=dtype)[:n] if len(value) >= n else np.full(n, fill, dtype=dtype)
+
+    coll, ke, p = column("collisions", -1, np.int64), column("kinetic_energy", np.nan), column("pressure", np.nan)
     t, idx = np.unique(np.asarray(t, dtype=float), return_index=True)
-    T, coll, ke = np.asarray(T, float)[idx], np.asarray(coll)[idx], np.asarray(ke, float)[idx]
+    T, coll, ke, p = np.asarray(T, float)[idx], coll[idx], ke[idx], p[idx]
     ok = np.isfinite(T)
     if particles is None:
         particles = load_snapshot(path, 0).radii.shape[0]
     cpp = collisions_per_particle(np.where(coll >= 0, coll, np.nan), particles)
-    return CoolingHistory(t[ok], T[ok], coll[ok], cpp[ok], ke[ok])
+    return CoolingHistory(t[ok], T[ok], coll[ok], cpp[ok], ke[ok], p[ok])
+
+
+@dataclass(frozen=True)
+class PressureSamples:
+    """Pressure windows of a run: each the mean over ``[start, end]`` (arrays (P,)).
+
+    ``temperature`` is the time average of T over the window (T log-linear between
+    samples), so ``Z = P / (n temperature)`` is the compressibility factor of the window.
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    pressure: np.ndarray
+    temperature: np.ndarray
+    Z: np.ndarray
+
+
+def _mean_temperature(t, T, a, b):
+    """Time average of T over [a, b], T log-linear between the samples (t, T)."""
+    inside = (t > a) & (t < b)
+    tt = np.concatenate([[a], t[inside], [b]])
+    lT = np.interp(tt, t, np.log(T))
+    dt, T0, T1 = np.diff(tt), np.exp(lT[:-1]), np.exp(lT[1:])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        seg = np.where(np.abs(T1 - T0) > 1e-12 * T0, (T1 - T0) / np.log(T1 / T0), 0.5 * (T0 + T1))
+    return float((seg * dt).sum() / (b - a))
+
+
+def pressure_samples(history: CoolingHistory, density: float) -> PressureSamples:
+    """The run's pressure windows with their mean temperature and Z (number density ``density``)."""
+    p = history.pressure if history.pressure is not None else np.full(history.time.shape, np.nan)
+    idx = np.flatnonzero(np.isfinite(p))
+    if idx.size == 0:
+        e = np.empty(0)
+        return PressureSamples(e, e, e, e, e)
+    t, T = history.time, history.temperature
+    # a window runs from the previous pressure sample (or the run's first sample) to this one
+    starts = np.concatenate([[t[0]], t[idx[:-1]]])
+    ends = t[idx]
+    keep = ends > starts
+    starts, ends, pres = starts[keep], ends[keep], p[idx][keep]
+    Tm = np.array([_mean_temperature(t, T, a, b) for a, b in zip(starts, ends)])
+    return PressureSamples(starts, ends, pres, Tm, pres / (density * Tm))
 
 
 def snapshot_series(path, func: Callable, every: int = 1, indices=None) -> Iterator:
@@ -225,30 +337,177 @@ def sonine_history(path, every: int = 1):
 
 @dataclass(frozen=True)
 class CoolingAnalysis:
-    """A run's cooling compared with theory (see :func:`analyze_cooling`)."""
+    """A run's cooling compared with kinetic theory (see :func:`analyze_cooling`).
+
+    Times in the arrays are measured from the first observable sample
+    (``t_offset``, non-zero for a restarted run's file); reports add it back.
+    """
 
     info: RunInfo
     history: CoolingHistory
-    prediction: Prediction
-    fit: CoolingFit | None  # exponent fixed to the theory's
+    prediction: Prediction  # closed-form reference law
+    fit: CoolingFit | None  # exponent fixed to the closed-form law's
     fit_free: CoolingFit | None  # exponent fitted
     sonine: tuple  # (time, a2, a3)
     t_offset: float  # time of the first sample (restarts), subtracted from every time
+    theory: CoolingCurve | None = None  # kinetic theory, T and a2 (theory.gas)
+    theory_fit: CoolingFit | None = None  # the fixed-exponent law fitted to the theory curve
+    theory_fit_free: CoolingFit | None = None
+    pressure: PressureSamples | None = None
+    kind: str = "cooling"
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times since the first sample, (S,)."""
+        return self.history.time - self.t_offset
+
+    @property
+    def theory_name(self) -> str:
+        return theory_name(self.info)
+
+    @property
+    def temperature_theory(self) -> np.ndarray:
+        """Kinetic-theory T at the sample times (closed form if no curve), (S,)."""
+        if self.theory is None:
+            return self.prediction.temperature(self.time)
+        return self.theory.temperature_at(self.time)
+
+    @property
+    def ratio(self) -> np.ndarray:
+        """T / T_theory at the sample times, (S,)."""
+        return self.history.temperature / self.temperature_theory
+
+    def ratio_mean(self, t_from: float) -> float:
+        """Mean of T / T_theory over the samples with (shifted) time >= t_from."""
+        sel = self.time >= t_from
+        return float(np.mean(self.ratio[sel])) if np.any(sel) else math.nan
+
+    @property
+    def T_ratio_final(self) -> float:
+        """Mean T / T_theory over the last :data:`FINAL_FRACTION` of the observation time span."""
+        t = self.time
+        return self.ratio_mean(t[-1] - FINAL_FRACTION * (t[-1] - t[0]))
+
+    @property
+    def T_ratio_last_decade(self) -> float:
+        """Mean T / T_theory over the last decade of time, t >= t_final / 10."""
+        return self.ratio_mean(self.time[-1] / 10.0)
 
     @property
     def tau0_deviation(self) -> float:
-        """Relative deviation of the fitted tau0 from the prediction."""
+        """Relative deviation of the fitted tau0 from the closed-form law's tau0."""
         if self.fit is None or not math.isfinite(self.prediction.tau0):
             return math.nan
         return self.fit.tau0 / self.prediction.tau0 - 1.0
 
+    @property
+    def a2_late(self):
+        """(mean, standard error, count) of a2 over the later half of the snapshots (in their order;
+        log-spaced snapshots make that the later half in log time). The error is the sampling
+        error of N particles, ``sqrt(8 / (d (d + 2) N))`` per snapshot."""
+        ts, a2, _ = self.sonine
+        sel = np.arange(ts.size) >= ts.size // 2
+        if not np.any(sel):
+            return math.nan, math.nan, 0
+        d, N = self.info.dimension, self.info.particles
+        se = math.sqrt(8.0 / (d * (d + 2) * N)) / math.sqrt(int(sel.sum()))
+        return float(np.mean(a2[sel])), se, int(sel.sum())
 
-def analyze_cooling(path, t_range=None, with_sonine: bool = True, sonine_every: int = 1) -> CoolingAnalysis:
+    @property
+    def Z(self) -> float:
+        """Mean measured compressibility factor over the pressure windows (nan if none)."""
+        if self.pressure is None or self.pressure.Z.size == 0:
+            return math.nan
+        return float(np.mean(self.pressure.Z))
+
+    @property
+    def Z_theory(self) -> float:
+        """Eq. (G4) of theory.gas averaged over the same windows (at the theory's a2)."""
+        if self.pressure is None or self.pressure.Z.size == 0 or self.theory is None:
+            return math.nan
+        mid = 0.5 * (self.pressure.start + self.pressure.end) - self.t_offset
+        from granulargas.theory.gas import compressibility_factor
+
+        z = compressibility_factor(self.info.gas(self.prediction.T0), self.pressure.temperature,
+                                   self.theory.a2_at(mid))
+        return float(np.mean(z))
+
+    def summary(self) -> dict:
+        """The numbers of the analysis as a flat, JSON-ready dict (``granulargas analyze --json``)."""
+        info, h, p = self.info, self.history, self.prediction
+        a2_mean, a2_err, _ = self.a2_late if self.sonine[0].size else (math.nan, math.nan, 0)
+        T_th = self.temperature_theory
+        return _clean({
+            "file": info.path,
+            "kind": self.kind,
+            "model": info.model,
+            "dimension": info.dimension,
+            "particles": info.particles,
+            "packing_fraction": info.packing_fraction,
+            "monodisperse": info.monodisperse,
+            "restitution": info.restitution,
+            "prefactor": info.prefactor,
+            "t_start": float(h.time[0]),
+            "t_final": float(h.time[-1]),
+            "T_initial": float(h.temperature[0]),
+            "T_final": float(h.temperature[-1]),
+            "collisions_per_particle": float(h.collisions_per_particle[-1]),
+            "theory": self.theory_name,
+            "T_theory_final": float(T_th[-1]),
+            "T_ratio_final": self.T_ratio_final,
+            "T_ratio_last_decade": self.T_ratio_last_decade,
+            "tau0_fit": self.fit.tau0 if self.fit else None,
+            "tau0_fit_error": self.fit.tau0_err if self.fit else None,
+            "tau0_theory": self.theory_fit.tau0 if self.theory_fit else p.tau0,
+            "tau0_closed_form": p.tau0,
+            "exponent_fit": -self.fit_free.exponent if self.fit_free else None,
+            "exponent_fit_error": self.fit_free.exponent_err if self.fit_free else None,
+            "exponent_theory": -self.theory_fit_free.exponent if self.theory_fit_free else -p.exponent,
+            "exponent_closed_form": -p.exponent,
+            "a2_mean": a2_mean,
+            "a2_error": a2_err,
+            "a2_theory_final": float(self.theory.a2_at(self.time[-1])) if self.theory is not None else None,
+            "Z": self.Z,
+            "Z_theory": self.Z_theory,
+            "instability_length": p.instability_length,
+            "box": float(info.box.max()),
+        })
+
+
+def _clean(d: dict) -> dict:
+    """Non-finite floats -> None (JSON null)."""
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, (float, np.floating)):
+            v = float(v) if math.isfinite(v) else None
+        elif isinstance(v, np.integer):
+            v = int(v)
+        elif isinstance(v, np.bool_):
+            v = bool(v)
+        out[k] = v
+    return out
+
+
+def _initial_a2(path, t0: float) -> float:
+    """a2 the theory starts from: 0 for a fresh run (Maxwellian start), else the a2 of
+    the snapshot at the first sample time (a restarted run)."""
+    if t0 == 0.0:
+        return 0.0
+    snap = load_snapshot(path, 0)
+    if abs(snap.time - t0) > 1e-9 * max(abs(t0), 1.0):
+        return 0.0
+    return sonine_coefficients(snap.velocities, snap.masses)[0]
+
+
+def analyze_cooling(path, t_range=None, with_sonine: bool = True, sonine_every: int = 1,
+                    with_theory: bool = True) -> CoolingAnalysis:
     """Fit the cooling law of a run and compare it with kinetic theory.
 
-    The fixed-exponent fit (2 for constant restitution, 5/3 viscoelastic) gives
-    tau0; the free fit gives the exponent. Times are measured from the first
-    observable sample (restarted runs start later than 0).
+    The kinetic theory (:func:`granulargas.theory.gas.cooling_curve`) starts at the
+    first sample's temperature. The fixed-exponent fit (2 for constant restitution,
+    5/3 viscoelastic) gives tau0, the free fit the exponent; both fits are applied to
+    the run and to the theory curve on the same samples. Times are measured from the
+    first observable sample (restarted runs start later than 0).
 
     Parameters
     ----------
@@ -256,6 +515,8 @@ def analyze_cooling(path, t_range=None, with_sonine: bool = True, sonine_every: 
         Fit window, in the shifted time.
     with_sonine : bool
         Also compute a2, a3 from the snapshots (reads every frame once).
+    with_theory : bool
+        Integrate the kinetic theory (a second or so); otherwise only the closed forms.
     """
     info = RunInfo.from_file(path)
     hist = cooling_history(path, info.particles)
@@ -263,11 +524,20 @@ def analyze_cooling(path, t_range=None, with_sonine: bool = True, sonine_every: 
         raise InputFileError(f"{path}: no temperature samples")
     t0 = float(hist.time[0])
     t = hist.time - t0
-    pred = info.prediction(float(hist.temperature[0]))
-    fit = fit_free = None
+    T0 = float(hist.temperature[0])
+    pred = info.prediction(T0)
+    curve = None
+    if with_theory and info.kind == "cooling" and t[-1] > 0:
+        curve = cooling_curve(info.gas(T0), t_end=float(t[-1]), t_min_ratio=None, a2_initial=_initial_a2(path, t0))
+    fit = fit_free = tfit = tfit_free = None
     if pred.law != "elastic" and t.size >= 4:
         fit = fit_cooling_law(t, hist.temperature, exponent=pred.exponent, t_range=t_range, tau0_guess=pred.tau0)
         fit_free = fit_cooling_law(t, hist.temperature, exponent=None, t_range=t_range, tau0_guess=pred.tau0)
+        if curve is not None:
+            T_th = curve.temperature_at(t)
+            tfit = fit_cooling_law(t, T_th, exponent=pred.exponent, t_range=t_range, tau0_guess=pred.tau0)
+            tfit_free = fit_cooling_law(t, T_th, exponent=None, t_range=t_range, tau0_guess=pred.tau0)
     son = sonine_history(path, sonine_every) if with_sonine else (np.empty(0),) * 3
     son = (son[0] - t0, son[1], son[2])
-    return CoolingAnalysis(info, hist, pred, fit, fit_free, son, t0)
+    return CoolingAnalysis(info, hist, pred, fit, fit_free, son, t0, curve, tfit, tfit_free,
+                           pressure_samples(hist, info.number_density))

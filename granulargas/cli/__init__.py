@@ -25,7 +25,7 @@ from granulargas.errors import UserError
 COMMANDS = {
     "run": ("granulargas.cli.run", "run a simulation from a TOML config, writing H5MD"),
     "epsilon": ("granulargas.cli.epsilon", "coefficient of restitution and contact duration"),
-    "analyze": ("granulargas.cli.analyze", "report on a run's H5MD file (cooling, a2, plots)"),
+    "analyze": ("granulargas.cli.analyze", "report on a run's H5MD file or a sweep against kinetic theory (--plot, --json)"),
     "advise": ("granulargas.cli.advise", "is a constant restitution good enough for this config?"),
     "sweep": ("granulargas.cli.sweep", "run a parameter sweep / ensemble from a sweep file"),
     "export": ("granulargas.cli.export", "export a run for LAMMPS or OVITO (GSD)"),

@@ -1,21 +1,32 @@
-"""Report on a run's H5MD file: T(t) table, fitted cooling law against theory, a2.
+"""Report on a run's H5MD file, or on a sweep directory, against kinetic theory.
 
-``granulargas analyze FILE [--plot PNG] [--fit-range TMIN TMAX] [--no-snapshots]``
+``granulargas analyze PATH [--plot PNG] [--json] [--fit-range TMIN TMAX] [--no-snapshots]``
+
+PATH is a run's H5MD file (the analysis of its kind, :mod:`granulargas.analysis.kinds`:
+cooling runs against the kinetic theory of :mod:`granulargas.theory.gas`, elastic runs
+against the equation of state and Enskog's collision frequency) or a sweep's output
+directory (its ``index.json``: one row per parameter set, mean +- standard error over
+the seeds). ``--json`` prints one JSON object instead of the text report.
 """
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 
-from granulargas.analysis.run import analyze_cooling
 from granulargas.errors import InputFileError
+
+INDEX_NAME = "index.json"
 
 
 def configure_parser(parser):
-    parser.add_argument("file", help="H5MD file written by 'granulargas run'")
-    parser.add_argument("--plot", metavar="PNG", help="write the cooling figure (T/T0, ratio to theory, a2) here")
+    parser.add_argument("file", metavar="PATH",
+                        help="H5MD file written by 'granulargas run', or a sweep's output directory (index.json)")
+    parser.add_argument("--plot", metavar="PNG", help="write the figure of the analysis here")
+    parser.add_argument("--json", action="store_true", help="print one JSON object instead of the report")
     parser.add_argument("--fit-range", nargs=2, type=float, metavar=("TMIN", "TMAX"),
                         help="fit window in time since the first sample (default: all samples)")
     parser.add_argument("--no-snapshots", action="store_true", help="skip a2/a3 (do not read the snapshots)")
@@ -23,12 +34,22 @@ def configure_parser(parser):
 
 
 def _fmt(x, spec=".4g"):
-    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+    if x is None or (isinstance(x, (float, np.floating)) and not math.isfinite(x)):
+        return "-"
+    return format(x, spec)
 
 
-def report(analysis, rows: int = 10) -> str:
-    """The text report of :func:`granulargas.analysis.run.analyze_cooling`'s result."""
-    a, info, p, h = analysis, analysis.info, analysis.prediction, analysis.history
+def _pm(value, error, spec=".5g"):
+    return _fmt(value, spec) + ("" if error is None or not math.isfinite(error) else f" +- {_fmt(error, '.2g')}")
+
+
+def _dev(value, ref):
+    if value is None or ref is None or not (math.isfinite(value) and math.isfinite(ref)) or ref == 0:
+        return ""
+    return f" ({100 * (value / ref - 1):+.2f} %)"
+
+
+def _header(info) -> list[str]:
     lines = [
         f"{info.path}",
         f"  {info.dimension}D, N = {info.particles}, box = {' x '.join(_fmt(float(L)) for L in info.box)}, "
@@ -37,60 +58,170 @@ def report(analysis, rows: int = 10) -> str:
         + (f" (prefactor k = {info.prefactor:.4g})" if info.prefactor is not None and info.model == "viscoelastic" else ""),
     ]
     if not info.monodisperse:
-        lines.append("  note: polydisperse run; theory below uses the mean diameter and mass")
-    lines.append(
-        f"  theory: law = {p.law}, T0 = {p.T0:.4g}, tau0 = {_fmt(p.tau0)}, exponent = -{p.exponent:.4g}, "
-        f"a2 = {p.a2:.4g}, mean free path = {p.mean_free_path:.4g}, instability length L_c = {_fmt(p.instability_length)}"
-    )
+        lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
+                     f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
+                     f"same number density (packing {info.packing_fraction:.4g})")
+    return lines
+
+
+def _table_rows(t, rows):
+    if t.size > 1 and t[-1] > t[0]:
+        targets = np.geomspace(max(t[1] - t[0], 1e-300), t[-1] - t[0], max(rows - 1, 1)) + t[0]
+        return np.unique(np.concatenate([[0], np.searchsorted(t, targets).clip(0, t.size - 1)]))
+    return np.array([0])
+
+
+def cooling_report(a, rows: int = 10) -> str:
+    """Text report of a :class:`granulargas.analysis.run.CoolingAnalysis`."""
+    info, p, h = a.info, a.prediction, a.history
+    lines = _header(info)
+    lines.append(f"  theory: {a.theory_name}")
+    lines.append(f"  closed form ({p.law}, reference): T0 = {p.T0:.4g}, tau0 = {_fmt(p.tau0)}, "
+                 f"exponent = -{p.exponent:.4g}, a2 = {p.a2:.4g}; mean free path = {p.mean_free_path:.4g}, "
+                 f"instability length L_c = {_fmt(p.instability_length)}")
     if math.isfinite(p.instability_length):
         L = float(info.box.max())
         side = "below" if L < p.instability_length else "ABOVE"
         lines.append(f"  box length {L:.4g} is {side} L_c ({p.instability_length:.4g})"
                      + ("" if L < p.instability_length else ": expect shear modes and clusters, not the homogeneous law"))
-    t = h.time - a.t_offset
-    if t.size > 1:
-        targets = np.geomspace(t[1], t[-1], max(rows - 1, 1))
-        idx = np.unique(np.concatenate([[0], np.searchsorted(t, targets).clip(0, t.size - 1)]))
-    else:
-        idx = np.array([0])
-    lines.append("")
-    lines.append(f"  {'t':>12} {'coll/part':>10} {'T':>12} {'T_theory':>12} {'T/T_theory':>10}")
-    for i in idx:
-        Tth = float(p.temperature(t[i]))
-        lines.append(f"  {t[i]:12.5g} {_fmt(float(h.collisions_per_particle[i]), '10.4g'):>10} {h.temperature[i]:12.5g} "
-                     f"{Tth:12.5g} {h.temperature[i] / Tth:10.4f}")
-    lines.append("")
+    t, T, Tth = a.time, h.temperature, a.temperature_theory
+    lines += ["", f"  {'t':>12} {'coll/part':>10} {'T':>12} {'T_theory':>12} {'T/T_theory':>10}"]
+    for i in _table_rows(t, rows):
+        lines.append(f"  {h.time[i]:12.5g} {_fmt(float(h.collisions_per_particle[i]), '10.4g'):>10} {T[i]:12.5g} "
+                     f"{Tth[i]:12.5g} {T[i] / Tth[i]:10.4f}")
+    lines += ["", f"  T/T_theory: {a.T_ratio_final:.4f} over the last 10 % of the time, "
+                  f"{a.T_ratio_last_decade:.4f} over the last decade (t >= {h.time[-1] / 10:.4g})"]
     if a.fit is not None:
         f, g = a.fit, a.fit_free
-        lines.append(f"  fit (exponent fixed at -{f.exponent:.4g}): tau0 = {f.tau0:.5g} +- {f.tau0_err:.2g}"
-                     f"  vs theory {p.tau0:.5g}  ({100 * a.tau0_deviation:+.2f} %)"
-                     + (f"; with the beta^2 term {p.tau0_second_order:.5g} ({100 * (f.tau0 / p.tau0_second_order - 1):+.2f} %)"
-                        if math.isfinite(p.tau0_second_order) else ""))
-        lines.append(f"  fit (exponent free): exponent = -{g.exponent:.4f} +- {g.exponent_err:.2g}, tau0 = {g.tau0:.5g}"
-                     f"  vs theory -{p.exponent:.4g}")
-    ts, a2, a3 = a.sonine
+        tf, tg = a.theory_fit, a.theory_fit_free
+        ref = tf.tau0 if tf is not None else p.tau0
+        lines.append(f"  fit T0 (1 + t/tau0)^-{f.exponent:.4g}: tau0 = {f.tau0:.5g} +- {f.tau0_err:.2g}, theory "
+                     f"{ref:.5g}{_dev(f.tau0, ref)}; closed form {p.tau0:.5g}{_dev(f.tau0, p.tau0)}")
+        ref_e = tg.exponent if tg is not None else p.exponent
+        lines.append(f"  fit with free exponent: exponent = -{g.exponent:.4f} +- {g.exponent_err:.2g}, theory "
+                     f"-{ref_e:.4f} (the same fit of the theory curve), closed form -{p.exponent:.4g}")
+    ts, a2, _ = a.sonine
     if ts.size:
         k = np.unique(np.linspace(0, ts.size - 1, min(ts.size, 6)).astype(int))
-        lines.append("  Sonine coefficients (snapshots): " + ", ".join(f"t={ts[i]:.3g}: a2={a2[i]:+.4f}" for i in k))
-        if p.law == "haff":
-            late = a2[ts.size // 2:]  # the later half of the snapshots (log-spaced in time)
-            se = math.sqrt(8.0 / (info.dimension * (info.dimension + 2) * info.particles))
-            lines.append(f"  a2 mean over the later half of the snapshots ({late.size}) {np.mean(late):+.4f}"
-                         f" +- {se / math.sqrt(max(late.size, 1)):.2g} (sampling error of N = {info.particles})"
-                         f" vs van Noije-Ernst {p.a2:+.4f}")
+        th = a.theory.a2_at(ts[k]) if a.theory is not None else np.full(k.size, np.nan)
+        lines.append("  a2 (snapshots, theory): " + ", ".join(
+            f"t={ts[i] + a.t_offset:.3g}: {a2[i]:+.4f} ({th[j]:+.4f})" for j, i in enumerate(k)))
+        mean, se, count = a.a2_late
+        if count:
+            lines.append(f"  a2 mean over the later half of the snapshots ({count}) {mean:+.4f} +- {se:.2g} "
+                         f"(sampling error of N = {info.particles}); theory at the end "
+                         f"{_fmt(float(a.theory.a2_at(t[-1])) if a.theory is not None else math.nan, '+.4f')}"
+                         + (f", van Noije-Ernst {p.a2:+.4f}" if p.law == "haff" else ""))
+    if math.isfinite(a.Z):
+        lines.append(f"  Z = P/(nT) = {a.Z:.4f} (mean over {a.pressure.Z.size} windows), Enskog "
+                     f"{_fmt(a.Z_theory, '.4f')}{_dev(a.Z, a.Z_theory)}")
     return "\n".join(lines)
 
 
-def run(args) -> int:
+def elastic_report(a, rows: int = 10) -> str:
+    """Text report of a :class:`granulargas.analysis.elastic.ElasticAnalysis`."""
+    s = a.summary()
+    lines = _header(a.info)
+    lines.append(f"  theory: {a.theory_name}; elastic collisions, no cooling")
+    lines.append(f"  energy drift (E - E0)/E0: {s['energy_drift_final']:.3g} at t = {s['t_final']:.4g}, "
+                 f"largest {s['energy_drift_max']:.3g}")
+    lines.append(f"  averages from t = {a.t_equilibrated:.4g} (equilibration left out); errors from "
+                 f"block means")
+    lines.append(f"  Z = P/(nT) = {_pm(s['Z'], s['Z_error'])}; {s['Z_theory_name']} {s['Z_theory']:.5g}"
+                 f"{_dev(s['Z'], s['Z_theory'])}; {s['Z_reference_name']} {s['Z_reference']:.5g}"
+                 f"{_dev(s['Z'], s['Z_reference'])}")
+    lines.append(f"  collision frequency per particle {_pm(s['collision_frequency'], s['collision_frequency_error'])}; "
+                 f"Enskog {s['collision_frequency_theory']:.5g}"
+                 f"{_dev(s['collision_frequency'], s['collision_frequency_theory'])}")
+    if s.get("a2_mean") is not None:
+        d, N = a.info.dimension, a.info.particles
+        lines.append(f"  a2 mean of the snapshots {s['a2_mean']:+.4f} (Maxwellian: 0 +- "
+                     f"{math.sqrt(8 / (d * (d + 2) * N)):.2g} per snapshot)")
+    return "\n".join(lines)
+
+
+def sweep_report(results, summaries) -> str:
+    """Text table of :meth:`granulargas.analysis.ensemble.SweepResults.summaries`."""
+    lines = [repr(results)]
+    if not summaries:
+        return "\n".join(lines + ["  no finished runs"])
+    names = results.varied
+    q = summaries[0].quantity
+    lines.append(f"  theory: {summaries[0].theory_name}")
+    lines.append(f"  {q}: " + ("fitted T0 (1 + t/tau0)^-p (p of the closed-form law), theory = the same fit of the "
+                               "theory curve" if q == "tau0" else "P/(nT) after equilibration, theory = equation of state"))
+    head = "  " + " ".join(f"{n:>22}" for n in names) + f" {'seeds':>5} {q + ' (+- s.e.)':>20} {'theory':>10} " \
+        f"{'dev':>8} {'T_final (+- s.e.)':>22} {'T_theory':>11} {'T/T_theory':>16}"
+    lines.append(head)
+    for g in summaries:
+        cells = " ".join(f"{_fmt(g.parameters.get(n), 'g') if not isinstance(g.parameters.get(n), str) else g.parameters.get(n):>22}"
+                         for n in names)
+        dev = _dev(g.value, g.theory).strip(" ()") or "-"
+        lines.append(f"  {cells} {g.seeds:>5} {_pm(g.value, g.error):>20} {_fmt(g.theory, '.5g'):>10} {dev:>8} "
+                     f"{_pm(g.T_final, g.T_final_error):>22} {_fmt(g.T_theory_final, '.5g'):>11} "
+                     f"{_pm(g.T_ratio_final, g.T_ratio_final_error, '.4f'):>16}")
+    return "\n".join(lines)
+
+
+#: kind -> text report ``f(analysis, rows) -> str``
+REPORTS = {"cooling": cooling_report, "elastic": elastic_report}
+
+
+def report(analysis, rows: int = 10) -> str:
+    """The text report of an analysis of any kind (:data:`REPORTS`)."""
+    return REPORTS[analysis.kind](analysis, rows=rows)
+
+
+def _is_sweep(path: Path) -> bool:
+    return path.is_dir() and (path / INDEX_NAME).exists()
+
+
+def _run_sweep(args) -> int:
+    from granulargas.analysis.ensemble import SweepResults
+
+    path = Path(args.file)
     try:
-        a = analyze_cooling(args.file, t_range=tuple(args.fit_range) if args.fit_range else None,
-                            with_sonine=not args.no_snapshots)
+        results = SweepResults(path)
+        summaries = results.summaries(t_range=tuple(args.fit_range) if args.fit_range else None)
+    except (ValueError, KeyError, json.JSONDecodeError) as exc:
+        raise InputFileError(f"{path}: cannot analyse the sweep ({exc})") from None
+    if args.json:
+        print(json.dumps({"sweep": str(path), "varied": results.varied, "runs_done": len(results.runs),
+                          "runs_not_done": len(results.failed), "groups": [g.as_dict() for g in summaries]},
+                         indent=1, ensure_ascii=False))
+    else:
+        print(sweep_report(results, summaries))
+    if args.plot:
+        from granulargas.analysis.plots import plot_sweep
+
+        plot_sweep(results, summaries, args.plot)
+        if not args.json:
+            print(f"  wrote {args.plot}")
+    return 0
+
+
+def run(args) -> int:
+    path = Path(args.file)
+    if path.is_dir():
+        if not _is_sweep(path):
+            raise InputFileError(f"{path}: is a directory without {INDEX_NAME} (give a run's .h5 file or a "
+                                 "sweep's output directory)")
+        return _run_sweep(args)
+    from granulargas.analysis.kinds import analyze_file
+
+    try:
+        a = analyze_file(args.file, t_range=tuple(args.fit_range) if args.fit_range else None,
+                         with_sonine=not args.no_snapshots)
     except ValueError as exc:
         raise InputFileError(f"{args.file}: cannot analyse ({exc})") from None
-    print(report(a, rows=args.rows))
+    if args.json:
+        print(json.dumps(a.summary(), indent=1, ensure_ascii=False))
+    else:
+        print(report(a, rows=args.rows))
     if args.plot:
-        from granulargas.analysis.plots import plot_cooling  # matplotlib only when a plot is asked for
+        from granulargas.analysis.plots import plot_analysis  # matplotlib only when a plot is asked for
 
-        plot_cooling(a, args.plot)
-        print(f"  wrote {args.plot}")
+        plot_analysis(a, args.plot)
+        if not args.json:
+            print(f"  wrote {args.plot}")
     return 0

@@ -7,6 +7,8 @@ Examples::
     granulargas epsilon --young 1e7 --poisson 0.3 --dissipation-time 1e-5 \\
         --radius 0.01 --density 1000 --speed 1.0
 
+Each contact end starts with the value to use, eps and tau_c from the restitution
+table the engine looks up, then compares the methods (ODE, table, series, Padé).
 The material form computes rho (Schwager & Pöschel (1997), eq. (3)) and beta = (3/2) A rho^{2/5} g^{1/5}
 for two identical spheres (or give --radius2/--mass2), prints physical
 durations in seconds, and warns when the model leaves its validity range.
@@ -19,8 +21,9 @@ import warnings
 
 import numpy as np
 
-from granulargas.contact import duration, material, restitution
+from granulargas.contact import duration, material, restitution, restitution_table
 from granulargas.contact.series import MAX_RELIABLE_ORDER, SeriesDivergenceWarning, radius_of_convergence
+from granulargas.contact.table import TABLE_BETA_MAX
 from granulargas.errors import UserError
 from granulargas.theory import particle_volume
 
@@ -29,7 +32,7 @@ def configure_parser(parser):
     parser.add_argument("--beta", type=float, nargs="+", metavar="B",
                         help="dimensionless damping (3/2) A rho^{2/5} g^{1/5} (one or more)")
     parser.add_argument("--end", choices=["overlap", "force", "both"], default="both",
-                        help="end of contact: x = 0 (seed), vanishing force, or both (default)")
+                        help="end of contact: x = 0 (the engine's default), vanishing force, or both (default)")
     parser.add_argument("--order", type=int, default=None,
                         help="extra series order to show (default: 10 overlap / 20 force)")
     m = parser.add_argument_group("material form (SI units)")
@@ -105,12 +108,25 @@ def _rows(beta, end, order):
     return rows, radius
 
 
+def _use_line(beta: float, end: str, unit) -> str:
+    """The value to use: the restitution table the engine looks up (and its interpolation error)."""
+    table = restitution_table(max(beta, 1e-6), end=end)
+    eps, tau = float(table.restitution(beta)), float(table.duration(beta))
+    err = table.parameters.get("max_error_restitution")
+    phys = f", t_c = {tau * unit:.8g} s" if unit is not None else ""
+    return (f"    use: eps = {eps:.14f}, tau_c = {tau:.14f}{phys}  (the engine's restitution table"
+            + (f", interpolation error < {float(err):.1g}" if err is not None else "") + ")")
+
+
 def run(args) -> int:
     if args.beta is None and args.young is None:
         raise UserError("give --beta B, or the material form (--young ... --speed G); see --help")
     if args.beta is not None:
         if any(not (b >= 0 and math.isfinite(b)) for b in args.beta):
             raise UserError(f"--beta {args.beta}: must be finite and >= 0")
+        if any(b > TABLE_BETA_MAX for b in args.beta):
+            raise UserError(f"--beta {args.beta}: the engine's restitution table covers beta <= {TABLE_BETA_MAX:g} "
+                            "(the viscoelastic model holds for beta well below ~3)")
         betas, speeds, units = np.asarray(args.beta, dtype=float), None, None
         for problem in material.validity_problems(beta=betas):
             print(f"warning: {problem}")
@@ -124,7 +140,10 @@ def run(args) -> int:
         print(head)
         for end in ends:
             rows, radius = _rows(float(beta), end, args.order)
-            print(f"  end = {end}  (series radius of convergence: beta < {radius:.4g})")
+            default = " (the engine's default)" if end == "overlap" else ""
+            print(f"  end = {end}{default}")
+            print(_use_line(float(beta), end, None if units is None else units[i]))
+            print(f"    comparison of the methods (series radius of convergence: beta < {radius:.4g}):")
             tunit = "t_c [s]" if units is not None else ""
             print(f"    {'method':<22}{'eps':>20}{'tau_c':>20}{tunit:>16}")
             for name, e, tau in rows:

@@ -7,7 +7,7 @@ advice predicts, with kinetic theory and no simulation
 (:mod:`granulargas.run.validity` explains each step):
 
 1. the temperature range of the run, from the viscoelastic cooling law solved
-   with the exact eps(beta) (a quadrature in ln T);
+   with the exact eps(beta) (:func:`granulargas.theory.gas.cooling_curve`);
 2. the spread of eps over the thermal impact speeds (central 90 % of collisions)
    from the hottest to the coldest moment of the run;
 3. the best constant eps: the one whose Haff law ``T0 / (1 + t/tau0)^2``
@@ -26,9 +26,10 @@ g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
 over the run, plus the inelastic-collapse risk.
 
-The prediction assumes a homogeneous gas with a Maxwellian velocity
-distribution (the viscoelastic a2 is of order beta and left out); it is checked
-against real runs in ``scripts/rule_choice.py`` (docs/choosing-a-model.md).
+The prediction is the kinetic theory of :mod:`granulargas.theory.gas`: a homogeneous
+gas whose temperature and second Sonine coefficient a2 evolve together (moment
+equations with the exact eps(g)); it is checked against real runs in
+``scripts/rule_choice.py`` (docs/choosing-a-model.md).
 
 Runner API: :func:`summary_line` ``(config, tolerance=DEFAULT_TOLERANCE) -> str | None``.
 """
@@ -45,6 +46,7 @@ from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.run import validity as V
 from granulargas.run.prepare import mean_particle
+from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant"]
 
@@ -162,6 +164,14 @@ def _equivalent_prefactor(gas: V.Gas, eps: float) -> float:
     return math.exp(brentq(f, math.log(1e-8 / scale), math.log(20.0 / scale), xtol=1e-10))
 
 
+def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.CoolingCurve:
+    """``curve``, or one integrated up to ``t_end`` if the run ends after ``curve`` does
+    (its T then falls below the default 1e-12 T0)."""
+    if t_end <= curve.time[-1]:
+        return curve
+    return cooling_curve(gas, t_end=t_end, t_min_ratio=None)
+
+
 def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     """Advice on the collision rule for a config (module doc)."""
     gas = V.gas_from_config(config)
@@ -171,6 +181,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = V.viscoelastic_cooling(gas)
         t_end, T_end = V.run_temperature_range(gas, curve)
+        curve = _curve_through(gas, curve, t_end)
         adv.t_end, adv.T_end = t_end, T_end / gas.temperature
         adv.spread = V.restitution_spread(gas, gas.temperature, T_end)
         adv.eps_best, adv.error = best_constant(gas, curve, t_end)
@@ -188,7 +199,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         k = _equivalent_prefactor(gas, eps)
         ve = replace(gas, model="viscoelastic", prefactor=k)
         curve = V.viscoelastic_cooling(ve)
-        t_ve, _ = V.run_temperature_range(replace(ve, end_time=t_end, collisions_per_particle=None), curve)
+        curve = _curve_through(ve, curve, t_end)
         adv.damping_equivalent = damping_from_prefactor(k)
         adv.eps_best = eps
         adv.error = constant_error(ve, eps, curve, t_end)

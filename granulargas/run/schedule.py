@@ -35,11 +35,18 @@ class Schedule:
 def mean_free_time(config: RunConfig) -> float:
     """Enskog estimate of the mean time between collisions of a particle at the
     initial temperature (:func:`granulargas.theory.collision_frequency`), with the
-    mean diameter and its mass (:func:`granulargas.run.prepare.mean_particle`)."""
+    mean diameter and its mass (:func:`granulargas.run.prepare.mean_particle`).
+
+    chi is the closed form (Carnahan-Starling, Henderson), fixed: the schedule only
+    needs an estimate, and its output times must not move when the theory's chi is
+    refined, because a run resynchronises at every snapshot and so its trajectory
+    depends on the snapshot times."""
     d = config.system.dimension
     sigma, mass = mean_particle(config)
-    n = theory.number_density(config.system.packing_fraction, d, sigma)
-    return 1.0 / float(theory.collision_frequency(n, config.initial.temperature, d, sigma, mass))
+    eta = config.system.packing_fraction
+    n = theory.number_density(eta, d, sigma)
+    chi = theory.contact_value(eta, d, "closed")
+    return 1.0 / float(theory.collision_frequency(n, config.initial.temperature, d, sigma, mass, chi=chi))
 
 
 def collision_budget(config: RunConfig) -> int:

@@ -4,7 +4,7 @@ A :class:`Gas` holds what the theory needs (reduced units; identical particles o
 the mean diameter ``sigma`` and mass ``m``); nothing is simulated. Used by the
 run checks (:mod:`granulargas.run.validity`), the advice on a constant
 restitution (:mod:`granulargas.run.advise`) and the analysis of a run
-(:mod:`granulargas.analysis.run`).
+(:mod:`granulargas.analysis`).
 
 Impact speeds
 -------------
@@ -16,20 +16,50 @@ quantiles are ``g_q = s sqrt(-2 ln(1 - q))``; the energy a collision removes
 weights it by a further ``g^2``. "Thermal impact speeds" below are the central
 90 % of collisions (quantiles 0.05 and 0.95).
 
-Cooling with the viscoelastic law (no power-law approximation)
---------------------------------------------------------------
-``dT/dt = -omega(T) (1 - eps^2)_eff(T) T / d`` with the Enskog collision
-frequency ``omega`` (:func:`granulargas.theory.collision_frequency`, a2 = 0) and
-the energy-weighted kernel average ``(1 - eps^2)_eff = <(1 - eps^2(beta(g))) g^3> / <g^3>``,
-evaluated with the exact eps(beta) (restitution table, error 2e-10) by
-Gauss-Legendre quadrature (:func:`_kernel_nodes`). Time and collisions per
-particle are then quadratures in ``ln T``:
+Cooling: temperature and a2 together
+------------------------------------
+The gas cools by the moment equations of the Enskog-Boltzmann equation in the
+first Sonine approximation (Brilliantov & Pöschel, Phys. Rev. E 61, 5573 (2000),
+who expanded them in the damping; here they are solved with the exact eps(g)):
 
-    t(T) = d int_T^T0 dT' / (omega (1-eps^2)_eff T'),
-    s(T) = d int_T^T0 dT' / ((1-eps^2)_eff T').
+    dT/dt  = -zeta(T, a2) T,            zeta = (2/d) nu_c mu_2(T, a2),          (G1)
+    da2/dt = (4/d) nu_c [mu_2 (1 + a2) - mu_4 / (d + 2)]   (linear in a2),      (G2)
+    ds/dt  = omega = nu_c nu_0(a2),     nu_c = chi n sigma^(d-1) sqrt(2T/m),    (G3)
 
-At small beta this reduces to ``T = T0 (1 + t/tau0)^(-5/3)``
-(:func:`granulargas.theory.viscoelastic_tau0`; the tests check it).
+with the collision moments mu_2, mu_4, nu_0 of :mod:`granulargas.theory.moments`
+(derivation and equation numbers there) evaluated with eps of the engine's
+restitution table at the quadrature nodes of the normal impact speed, s the
+collisions per particle and chi the Enskog contact value of the packing fraction
+(:func:`granulargas.theory.contact_value`, Kolafa-Labík-Malijevský in 3D, the
+resummed virial series in 2D). The gas starts Maxwellian (a2 = 0); a2 relaxes in
+a few collisions to a quasi-stationary value that, with the viscoelastic law,
+drifts as eps -> 1 on cooling. :func:`cooling_curve` integrates (G1)-(G3) with
+scipy's ``solve_ivp`` (LSODA, relative tolerance 1e-10) in the variable
+``x = ln(1 + t/t_free)`` (t_free the mean free time at T0), which keeps the step
+count small over many decades of time.
+
+Limits (the tests check each): for constant eps, (G1)-(G2) is Haff's law with
+the van Noije-Ernst a2 once a2 has relaxed; at small damping, zeta at a2 = 0
+approaches the closed forms of :mod:`granulargas.theory.viscoelastic` (first and
+second order in the damping) and T(t) the law ``T0 (1 + t/tau0)^(-5/3)``.
+
+The Maxwellian average ``(1 - eps^2)_eff(T) = <(1 - eps^2) g^3> / <g^3>`` over the
+collision kernel (:func:`effective_inelasticity`, the same quadrature at a2 = 0)
+sets the constant eps equivalent to the viscoelastic gas at temperature T.
+
+Pressure
+--------
+A collision transfers the momentum ``m_eff (1 + eps) g_n`` across the distance sigma,
+so the collisional part of the pressure carries ``(1 + eps)/2`` averaged with the
+weight ``Theta(c_n) c_n^2`` of the normal impact speeds (Enskog's collisional
+transfer; for eps = 1 the virial theorem's ``Z = 1 + 2^(d-1) eta chi``):
+
+    Z = P / (n T) = 1 + 2^(d-1) eta chi <(1 + eps)/2>,                           (G4)
+
+:func:`pressure_factor` is the average, with the same quadrature and a2 weight as
+the moments; for constant eps it is ``(1 + eps)/2`` whatever a2 (the second
+moment of the relative velocity does not depend on a2), the Enskog pressure of
+the homogeneous cooling state ``1 + 2^(d-2)(1 + eps) eta chi``.
 
 Shear instability
 -----------------
@@ -38,19 +68,29 @@ cooling state is unstable (:func:`granulargas.theory.instability_length`) at a
 temperature T: with the config's eps and the van Noije-Ernst a2 for a constant
 restitution; with the effective ``eps_eff = sqrt(1 - (1 - eps^2)_eff(T))`` and
 a2 = 0 for a viscoelastic gas, whose ``L_c`` grows as it cools (smallest at T0).
+
+Mixtures
+--------
+The engine runs polydisperse gases (a continuous range of diameters). This theory
+is that of identical particles: a polydisperse run is described by particles of
+the mean diameter and the mass of that diameter, and callers say so (the analysis
+report prints a note). A mixture theory would need one temperature and one a2
+per species (non-equipartition); it is not attempted.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.polynomial.legendre import leggauss
+from scipy.integrate import solve_ivp
 
 from granulargas.contact import restitution_table
 from granulargas.contact.material import pair_constant
-from granulargas.theory.enskog import collision_frequency, haff_tau0, instability_length
+from granulargas.theory.enskog import collision_frequency, contact_value, haff_tau0, instability_length
+from granulargas.theory.moments import moment_coefficients, speed_quadrature
 
 __all__ = [
     "THERMAL_QUANTILES",
@@ -59,6 +99,11 @@ __all__ = [
     "impact_speed_quantile",
     "restitution_spread",
     "effective_inelasticity",
+    "restitution_at_nodes",
+    "cooling_rates",
+    "pressure_factor",
+    "compressibility_factor",
+    "cooling_curve",
     "viscoelastic_cooling",
     "predicted_end",
     "run_temperature_range",
@@ -129,9 +174,15 @@ class Gas:
     collisions_per_particle: float | None = None
 
     @property
+    def chi(self) -> float:
+        """Enskog pair correlation at contact of the packing fraction (:func:`granulargas.theory.contact_value`)."""
+        return float(contact_value(self.packing_fraction, self.dimension))
+
+    @property
     def collision_frequency(self):
-        """Enskog collision frequency per particle at T0."""
-        return float(collision_frequency(self.density, self.temperature, self.dimension, self.sigma, self.mass))
+        """Enskog collision frequency per particle at T0 (Maxwellian)."""
+        return float(collision_frequency(self.density, self.temperature, self.dimension, self.sigma, self.mass,
+                                         chi=self.chi))
 
     @property
     def pair_constant(self) -> float:
@@ -192,10 +243,8 @@ def restitution_spread(gas: Gas, t_high, t_low, quantiles=THERMAL_QUANTILES):
             "spread": float(e_hi - e_lo)}
 
 
-def effective_inelasticity(gas: Gas, temperature, nodes: int = _NODES, restitution=None):
-    """``(1 - eps^2)_eff(T) = <(1 - eps^2) g^3> / <g^3>`` over the collision kernel.
-
-    Quadrature of :func:`_kernel_nodes` (weight ``g^3 exp(-g^2/(2 s^2))``).
+def restitution_at_nodes(gas: Gas, temperature, restitution=None, table=None):
+    """eps at the normal impact speeds ``g_j = v_T u_j`` of the collision-moment quadrature.
 
     Parameters
     ----------
@@ -203,36 +252,143 @@ def effective_inelasticity(gas: Gas, temperature, nodes: int = _NODES, restituti
     restitution : callable, optional
         ``eps(beta)`` (vectorised) to use instead of the exact law (to predict the
         effect of an approximation, e.g. a truncated series).
+    table : RestitutionTable, optional
+        A table covering the betas needed (saves building one per call).
+
+    Returns
+    -------
+    array (J,) or (K, J)
+        eps at the nodes ``granulargas.theory.moments.speed_quadrature(d).u``.
+    """
+    u = speed_quadrature(gas.dimension).u
+    T = np.asarray(temperature, dtype=float)
+    shape = T.shape + u.shape
+    if gas.model == "constant" and gas.restitution is not None:
+        return np.full(shape, float(gas.restitution))
+    if gas.model != "viscoelastic" or not gas.pair_constant:
+        return np.ones(shape)
+    g = np.sqrt(2.0 * T / gas.mass)[..., None] * u
+    beta = gas.beta(g)
+    if restitution is not None:
+        return np.asarray(restitution(beta), dtype=float)
+    if table is None or not table.covers(float(beta.max())):
+        return _eps(beta, gas.end)
+    return table.restitution(beta)
+
+
+def effective_inelasticity(gas: Gas, temperature, restitution=None):
+    """``(1 - eps^2)_eff(T) = <(1 - eps^2) g^3> / <g^3>`` over the Maxwellian collision kernel.
+
+    The quadrature of :mod:`granulargas.theory.moments` at a2 = 0: ``mu_2(T) / mu_2(eps = 0)``.
+
+    Parameters
+    ----------
+    temperature : float or array (K,)
+    restitution : callable, optional
+        ``eps(beta)``, see :func:`restitution_at_nodes`.
 
     Returns
     -------
     float or array (K,)
     """
-    u, w = _kernel_nodes(3, nodes)
-    T = np.atleast_1d(np.asarray(temperature, dtype=float))
-    s = np.sqrt(2.0 * T / gas.mass)
-    g = s[:, None] * u[None, :]
-    eps = _eps(gas.beta(g), gas.end) if restitution is None else restitution(gas.beta(g))
-    out = (1.0 - eps**2) @ w
+    eps = restitution_at_nodes(gas, np.atleast_1d(np.asarray(temperature, dtype=float)), restitution)
+    _, mu2, _ = moment_coefficients(eps, gas.dimension)
+    _, mu2_inelastic, _ = moment_coefficients(np.zeros(eps.shape[-1]), gas.dimension)
+    out = mu2[..., 0] / mu2_inelastic[0]
     return out if np.ndim(temperature) else float(out[0])
+
+
+def _collision_scale(gas: Gas, temperature):
+    """nu_c = chi n sigma^(d-1) sqrt(2T/m) of eq. (G3)."""
+    return gas.chi * gas.density * gas.sigma ** (gas.dimension - 1) * np.sqrt(2.0 * np.asarray(temperature) / gas.mass)
+
+
+def cooling_rates(gas: Gas, temperature, a2, restitution=None, table=None):
+    """Right-hand sides of (G1)-(G3) (module doc).
+
+    Parameters
+    ----------
+    temperature : float or array (K,)
+    a2 : float or array (K,)
+
+    Returns
+    -------
+    zeta, da2_dt, omega : float or arrays (K,)
+        Cooling rate (dT/dt = -zeta T), rate of change of a2, and collision
+        frequency per particle.
+    """
+    d = gas.dimension
+    eps = restitution_at_nodes(gas, temperature, restitution, table)
+    nu, mu2, mu4 = moment_coefficients(eps, d)
+    a = np.asarray(a2, dtype=float)
+    scale = _collision_scale(gas, temperature)
+    zeta = 2.0 / d * scale * (mu2[..., 0] + a * mu2[..., 1])
+    # mu_2 (1 + a2) - mu_4 / (d + 2), linear in a2
+    source = mu2[..., 0] + (mu2[..., 0] + mu2[..., 1]) * a - (mu4[..., 0] + mu4[..., 1] * a) / (d + 2)
+    da2 = 4.0 / d * scale * source
+    omega = scale * (nu[..., 0] + a * nu[..., 1])
+    return zeta, da2, omega
+
+
+def pressure_factor(gas: Gas, temperature, a2=0.0, restitution=None):
+    """``<(1 + eps)/2>`` of eq. (G4) at temperature T and Sonine coefficient a2.
+
+    Returns
+    -------
+    float or array (K,)
+    """
+    q = speed_quadrature(gas.dimension)
+    eps = restitution_at_nodes(gas, temperature, restitution)
+    a = np.asarray(a2, dtype=float)[..., None]
+    w = (q.nu[:, 0] + a * q.nu[:, 1]) * q.u  # Theta(c_n) c_n^2 with the a2 weight
+    out = (w * 0.5 * (1.0 + eps)).sum(-1) / w.sum(-1)
+    return out if np.ndim(out) else float(out)
+
+
+def compressibility_factor(gas: Gas, temperature, a2=0.0, restitution=None):
+    """``Z = P / (n T)`` of the gas, eq. (G4)."""
+    d = gas.dimension
+    return 1.0 + 2.0 ** (d - 1) * gas.packing_fraction * gas.chi * pressure_factor(gas, temperature, a2, restitution)
 
 
 @dataclass(frozen=True)
 class CoolingCurve:
-    """Kinetic-theory cooling on a grid of temperatures (decreasing).
+    """Kinetic-theory cooling from (G1)-(G3): T, a2 and collisions per particle against time.
 
-    Attributes ``temperature``, ``time``, ``collisions`` (per particle), all (K,).
+    Attributes ``time``, ``temperature``, ``collisions`` (per particle), ``a2``: arrays (K,)
+    on a grid from t = 0 (uniform in ``ln(1 + t/t_free)``); the methods interpolate
+    the ODE solution itself (dense output), not the grid.
     """
 
     temperature: np.ndarray
     time: np.ndarray
     collisions: np.ndarray
+    a2: np.ndarray | None = None
+    solution: object = field(default=None, repr=False, compare=False)
+    time_scale: float = 1.0
+
+    def _state(self, t):
+        t = np.asarray(t, dtype=float)
+        x = np.log1p(np.clip(t, 0.0, None) / self.time_scale)
+        y = np.asarray(self.solution(np.atleast_1d(x).ravel()))
+        y = y.reshape((3,) + t.shape)
+        beyond = t > self.time[-1] * (1.0 + 1e-12)
+        return np.where(beyond, np.nan, y)
 
     def temperature_at(self, t):
-        """T at times t (log-linear interpolation; t beyond the grid -> nan)."""
-        t = np.asarray(t, dtype=float)
-        lt = np.interp(t, self.time, np.log(self.temperature), right=np.nan)
-        return np.exp(lt)
+        """T at times t (nan beyond the curve)."""
+        if self.solution is None:
+            lt = np.interp(np.asarray(t, dtype=float), self.time, np.log(self.temperature), right=np.nan)
+            return np.exp(lt)
+        return np.exp(self._state(t)[0])
+
+    def a2_at(self, t):
+        """a2 at times t (nan beyond the curve)."""
+        return self._state(t)[1]
+
+    def collisions_at(self, t):
+        """Collisions per particle by time t (nan beyond the curve)."""
+        return self._state(t)[2]
 
     def temperature_after(self, s):
         """T after s collisions per particle."""
@@ -240,23 +396,70 @@ class CoolingCurve:
         return np.exp(lt)
 
 
-def viscoelastic_cooling(gas: Gas, t_min_ratio: float = 1e-12, points: int = 600,
-                         restitution=None) -> CoolingCurve:
-    """Cooling curve of the viscoelastic gas from T0 down to ``t_min_ratio T0`` (module doc).
+def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | None = 1e-12, points: int = 600,
+                  a2_initial: float = 0.0, restitution=None, rtol: float = 1e-10) -> CoolingCurve:
+    """Integrate (G1)-(G3) from T0, a2 = ``a2_initial`` (module doc).
 
-    ``restitution``: optional eps(beta) callable, see :func:`effective_inelasticity`.
+    Parameters
+    ----------
+    t_end : float, optional
+        Stop at this time.
+    t_min_ratio : float, optional
+        Stop when T falls to ``t_min_ratio T0`` (whichever comes first; at least one
+        of the two must be given; an elastic gas needs ``t_end``).
+    points : int
+        Grid points of the returned arrays.
+    restitution : callable, optional
+        ``eps(beta)``, see :func:`restitution_at_nodes`.
     """
     T0 = gas.temperature
-    lnT = np.linspace(math.log(T0), math.log(T0 * t_min_ratio), points)
-    T = np.exp(lnT)
-    inel = effective_inelasticity(gas, T, restitution=restitution)
-    omega = collision_frequency(gas.density, T, gas.dimension, gas.sigma, gas.mass)
-    ds = gas.dimension / inel          # d s / d(-ln T)
-    dt = ds / omega                     # d t / d(-ln T)
-    step = -np.diff(lnT)
-    s = np.concatenate([[0.0], np.cumsum(0.5 * (ds[1:] + ds[:-1]) * step)])
-    t = np.concatenate([[0.0], np.cumsum(0.5 * (dt[1:] + dt[:-1]) * step)])
-    return CoolingCurve(T, t, s)
+    inelastic = not (gas.model == "elastic" or (gas.model == "constant" and gas.restitution == 1.0)
+                     or (gas.model == "viscoelastic" and not gas.pair_constant))
+    if t_end is None and (t_min_ratio is None or not inelastic):
+        raise ValueError("cooling_curve needs t_end (an elastic gas does not cool)")
+    t_free = 1.0 / float(cooling_rates(gas, T0, a2_initial, restitution)[2])
+    table = None
+    if gas.model == "viscoelastic" and gas.pair_constant and restitution is None:
+        u_max = float(speed_quadrature(gas.dimension).u.max())
+        table = restitution_table(float(gas.beta(math.sqrt(4.0 * T0 / gas.mass) * u_max)) * 1.01, end=gas.end)
+
+    def rhs(x, y):
+        t_plus = t_free * math.exp(x)  # dt/dx = t + t_free
+        T = math.exp(y[0])
+        zeta, da2, omega = cooling_rates(gas, T, y[1], restitution, table)
+        return [-float(zeta) * t_plus, float(da2) * t_plus, float(omega) * t_plus]
+
+    x_end = math.log1p(t_end / t_free) if t_end is not None else math.inf
+    events = None
+    if inelastic and t_min_ratio is not None:
+        ln_stop = math.log(t_min_ratio)
+
+        def cooled(x, y):
+            return y[0] - math.log(T0) - ln_stop
+
+        cooled.terminal = True
+        events = cooled
+        if not math.isfinite(x_end):
+            x_end = 200.0  # t = t_free e^200: the event comes first for any cooling gas
+    sol = solve_ivp(rhs, (0.0, x_end), [math.log(T0), float(a2_initial), 0.0], method="LSODA", rtol=rtol,
+                    atol=[1e-12, 1e-12, 1e-10], dense_output=True, events=events)
+    if sol.status < 0:
+        raise RuntimeError(f"cooling_curve: the ODE solver failed ({sol.message})")
+    x_last = float(sol.t[-1])
+    x = np.linspace(0.0, x_last, points)
+    y = sol.sol(x)
+    t = t_free * np.expm1(x)
+    t[-1] = t_free * math.expm1(x_last)
+    return CoolingCurve(np.exp(y[0]), t, y[2], y[1], solution=sol.sol, time_scale=t_free)
+
+
+def viscoelastic_cooling(gas: Gas, t_min_ratio: float = 1e-12, points: int = 600,
+                         restitution=None) -> CoolingCurve:
+    """Cooling curve of the gas from T0 down to ``t_min_ratio T0`` (:func:`cooling_curve`).
+
+    ``restitution``: optional eps(beta) callable, see :func:`restitution_at_nodes`.
+    """
+    return cooling_curve(gas, t_end=None, t_min_ratio=t_min_ratio, points=points, restitution=restitution)
 
 
 def _haff_end(gas: Gas):

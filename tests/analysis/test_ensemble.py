@@ -1,12 +1,17 @@
 """Sweep aggregation: seed averages against a direct read, tau0 against theory."""
 
+import json
+import math
 from concurrent.futures import ThreadPoolExecutor
 
 import h5py
 import numpy as np
+import pytest
 
 from granulargas import theory
 from granulargas.analysis.ensemble import SweepResults
+from granulargas.analysis.kinds import analyze_file
+from granulargas.cli import main
 from granulargas.run.sweep import load_sweep, run_sweep
 
 BASE = """\
@@ -33,7 +38,9 @@ observables_interval = 0.5
 """
 
 
-def test_seed_average_and_tau0_scan(tmp_path):
+@pytest.fixture(scope="module")
+def sweep_dir(tmp_path_factory):
+    tmp_path = tmp_path_factory.mktemp("sweep")
     (tmp_path / "base.toml").write_text(BASE)
     (tmp_path / "sweep.toml").write_text(
         'base = "base.toml"\noutput_dir = "out"\n[vary]\n'
@@ -42,8 +49,11 @@ def test_seed_average_and_tau0_scan(tmp_path):
     with ThreadPoolExecutor(1) as pool:
         entries = run_sweep(load_sweep(tmp_path / "sweep.toml"), pool, log=lambda *a: None)
     assert all(e["status"] == "done" for e in entries)
+    return tmp_path / "out"
 
-    results = SweepResults(tmp_path / "out")
+
+def test_seed_average_and_tau0_scan(sweep_dir):
+    results = SweepResults(sweep_dir)
     assert results.varied == ["collision.restitution"]
     histories = {h.parameters["collision.restitution"]: h for h in results.temperature()}
     assert set(histories) == {0.95, 0.8}
@@ -64,3 +74,29 @@ def test_seed_average_and_tau0_scan(tmp_path):
     predicted = np.array([theory.haff_tau0(e, n, T0=1.0, dim=2) for e in scan.values])
     assert scan.mean[0] < scan.mean[1]
     np.testing.assert_allclose(scan.mean, predicted, rtol=0.10)
+
+
+def test_sweep_summaries_repr_and_cli(sweep_dir, capsys, tmp_path):
+    results = SweepResults(sweep_dir)
+    text = repr(results)
+    assert "6 runs done" in text and "2 parameter sets" in text and "3 seeds" in text
+    groups = results.summaries()
+    assert [g.parameters["collision.restitution"] for g in groups] == [0.8, 0.95]
+    for g in groups:
+        # mean and standard error over the seeds of the per-file analyses
+        tau = [analyze_file(f, with_sonine=False).fit.tau0 for f in g.files]
+        assert g.quantity == "tau0" and g.seeds == 3
+        assert g.value == pytest.approx(np.mean(tau), rel=1e-12)
+        assert g.error == pytest.approx(np.std(tau, ddof=1) / math.sqrt(3), rel=1e-9)
+        assert abs(g.value / g.theory - 1) < 0.1 and abs(g.T_ratio_final - 1) < 0.1
+        assert g.ratio_mean.shape == g.ratio_time.shape and g.ratio_time.size > 10
+    assert main(["analyze", str(sweep_dir), "--json", "--plot", str(tmp_path / "s.png")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["varied"] == ["collision.restitution"] and len(out["groups"]) == 2
+    g = out["groups"][0]
+    assert g["seeds"] == 3 and g["quantity"] == "tau0" and "first Sonine" in g["theory"]
+    assert g["value"] == pytest.approx(groups[0].value) and g["theory_value"] == pytest.approx(groups[0].theory)
+    assert (tmp_path / "s.png").stat().st_size > 10_000
+    assert main(["analyze", str(sweep_dir)]) == 0
+    table = capsys.readouterr().out
+    assert "seeds" in table and "T_theory" in table and "0.95" in table

@@ -70,3 +70,56 @@ def test_cli_missing_file_is_one_line_error(tmp_path, capsys):
     assert main(["analyze", str(tmp_path / "nope.h5")]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error:") and err.count("\n") == 1
+
+
+REQUIRED_JSON = ("model", "dimension", "t_final", "T_final", "theory", "T_theory_final", "T_ratio_final", "tau0_fit",
+                 "tau0_theory", "exponent_fit", "exponent_theory", "a2_mean", "Z", "Z_theory")
+
+
+def test_cooling_analysis_uses_the_kinetic_theory(tmp_path):
+    # the file holds Haff's law with the van Noije-Ernst a2 from t = 0; the kinetic theory
+    # starts Maxwellian (a2 = 0), relaxes to the same a2 and then runs parallel to it
+    path, tau0 = _write(tmp_path / "a.h5")
+    a = analyze_cooling(path)
+    assert a.theory is not None and "first Sonine" in a.theory_name
+    late = a.time > 10 * tau0
+    r = a.ratio[late]
+    assert np.ptp(r) < 2e-3 and abs(r.mean() - 1) < 0.01
+    # the same fixed-exponent fit of run and theory curve
+    assert a.theory_fit.tau0 == pytest.approx(tau0, rel=0.01)
+    assert a.T_ratio_final == pytest.approx(r[-1], rel=1e-3)
+
+
+def test_analyze_json_has_the_documented_keys(tmp_path, capsys):
+    import json
+
+    path, tau0 = _write(tmp_path / "a.h5")
+    assert main(["analyze", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in REQUIRED_JSON:
+        assert key in out, key
+    assert out["model"] == "constant" and out["dimension"] == 3 and out["kind"] == "cooling"
+    assert out["tau0_fit"] == pytest.approx(tau0, rel=1e-6) and out["exponent_fit"] == pytest.approx(-2.0, rel=1e-6)
+    assert 0.98 < out["T_ratio_final"] < 1.02
+    assert out["Z"] is None  # the synthetic file has no pressure
+
+
+def test_analyze_directory_without_index_is_one_line(tmp_path, capsys):
+    assert main(["analyze", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "index.json" in err and err.count("\n") == 1
+
+
+def test_pressure_windows_use_the_mean_temperature(tmp_path):
+    from granulargas.analysis.run import CoolingHistory, pressure_samples
+
+    t = np.linspace(0.0, 4.0, 5)
+    T = np.exp(-t)  # log-linear: the mean of T over [a, b] is (T(a) - T(b)) / (b - a)
+    p = np.array([np.nan, 1.0, np.nan, 2.0, 3.0])
+    h = CoolingHistory(t, T, np.zeros(5, int), np.zeros(5), np.full(5, np.nan), p)
+    s = pressure_samples(h, density=0.5)
+    np.testing.assert_allclose(s.start, [0.0, 1.0, 3.0])
+    np.testing.assert_allclose(s.end, [1.0, 3.0, 4.0])
+    Tm = (np.exp(-s.start) - np.exp(-s.end)) / (s.end - s.start)
+    np.testing.assert_allclose(s.temperature, Tm, rtol=1e-12)
+    np.testing.assert_allclose(s.Z, [1.0, 2.0, 3.0] / (0.5 * Tm), rtol=1e-12)

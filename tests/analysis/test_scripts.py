@@ -46,3 +46,10 @@ def test_movie_script_writes_gif(tiny_run, tmp_path):
     out = tmp_path / "m.gif"
     assert mod.main([str(tiny_run), "--out", str(out), "--pixels", "50"]) == 0
     assert out.stat().st_size > 1000
+
+
+def test_kinetic_theory_check_script(capsys):
+    mod = _load("kinetic_theory_check")
+    assert mod.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "engine/theory-1" in out and "a2 theory" in out

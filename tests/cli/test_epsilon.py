@@ -40,3 +40,25 @@ def test_bad_input_is_one_line(argv, msg, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert msg in err and err.count("\n") == 1
+
+
+def test_beta_form_names_the_value_to_use_first(capsys, cache_dir):
+    # the engine's table value, before the comparison of the methods, for each end
+    from granulargas.contact import restitution_table
+
+    assert main(["epsilon", "--beta", "0.3"]) == 0
+    out = capsys.readouterr().out
+    for end in ("overlap", "force"):
+        block = out[out.index(f"end = {end}"):]
+        use = block.index("use: eps = ")
+        assert use < block.index("comparison") < block.index("ode")
+        table = restitution_table(0.3, end=end)
+        assert f"use: eps = {float(table.restitution(0.3)):.14f}" in block
+        assert f"tau_c = {float(table.duration(0.3)):.14f}" in block
+    assert "end = overlap (the engine's default)" in out
+
+
+def test_beta_beyond_the_table_is_one_line(capsys):
+    assert main(["epsilon", "--beta", "50"]) == 2
+    err = capsys.readouterr().err
+    assert "40" in err and err.count("\n") == 1

@@ -48,6 +48,53 @@ def test_eos_against_exact_virial_series():
     assert th.compressibility_factor(eta, 2) == pytest.approx(z2, abs=0.005 * eta**2)
 
 
+# Hansen-Goos, J. Chem. Phys. 144, 164506 (2016): P sigma^3 / T of hard spheres at
+# n sigma^3 = 0.50 ... 0.75 (his equation of state, fitted to simulations), as tabulated
+# in the examples of Allen & Tildesley, Computer Simulation of Liquids (2nd ed., 2017)
+HANSEN_GOOS = [(0.50, 1.6347), (0.55, 2.0574), (0.60, 2.5769), (0.65, 3.2171), (0.70, 4.0087), (0.75, 4.9910)]
+
+
+def test_kolafa_labik_malijevsky_against_hansen_goos():
+    for n, p in HANSEN_GOOS:
+        eta = math.pi / 6 * n
+        z = p / n
+        assert th.compressibility_factor(eta, 3) == pytest.approx(z, rel=2e-4)
+        # Carnahan-Starling is 0.2-0.3 % low there
+        assert -0.0032 < th.compressibility_factor(eta, 3, "closed") / z - 1 < -0.0019
+        # chi from the virial theorem Z = 1 + 4 eta chi
+        assert th.contact_value(eta, 3) == pytest.approx((z - 1) / (4 * eta), rel=4e-4)
+
+
+def test_kolafa_labik_malijevsky_virial_coefficients():
+    # Z = 1 + 4 eta + 10 eta^2 + (55/3) eta^3 + ...: B2, B3 exact, B4 = 18.333 against the exact 18.365
+    eta = 1e-3
+    z = th.compressibility_factor(eta, 3)
+    assert (z - 1 - 4 * eta - 10 * eta**2) / eta**3 == pytest.approx(18.3648, rel=3e-3)
+
+
+def test_hard_disk_resummation_converges_and_reproduces_the_series():
+    from granulargas.theory.enskog import DISK_VIRIAL_RATIOS, _disk_compressibility
+
+    # Padé approximants of different orders agree where the fluid is stable
+    for eta in (0.3, 0.5, 0.65):
+        z = th.compressibility_factor(eta, 2)
+        for m in (2, 4):
+            assert _disk_compressibility(eta, m) == pytest.approx(z, rel=1e-4 if eta <= 0.5 else 1e-3)
+    # and the virial series at low density (all ten terms)
+    eta = 0.02
+    series = 1 + sum(b * (2 * eta) ** (k + 1) for k, b in enumerate(DISK_VIRIAL_RATIOS))
+    assert th.compressibility_factor(eta, 2) == pytest.approx(series, rel=1e-13)
+    # Henderson's chi is 0.5-0.7 % high at eta = 0.5
+    assert 1.005 < th.contact_value(0.5, 2, "closed") / th.contact_value(0.5, 2) < 1.007
+
+
+def test_eos_names():
+    assert th.eos_name(3) == "Kolafa-Labík-Malijevský"
+    assert th.eos_name(2, "closed") == "Henderson"
+    with pytest.raises(ValueError):
+        th.contact_value(0.1, 3, "nonsense")
+
+
 def test_packing_fraction_roundtrip():
     for dim in (2, 3):
         assert th.packing_fraction(th.number_density(0.2, dim), dim) == pytest.approx(0.2)
@@ -146,7 +193,7 @@ def test_haff_tau0_closed_form_3d():
     # 1/tau0 = (2 sqrt(pi)/3)(1 - e^2) chi n sqrt(T0) (1 + 3 a2/16), hand-evaluated
     eps, eta = 0.9, 0.1
     n = 6 * eta / math.pi
-    chi = (1 - eta / 2) / (1 - eta) ** 3
+    chi = (1 - eta / 2 + eta**2 / 12 - eta**3 / 6) / (1 - eta) ** 3  # (Z_KLM - 1) / (4 eta)
     a2 = -0.0145608  # van Noije-Ernst at eps = 0.9, d = 3, evaluated by hand
     inv = 2 * math.sqrt(math.pi) / 3 * 0.19 * chi * n * (1 + 3 * a2 / 16)
     assert th.haff_tau0(eps, n) == pytest.approx(1 / inv, rel=1e-5)
