@@ -55,7 +55,7 @@ def measure(args, fraction, seed):
     first = max(1, round(args.relax / zeta / dt_k))
     ts, a2s = [], []
     for k in range(int(round(args.measure / (spacing * dt_k * zeta)))):
-        sim.run((first + k * spacing + 0.5) * dt_k)
+        sim.run((first + k * spacing) * dt_k)  # kicks at (k + 1/2) dt_k
         v = sim.velocities
         c = v - v.mean(axis=0)
         c2 = np.sum(c * c, axis=1)

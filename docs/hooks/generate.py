@@ -75,6 +75,10 @@ _MATERIAL = {"collision": {"model": "viscoelastic", "material": {
     "young_modulus": 1.0e7, "poisson_ratio": 0.3, "dissipation_time": 1.0e-5,
     "diameter": 0.01, "density": 1000.0, "speed_unit": 1.0}}}
 
+_WALLS_CONSTANT = {"system": {"boundary": ["periodic", "periodic", "wall"]},
+                   "collision": {"model": "constant", "restitution": 0.9}}
+_DRIVEN = {"driving": {"heating_rate": 0.1}}
+
 MEANINGS: dict[tuple[str, str], dict] = {
     ("system", "dimension"): dict(meaning="2 (disks) or 3 (spheres)."),
     ("system", "particles"): dict(
@@ -84,8 +88,15 @@ MEANINGS: dict[tuple[str, str], dict] = {
                 "Random placement works up to about 0.54 (3D) and 0.76 (2D).",
         also=[("in 2D", {"system": {"dimension": 2}})]),
     ("system", "seed"): dict(
-        meaning="Seed of all randomness (diameters, positions, velocities); a seed gives the "
-                "same initial state on every machine."),
+        meaning="Seed of all randomness (diameters, positions, velocities, the driving's kicks); a "
+                "seed gives the same initial state on every machine."),
+    ("system", "boundary"): dict(
+        meaning="One entry per axis (x, y, z): `\"periodic\"`, or `\"wall\"` for flat hard walls at 0 "
+                "and L (no sphere may start overlapping them; sphere-wall collisions follow the "
+                "collision model with R_eff = R, m_eff = m). A wall axis must be at least 4.15 largest "
+                "diameters long; the packing fraction counts the whole box. See docs/walls-and-driving.md.",
+        type="list of strings", allowed='one entry per dimension, each "periodic" or "wall"',
+        default=Text("all \"periodic\"")),
     ("particles", "diameter"): dict(
         meaning="Particle diameter, or `{ min = ..., max = ... }` for a uniform polydisperse mix "
                 "(the reference diameter is then the mean)."),
@@ -121,6 +132,21 @@ MEANINGS: dict[tuple[str, str], dict] = {
         meaning="`model = \"constant\"` only: TC model (Luding & McNamara 1998); a collision "
                 "within `tc_time` of either particle's previous one is elastic, which guards "
                 "against inelastic collapse.", context=_CONSTANT),
+    ("collision", "wall_restitution"): dict(
+        meaning="`model = \"constant\"` with walls only: the constant ε of sphere-wall collisions "
+                "(default: `restitution`).", context=_WALLS_CONSTANT),
+    ("driving", "model"): dict(
+        meaning="`\"white_noise\"`: every particle gets independent Gaussian velocity kicks "
+                "(their momentum removed at each kick) at the times (k + 1/2) × `interval`.",
+        context=_DRIVEN),
+    ("driving", "heating_rate"): dict(
+        meaning="H: the driving alone raises the temperature as dT/dt = H; the gas settles where "
+                "ζ(T) T = H. 0 means no driving.", context=_DRIVEN, default=Text("— (required)")),
+    ("driving", "interval"): dict(
+        meaning="Time between kicks; the steady state is independent of it for ζ × interval ≤ 0.05.",
+        context=_DRIVEN,
+        default=Text("0.02 / ζ (the shortest of the steady, initial cooling and heating times), "
+                     "shortened to a whole fraction of `observables_interval`")),
     ("collision.material", "young_modulus"): dict(meaning="Young's modulus Y (Pa).", context=_MATERIAL),
     ("collision.material", "poisson_ratio"): dict(meaning="Poisson ratio ν.", context=_MATERIAL),
     ("collision.material", "dissipation_time"): dict(
@@ -165,6 +191,7 @@ SECTION_TEXT = {
     "collision.material": "Instead of `damping`: the viscoelastic contact from material constants "
                           "(SI; all keys required), converted once to the reduced pair prefactor "
                           "k = (3/2) A (2Y / (3(1 − ν²)))^(2/5) (σ u / m²)^(1/5).",
+    "driving": "Optional: white-noise driving (a heated granular gas in a steady state).",
     "run": "When to stop (at least one key).",
     "output": "The output file and its schedule.",
 }
@@ -177,7 +204,7 @@ def _dataclass_keys():
     table = [
         ("system", c.SystemConfig), ("particles", c.ParticlesConfig), ("initial", c.InitialConfig),
         ("collision", c.CollisionConfig), ("collision.material", c.MaterialConfig),
-        ("run", c.RunSection), ("output", c.OutputConfig),
+        ("driving", c.DrivingConfig), ("run", c.RunSection), ("output", c.OutputConfig),
     ]
     rename = {("initial", "from_file"): "from", ("particles", "diameter_min"): "diameter.min",
               ("particles", "diameter_max"): "diameter.max"}
@@ -238,6 +265,9 @@ def _derived_entry(section: str, key: str, default) -> ConfigKey:
     if spec is None:
         raise RuntimeError(f"config reference: no meaning for {dotted} in docs/hooks/generate.py MEANINGS")
     context = spec.get("context", {})
+    if "type" in spec:  # the probes cannot tell (e.g. a list)
+        return ConfigKey(section, key, spec["type"], spec.get("default", default), spec["allowed"],
+                         spec["meaning"])
     kind = _must_be(_probe(section, key, "__not_a_value__", context), dotted)
     if kind is None:
         typ, allowed = "string", _must_be(_probe(section, key, "", context), dotted) or "any string"

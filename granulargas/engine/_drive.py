@@ -4,7 +4,7 @@ A white-noise thermostat (Williams & MacKintosh 1996; van Noije, Ernst, Trizac
 & Pagonabarraga 1999) adds to every particle's velocity an independent
 Gaussian random force, dv_i = xi_i(t) dt with <xi_ia(t) xi_jb(t')> =
 (H / m_i) delta_ij delta_ab delta(t - t'). Integrated over steps of length
-dt_k, each particle receives at times t_k = k dt_k the kick
+dt_k, each particle receives at the times t_k = (k + 1/2) dt_k the kick
 
     Delta v_i = s_i g_i - (sum_j m_j s_j g_j) / M,   s_i^2 = H dt_k N / ((N - 1) m_i)      (1)
 
@@ -13,6 +13,10 @@ the kicks of a step carry no momentum, and, since removing the centre-of-mass
 part takes 1/N of the injected energy, the factor N/(N-1) makes the driving
 alone raise the granular temperature T = sum m c^2 / (d N) at the rate
 dT/dt = H exactly on average. Between kicks the gas moves and collides freely.
+The half step puts the multiples of dt_k half-way between kicks: there T equals
+its average over a kick interval to second order in zeta dt_k, whereas right
+after a kick it is higher by H dt_k / 2, so output at multiples of dt_k samples
+the steady state without bias.
 The kick interval must be short compared with the time over which the gas
 cools, zeta dt_k << 1 (zeta the cooling rate); the steady state is then
 independent of dt_k (see ``scripts/driven_steady_state.py`` for the measured

@@ -11,8 +11,8 @@ pair event whose partner has collided since is stale and is simply
 re-predicted. A pair collision needs to be scheduled by only one of the two:
 whichever changes its velocity first re-predicts against all its neighbours,
 the other included. The white-noise driving is a global event source: every
-particle is kicked at the times k dt_k; :func:`advance_driven` runs the loop up
-to each driving step and executes it, so that the loop of an undriven run
+particle is kicked at the times (k + 1/2) dt_k; :func:`advance_driven` runs the
+loop up to each driving step and executes it, so that the loop of an undriven run
 carries no trace of it.
 
 Event kinds, each with one predict and one execute function here:
@@ -188,8 +188,8 @@ def predict_wall(i, t, rec, space):
 
 @kernel(inline="always")
 def predict_kick(c, prm):
-    """Time of the next driving step, k dt_k (inf without driving)."""
-    return c.kick_step * prm.kick_interval if prm.kick_interval < math.inf else math.inf
+    """Time of the next driving step, (k + 1/2) dt_k (inf without driving)."""
+    return (c.kick_step + 0.5) * prm.kick_interval if prm.kick_interval < math.inf else math.inf
 
 
 @kernel
@@ -565,7 +565,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
 def advance_driven(engine, prm, until, max_events, max_collisions, probe):
     """:func:`advance` with the white-noise driving: the driving step is a global event.
 
-    Runs :func:`advance` up to the next driving step k dt_k (:func:`predict_kick`;
+    Runs :func:`advance` up to the next driving step (k + 1/2) dt_k (:func:`predict_kick`;
     events at the same time come first), executes it (:func:`execute_kick`, one
     event) and goes on, until ``until`` or a budget. A step due at ``until``
     itself is executed. Same arguments and status codes as :func:`advance`.

@@ -79,7 +79,7 @@ Params = namedtuple("Params", ["rule", "space", "shell", "half_shell", "rmax", "
 #: (cumulative); ``virial`` sum of r_ij . Delta p_ij and ``kin_int`` integral of
 #: sum m v^2 dt since the last pressure reset; ``sum_mv2`` = sum m v^2 now;
 #: ``injected`` energy put in by the driving (cumulative); event counts; ``kick_step``
-#: index k of the next driving step (at time k * kick_interval); ``err_i``, ``err_j``
+#: index k of the next driving step (at time (k + 1/2) kick_interval); ``err_i``, ``err_j``
 #: the slots involved in an error.
 COUNTERS = np.dtype([
     ("time", "f8"), ("dissipated", "f8"), ("virial", "f8"), ("kin_int", "f8"),

@@ -22,7 +22,8 @@ class WhiteNoise:
         H >= 0: the driving alone raises the granular temperature as dT/dt = H
         (reduced units T0 per time unit).
     interval : float
-        Time between kicks dt_k > 0; the steady state does not depend on it once
+        Time between kicks dt_k > 0 (kicks at (k + 1/2) dt_k, k = 0, 1, ...); the
+        steady state does not depend on it once
         zeta(T) dt_k << 1 (zeta the cooling rate; see
         :func:`granulargas.theory.driving_interval`).
     seed : int

@@ -131,10 +131,10 @@ class Simulation:
         Sphere-wall collisions so far (carried over on restart).
     driving : WhiteNoise, optional
         White-noise driving (:class:`granulargas.engine.driving.WhiteNoise`):
-        kicks at the times k * interval.
+        kicks at the times (k + 1/2) * interval.
     kick_step : int, optional
         Index k of the next driving step (carried over on restart; default: the
-        first k with k * interval > time).
+        first k with (k + 1/2) * interval > time).
     injected_energy : float
         Energy put in by the driving so far (carried over on restart).
     remove_drift : bool
@@ -230,14 +230,14 @@ class Simulation:
         if driving is None:
             self._kick_step = 0
         elif kick_step is None:
-            self._kick_step = int(math.floor(self._time / driving.interval)) + 1
-            while self._kick_step * driving.interval <= self._time:  # round-off in the floor
+            self._kick_step = max(0, int(math.floor(self._time / driving.interval - 0.5)))
+            while (self._kick_step + 0.5) * driving.interval <= self._time:  # round-off in the floor
                 self._kick_step += 1
         else:
             self._kick_step = int(kick_step)
-            if not self._kick_step * driving.interval > self._time:
-                raise ConfigError(f"kick_step = {kick_step}: the next driving step k must come "
-                                  f"after the current time (k * interval > {self._time:.17g})")
+            if not (self._kick_step + 0.5) * driving.interval > self._time:
+                raise ConfigError(f"kick_step = {kick_step}: the next driving step k must come after the "
+                                  f"current time ((k + 1/2) interval > {self._time:.17g})")
         self._virial = 0.0
         self._kin_int = 0.0
         self._wall_impulse = np.zeros((3, 2))
@@ -593,7 +593,7 @@ class Simulation:
 
     @property
     def kick_step(self) -> int:
-        """Index k of the next driving step (at time k * interval); 0 without driving."""
+        """Index k of the next driving step (at time (k + 1/2) * interval); 0 without driving."""
         return int(self._counters["kick_step"]) if self._built else self._kick_step
 
     @property

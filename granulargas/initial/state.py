@@ -25,6 +25,9 @@ class InitialState:
         Periodic images (a restart continues the unwrapped trajectories).
     time, collisions, events, dissipated_energy :
         Clock and counters to continue from (0 for a fresh state).
+    wall_collisions, injected_energy, kick_step :
+        Sphere-wall collisions, energy put in by the driving, index of the next driving
+        step (restarts; None: the first step after ``time``).
     last_collision : array (N,), optional
         Time of each particle's last collision (TC model restarts).
     source : str, optional
@@ -43,6 +46,9 @@ class InitialState:
     collisions: int = 0
     events: int = 0
     dissipated_energy: float = 0.0
+    wall_collisions: int = 0
+    injected_energy: float = 0.0
+    kick_step: int | None = None
     last_collision: np.ndarray | None = None
     source: str | None = None
 

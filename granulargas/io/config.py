@@ -1,8 +1,8 @@
 """TOML run configuration -> frozen dataclasses, with validation.
 
 A config file has the sections ``[system]``, ``[particles]``, ``[initial]``,
-``[collision]`` (with the optional sub-table ``[collision.material]``), ``[run]``
-and ``[output]``; :func:`load_config` reads it with :mod:`tomllib`, applies
+``[collision]`` (with the optional sub-table ``[collision.material]``),
+``[driving]`` (optional), ``[run]`` and ``[output]``; :func:`load_config` reads it with :mod:`tomllib`, applies
 optional dotted-key overrides, and returns a :class:`RunConfig`. Every value is
 checked once, here: unknown keys, wrong types and out-of-range values raise
 :class:`granulargas.errors.ConfigError` with one line naming the file, the key,
@@ -30,17 +30,27 @@ from granulargas.errors import ConfigError
 MAX_PACKING = {3: math.pi / (3.0 * math.sqrt(2.0)), 2: math.pi / (2.0 * math.sqrt(3.0))}
 MODELS = ("elastic", "constant", "viscoelastic")
 CONTACT_ENDS = ("overlap", "force")
+BOUNDARIES = ("periodic", "wall")
+DRIVING_MODELS = ("white_noise",)
 DEFAULT_SNAPSHOTS = 20
 
 
 @dataclass(frozen=True)
 class SystemConfig:
-    """``[system]``: dimension, particle count, packing fraction, RNG seed."""
+    """``[system]``: dimension, particle count, packing fraction, RNG seed, and the
+    boundary of each axis: "periodic" or "wall" (flat hard walls at 0 and L; the
+    packing fraction counts the whole box)."""
 
     dimension: int = 3
     particles: int = 1000
     packing_fraction: float = 0.1
     seed: int = 1
+    boundary: tuple = ("periodic", "periodic", "periodic")
+
+    @property
+    def walls(self) -> bool:
+        """Whether any axis has walls."""
+        return "wall" in self.boundary
 
 
 @dataclass(frozen=True)
@@ -93,7 +103,10 @@ class CollisionConfig:
     It is a positive time; without the key (None) the TC model is off.
     ``damping``: beta at normal impact speed g = 1 for two reference particles
     (diameter 1, mass 1); :func:`granulargas.run.prepare.reduced_prefactor`
-    turns it (or ``[collision.material]``) into the pair prefactor k."""
+    turns it (or ``[collision.material]``) into the pair prefactor k.
+    ``wall_restitution`` (constant model, with walls): the constant eps of
+    sphere-wall collisions (default: ``restitution``); elastic runs have elastic
+    walls, viscoelastic runs the sphere-plane contact of the same material."""
 
     model: str = "viscoelastic"
     restitution: float | None = None
@@ -101,6 +114,20 @@ class CollisionConfig:
     material: MaterialConfig | None = None
     contact_end: str = "overlap"
     tc_time: float | None = None
+    wall_restitution: float | None = None
+
+
+@dataclass(frozen=True)
+class DrivingConfig:
+    """``[driving]`` (optional): white-noise driving, every particle kicked by independent
+    Gaussian velocity kicks (momentum-conserving) that raise the temperature at
+    ``heating_rate`` (dT/dt of the driving alone, T0 per time unit); ``interval``
+    between kicks (default: 0.02 of the theoretical steady state's cooling time,
+    :func:`granulargas.theory.driving_interval`)."""
+
+    model: str = "white_noise"
+    heating_rate: float = 0.0
+    interval: float | None = None
 
 
 @dataclass(frozen=True)
@@ -145,6 +172,7 @@ class RunConfig:
     output: OutputConfig
     source: str = "<config>"
     text: str = ""
+    driving: DrivingConfig | None = None
 
     def to_toml(self) -> str:
         """The resolved configuration (defaults filled in) as TOML text."""
@@ -239,10 +267,12 @@ def _show(value: Any) -> str:
         return "true" if value else "false"
     if isinstance(value, dict):
         return "{ " + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, list):
+        return "[" + ", ".join(_show(v) for v in value) + "]"
     return repr(value) if not isinstance(value, float) else f"{value:g}"
 
 
-SECTIONS = ("system", "particles", "initial", "collision", "run", "output")
+SECTIONS = ("system", "particles", "initial", "collision", "driving", "run", "output")
 
 
 def load_config(path, overrides: dict[str, Any] | None = None) -> RunConfig:
@@ -336,8 +366,22 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
         what=f"in (0, {eta_max:.4f}) (densest packing of {'spheres' if dimension == 3 else 'disks'} in {dimension}D)",
     )
     seed = r.integer("seed", 1, minimum=0)
+    boundary = ("periodic",) * dimension
+    if "boundary" in r.table:
+        raw = r.pop("boundary")
+        if not isinstance(raw, list) or not all(isinstance(b, str) for b in raw):
+            r.fail_key("boundary", raw, f"a list of {dimension} strings, each one of "
+                       + ", ".join(f'"{b}"' for b in BOUNDARIES))
+        if len(raw) != dimension:
+            r.fail("boundary", raw, f"{len(raw)} entries for a {dimension}D system: give one per axis "
+                   f"(x, y{', z' if dimension == 3 else ''}), each one of "
+                   + ", ".join(f'"{b}"' for b in BOUNDARIES))
+        bad = [b for b in raw if b not in BOUNDARIES]
+        if bad:
+            r.fail("boundary", raw, f'"{bad[0]}" is not one of ' + ", ".join(f'"{b}"' for b in BOUNDARIES))
+        boundary = tuple(raw)
     r.done()
-    system = SystemConfig(dimension, particles, packing, seed)
+    system = SystemConfig(dimension, particles, packing, seed, boundary)
 
     # [particles]
     r = reader("particles")
@@ -387,6 +431,7 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
     # TC model off) while still tracking and writing last-collision times; leave the key out instead
     tc_time = r.number("tc_time", None, low=0.0, low_open=True,
                        what="a number > 0 (TC-model time; leave tc_time out for no TC model)")
+    wall_restitution = r.number("wall_restitution", None, low=0.0, high=1.0, what="in (0, 1]")
     material = None
     if "material" in r.table:
         m = _Reader(source, "collision.material", r.pop("material"), overridden)
@@ -428,7 +473,29 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
         for key, val in (("restitution", restitution), ("damping", damping), ("material", material), ("tc_time", tc_time)):
             if val is not None:
                 r.fail(key, val if key != "material" else "{...}", 'is not used with model = "elastic"')
-    collision = CollisionConfig(model, restitution, damping, material, contact_end, tc_time)
+    if wall_restitution is not None:
+        if model != "constant":
+            r.fail("wall_restitution", wall_restitution, 'is only used with model = "constant" (elastic '
+                   "runs have elastic walls, viscoelastic ones the sphere-plane contact)")
+        if not system.walls:
+            r.fail("wall_restitution", wall_restitution, 'is only used with walls (system.boundary with '
+                   'a "wall" entry)')
+    collision = CollisionConfig(model, restitution, damping, material, contact_end, tc_time,
+                                wall_restitution)
+
+    # [driving]
+    driving = None
+    if "driving" in data:
+        r = reader("driving")
+        dmodel = r.string("model", "white_noise", allowed=DRIVING_MODELS)
+        if "heating_rate" not in r.table:
+            raise ConfigError(f"{r.where('heating_rate')}: missing; [driving] needs heating_rate >= 0 "
+                              "(dT/dt of the driving alone)")
+        heating = r.number("heating_rate", None, low=0.0, low_open=False,
+                           what="a number >= 0 (dT/dt of the driving alone)")
+        interval = r.number("interval", None, low=0.0, what="a number > 0 (time between kicks)")
+        r.done()
+        driving = DrivingConfig(dmodel, heating, interval)
 
     # [run]
     r = reader("run")
@@ -462,7 +529,8 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
     r.done()
     output = OutputConfig(file, snapshots, snap_dt, first, obs_dt)
 
-    return RunConfig(system, particles_cfg, initial, collision, run, output, source=source, text=text)
+    return RunConfig(system, particles_cfg, initial, collision, run, output, source=source, text=text,
+                     driving=driving)
 
 
 # --------------------------------------------------------------------------- writing
@@ -491,17 +559,21 @@ def dump_toml(config: RunConfig) -> str:
                 lines.append(f"{k} = {v if isinstance(v, _Raw) else _toml_value(v)}")
 
     s, p, i, c, r, o = (config.system, config.particles, config.initial, config.collision, config.run, config.output)
-    section("system", [(f.name, getattr(s, f.name)) for f in fields(s)])
+    boundary = _Raw("[" + ", ".join(_toml_value(b) for b in s.boundary) + "]")
+    section("system", [(f.name, boundary if f.name == "boundary" else getattr(s, f.name))
+                       for f in fields(s)])
     diam = _Raw(f"{{ min = {p.diameter_min!r}, max = {p.diameter_max!r} }}") if p.polydisperse else p.diameter
     section("particles", [("diameter", diam), ("mass", p.mass), ("density", p.density)])
     section("initial", [("temperature", i.temperature), ("from", i.from_file)])
     section(
         "collision",
         [("model", c.model), ("restitution", c.restitution), ("damping", c.damping),
-         ("contact_end", c.contact_end), ("tc_time", c.tc_time)],
+         ("contact_end", c.contact_end), ("tc_time", c.tc_time), ("wall_restitution", c.wall_restitution)],
     )
     if c.material is not None:
         section("collision.material", [(f.name, getattr(c.material, f.name)) for f in fields(c.material)])
+    if config.driving is not None:
+        section("driving", [(f.name, getattr(config.driving, f.name)) for f in fields(config.driving)])
     section("run", [(f.name, getattr(r, f.name)) for f in fields(r)])
     section("output", [(f.name, getattr(o, f.name)) for f in fields(o)])
     return "\n".join(lines) + "\n"

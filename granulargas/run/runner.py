@@ -152,7 +152,7 @@ def check_output(config: RunConfig, overwrite: bool) -> Path:
 
 
 def _observables(sim, pressure: bool) -> dict:
-    return {
+    out = {
         "temperature": float(sim.temperature),
         "kinetic_energy": float(sim.kinetic_energy),
         "collisions": int(sim.collisions),
@@ -161,6 +161,13 @@ def _observables(sim, pressure: bool) -> dict:
         "momentum": np.asarray(sim.momentum, dtype=np.float64),
         "pressure": float(sim.pressure_window()) if pressure else math.nan,
     }
+    if "wall" in sim.boundary:
+        out["wall_collisions"] = int(sim.wall_collisions)
+        out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
+    if sim.driving is not None:
+        out["injected_energy"] = float(sim.injected_energy)
+        out["kick_step"] = int(sim.kick_step)
+    return out
 
 
 def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True, progress=None,
@@ -208,7 +215,9 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     sim = Simulation(
         st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
         time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
-        events=st.events, dissipated_energy=st.dissipated_energy,
+        events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
+        wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
+        injected_energy=st.injected_energy,
     )
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
@@ -231,7 +240,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
                              f"({exc.strerror or exc})") from None
     tc = setup.rule_name == "constant" and config.collision.tc_time is not None
     writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
-                        last_collision=tc, overwrite=overwrite)
+                        last_collision=tc, overwrite=overwrite, boundary=sim.boundary,
+                        driven=sim.driving is not None)
 
     show = _want_progress(quiet, progress)
     bar = None

@@ -15,10 +15,9 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.io.config import RunConfig
-from granulargas.run.prepare import mean_particle
+from granulargas.run.prepare import DEFAULT_OBSERVABLE_SAMPLES, mean_particle
 
-#: default number of evenly spaced observables samples (plus every snapshot time)
-DEFAULT_OBSERVABLE_SAMPLES = 200
+__all__ = ["DEFAULT_OBSERVABLE_SAMPLES", "Schedule", "collision_budget", "mean_free_time", "output_schedule"]
 
 
 @dataclass(frozen=True)

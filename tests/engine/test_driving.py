@@ -21,9 +21,9 @@ def test_one_kick_from_rest_heats_by_h_dt_equally_for_every_mass_and_keeps_momen
     masses = np.where(np.arange(n) % 2 == 0, 1.0, 3.0)
     sim = Simulation(st.positions, np.zeros((n, d)), st.radii, masses, st.box,
                      CollisionRule.elastic(), driving=WhiteNoise(h, dt, seed=9))
-    assert sim.kick_step == 1
-    sim.run(dt)  # the step at t = dt is executed
-    assert sim.kick_step == 2 and sim.events == 1
+    assert sim.kick_step == 0
+    sim.run(0.5 * dt)  # the step at t = dt / 2 (a step due at the end of a run is executed)
+    assert sim.kick_step == 1 and sim.events == 1 and sim.collisions == 0
     v = sim.velocities
     # <m c^2>/d = H dt for the light and the heavy particles alike (2/(dN) relative spread)
     for sel in (masses == 1.0, masses == 3.0):
@@ -56,7 +56,7 @@ def test_driven_energy_balance_and_momentum():
     e0 = sim.kinetic_energy
     p0 = sim.momentum
     sim.run(10.0)
-    assert sim.kick_step == 501
+    assert sim.kick_step == 500  # kicks at 0.01, 0.03, ..., 9.99
     assert sim.kinetic_energy == pytest.approx(e0 + sim.injected_energy - sim.dissipated_energy,
                                                rel=1e-10)
     assert sim.injected_energy > e0 and sim.dissipated_energy > e0
@@ -85,7 +85,7 @@ def test_restart_equality_with_driving_bit_for_bit(d, walls):
     a.run(6.0)
     b = Simulation(**saved, rule=rule, boundary=boundary, driving=drive)
     b.run(6.0)
-    assert a.kick_step == b.kick_step == 163 and a.collisions == b.collisions
+    assert a.kick_step == b.kick_step == 162 and a.collisions == b.collisions
     assert a.events == b.events and a.wall_collisions == b.wall_collisions
     for k in ("positions", "velocities", "images"):
         np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
@@ -124,15 +124,15 @@ def test_kick_step_must_lie_ahead():
     st = random_state(50, 0.1, 3, seed=1)
     with pytest.raises(ConfigError, match="kick_step"):
         Simulation(**st.as_kwargs(), rule=CollisionRule.elastic(), time=1.0,
-                   driving=WhiteNoise(0.1, 0.5), kick_step=2)
+                   driving=WhiteNoise(0.1, 0.5), kick_step=1)  # (1 + 1/2) 0.5 < 1
 
 
 def _steady_state(d, eps, packing, n, h, measure, seed=1):
     """(mean T / T_theory, its error) over ``measure`` cooling times after 5 of relaxation.
 
-    T is sampled half-way between kicks, where it equals its average over a kick
-    interval to second order in zeta dt_k (right after a kick it is higher by
-    H dt_k / 2)."""
+    T is sampled at multiples of dt_k, half-way between kicks, where it equals its
+    average over a kick interval to second order in zeta dt_k (right after a kick it
+    is higher by H dt_k / 2)."""
     n_dens = theory.number_density(packing, d)
     t_th = float(theory.driven_temperature(h, eps, n_dens, d))
     zeta = float(theory.enskog_cooling_rate(eps, n_dens, t_th, d,
@@ -145,7 +145,7 @@ def _steady_state(d, eps, packing, n, h, measure, seed=1):
     first = round(5.0 / zeta / dt_k)
     temps = []
     for k in range(int(4 * measure)):
-        sim.run((first + k * spacing + 0.5) * dt_k)
+        sim.run((first + k * spacing) * dt_k)
         temps.append(sim.temperature)
     blocks = np.array(temps[: len(temps) // 10 * 10]).reshape(10, -1).mean(axis=1)
     return blocks.mean() / t_th, blocks.std(ddof=1) / math.sqrt(10) / t_th

@@ -205,3 +205,49 @@ def test_bad_wall_input_raises_config_error(kwargs, match):
     base.update(kwargs)
     with pytest.raises(ConfigError, match=match):
         Simulation(**base, rule=CollisionRule.elastic())
+
+
+def _wall_pressure_against_eos(d, n, packing, t_end, seed=1):
+    """(wall pressure, EOS pressure at the bulk density and T, bulk density error) of an elastic
+    gas between walls on the last axis, averaged from t = 20 to t_end."""
+    from granulargas import theory
+
+    kw, boundary = walled_state(n, packing, d, (d - 1,), seed=seed)
+    sim = Simulation(**kw, rule=CollisionRule.elastic(), boundary=boundary)
+    sim.run(20.0)
+    sim.wall_pressure_window()
+    L = sim.box[-1]
+    counts = []
+    for t in np.arange(20.5, t_end + 1e-9, 0.5):
+        sim.run(t)
+        z = sim.positions[:, -1]
+        counts.append(np.sum((z > 0.25 * L) & (z < 0.75 * L)))
+    p_wall = sim.wall_pressure_window()
+    # degrees of freedom: momentum along the periodic axes is conserved
+    temperature = 2.0 * sim.kinetic_energy / (d * sim.n - (d - 1))
+    slab = np.prod(sim.box) / 2.0
+    blocks = np.array(counts[: len(counts) // 20 * 20], float).reshape(20, -1).mean(axis=1)
+    n_bulk = blocks.mean() / slab
+    eta = float(theory.packing_fraction(n_bulk, d))
+    p_eos = n_bulk * temperature * float(theory.compressibility_factor(eta, d))
+    return p_wall, p_eos, blocks.std(ddof=1) / np.sqrt(20) / blocks.mean()
+
+
+def test_wall_pressure_is_the_bulk_pressure():
+    """Mechanical equilibrium: the momentum an elastic gas delivers to the walls per area and
+    time equals the equation-of-state pressure n T Z(eta) of the bulk density (middle half of
+    the slab; the density next to the walls differs). 3 % here (short run, 3D, N = 1000);
+    1 % in the slow test."""
+    p_wall, p_eos, err = _wall_pressure_against_eos(3, 1000, 0.1, 300.0)
+    assert err < 0.005
+    assert p_wall == pytest.approx(p_eos, rel=0.03)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("d, packing", [(3, 0.1), (2, 0.3)])
+def test_wall_pressure_is_the_bulk_pressure_precise(d, packing):
+    """As above within 1 %: N = 2000, t = 1000 (3D eta = 0.1: the equation of state is within
+    0.1 %, and the bulk density is known to 0.1 %, which moves P_eos by 0.2 %)."""
+    p_wall, p_eos, err = _wall_pressure_against_eos(d, 2000, packing, 1000.0)
+    assert err < 0.002
+    assert p_wall == pytest.approx(p_eos, rel=0.01)
