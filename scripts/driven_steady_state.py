@@ -8,8 +8,9 @@ between two kicks, where T equals its average over the kick interval to second
 order in zeta dt_k; errors from 10 blocks).
 The theory: zeta(T) T = H with the Enskog cooling rate and van Noije & Ernst's
 driven a2 (``theory.driven_temperature``, ``theory.driven_sonine_a2``); for a
-viscoelastic gas the effective-restitution model of Dubey et al. (2013)
-(``theory.viscoelastic_driven_state``). The a2 estimator over N particles is
+viscoelastic gas the first Sonine moment equations with the exact eps(g)
+(``theory.driven_state``), and a2 of the effective-restitution model of Dubey et
+al. (2013) (``theory.viscoelastic_driven_state``) for comparison. The a2 estimator over N particles is
 biased by -2/(dN) (printed corrected).
 
 Usage::
@@ -39,13 +40,18 @@ def measure(args, fraction, seed):
     if args.damping is None:
         rule = CollisionRule.constant(args.eps)
         t_th = float(theory.driven_temperature(h, args.eps, n_dens, d))
-        a2_th = float(theory.driven_sonine_a2(args.eps, d))
+        a2_th = a2_eff = float(theory.driven_sonine_a2(args.eps, d))
         eps_eff = args.eps
     else:
         from granulargas.contact import prefactor_from_damping, restitution_table
 
+        from granulargas.theory.gas import Gas
+
         k = prefactor_from_damping(args.damping)
-        t_th, a2_th, eps_eff = theory.viscoelastic_driven_state(h, k, n_dens, d)
+        _, a2_eff, eps_eff = theory.viscoelastic_driven_state(h, k, n_dens, d)
+        gas = Gas(dimension=d, packing_fraction=args.packing, density=n_dens, sigma=1.0, mass=1.0,
+                  temperature=1.0, model="viscoelastic", prefactor=k)
+        t_th, a2_th = theory.driven_state(gas, h)
         rule = CollisionRule.viscoelastic(k, restitution_table(min(40.0, 3.0 * k * (40 * t_th) ** 0.1 + 0.1)))
     zeta = float(theory.enskog_cooling_rate(eps_eff, n_dens, t_th, d, a2=a2_th))
     dt_k = theory.driving_interval(zeta, fraction)
@@ -66,7 +72,7 @@ def measure(args, fraction, seed):
     bt, ba = blocks(ts), blocks(a2s)
     return dict(fraction=fraction, dt_k=dt_k, omega_dt=float(theory.collision_frequency(n_dens, t_th, d)) * dt_k,
                 T=bt.mean(), T_err=bt.std(ddof=1) / math.sqrt(10), a2=ba.mean(),
-                a2_err=ba.std(ddof=1) / math.sqrt(10), T_th=t_th, a2_th=a2_th,
+                a2_err=ba.std(ddof=1) / math.sqrt(10), T_th=t_th, a2_th=a2_th, a2_eff=a2_eff,
                 collisions=sim.collisions, kicks=sim.kick_step)
 
 
@@ -97,7 +103,9 @@ def main(argv=None):
         r = measure(args, f, args.seed)
         print(f"{f:9.4g} {r['omega_dt']:10.4g} {r['T'] / r['T_th']:8.4f} +- {r['T_err'] / r['T_th']:.4f} "
               f"{r['a2']:9.4f} +- {r['a2_err']:.4f} {r['a2_th']:9.4f} {r['collisions']:10d} "
-              f"{r['kicks']:7d} {time.perf_counter() - w:6.0f}", flush=True)
+              f"{r['kicks']:7d} {time.perf_counter() - w:6.0f}"
+              + (f"   (a2 of the eps_eff model {r['a2_eff']:+.4f})" if args.damping is not None else ""),
+              flush=True)
 
 
 if __name__ == "__main__":

@@ -7,12 +7,13 @@ run shows is
 
 * the **steady temperature**: the mean of T over the observables samples after
   the relaxation (the first :data:`RELAXATION_TIMES` cooling times 1/zeta(T_ss),
-  at least :data:`RELAXATION_FRACTION` of the run), against the theory: Enskog
-  cooling rate with van Noije & Ernst's driven a2 (constant eps), or the
-  effective-restitution model of Dubey et al. (2013) (viscoelastic);
+  at least :data:`RELAXATION_FRACTION` of the run), against the theory
+  (:func:`granulargas.theory.driven_state`: the Enskog-Boltzmann moment equations in
+  the first Sonine approximation with the exact eps(g) and the heating term; for
+  constant eps van Noije & Ernst's driven state);
 * the **second Sonine coefficient** a2 of the snapshots after the relaxation
   (corrected for the -2/(dN) bias of the estimator over N particles) against the
-  driven first-Sonine value;
+  driven first-Sonine value of the same theory;
 * T(t) with the theoretical relaxation from T0 (``dT/dt = H - zeta(T) T``
   integrated with the steady a2), for the figure.
 
@@ -54,17 +55,19 @@ class DrivenTheory:
 
 
 def driven_theory(info: RunInfo, heating_rate: float) -> DrivenTheory:
-    """:class:`DrivenTheory` of a run (identical particles of the mean diameter)."""
-    d, n, s, m = info.dimension, info.number_density, info.diameter, info.mass
+    """:class:`DrivenTheory` of a run (identical particles of the mean diameter): the moment
+    equations with the exact eps(g) and the heating term (:func:`granulargas.theory.driven_state`);
+    for constant eps this is van Noije & Ernst's driven state."""
+    d = info.dimension
     if info.model == "viscoelastic" and info.prefactor:
-        T, a2, eps = theory.viscoelastic_driven_state(heating_rate, info.prefactor, n, d, s, m,
-                                                      end=info.contact_end)
-        name = ("Enskog, zeta(T) T = H with the effective restitution of the exact eps(g) "
-                "(Dubey et al. 2013), driven first-Sonine a2 (van Noije & Ernst 1998)")
+        gas = info.gas(1.0)
+        T, a2 = theory.driven_state(gas, heating_rate)
+        eps = theory.effective_restitution(info.prefactor, T, d, info.diameter, info.mass, info.contact_end)
+        name = ("Enskog-Boltzmann, first Sonine with the exact eps(g): zeta(T, a2) T = H and the driven "
+                "a2 equation")
     elif info.model == "constant" and info.restitution is not None and info.restitution < 1.0:
         eps = info.restitution
-        a2 = float(theory.driven_sonine_a2(eps, d))
-        T = float(theory.driven_temperature(heating_rate, eps, n, d, s, m, a2=a2))
+        T, a2 = theory.driven_state(info.gas(1.0), heating_rate)
         name = "Enskog, zeta(T) T = H, driven first-Sonine a2 (van Noije & Ernst 1998)"
     else:
         return DrivenTheory("elastic: no steady state, T = T0 + H t", math.inf, 0.0, 0.0, 1.0)

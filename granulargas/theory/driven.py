@@ -13,7 +13,12 @@ where heating balances cooling, ``zeta(T) T = H``.
   dissipates as one of constant ``eps_eff(T)``, with ``1 - eps_eff^2`` the
   collision-kernel average of ``1 - eps^2`` over the impact speeds
   (:func:`granulargas.theory.gas.effective_inelasticity`, exact eps(beta)); the
-  steady state solves ``zeta(eps_eff(T), T) T = H``.
+  steady state solves ``zeta(eps_eff(T), T) T = H``
+  (:func:`viscoelastic_driven_state`).
+* Any restitution law, first Sonine with the exact eps(g): the moment equations of
+  :mod:`granulargas.theory.moments` with the heating term (:func:`driven_state`);
+  for constant eps the same as the first item, for viscoelastic particles it also
+  gives a2 without the effective-restitution approximation.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ from granulargas.theory.enskog import (_check_dim, contact_value, enskog_cooling
 from granulargas.theory.gas import Gas, effective_inelasticity
 
 __all__ = [
+    "driven_state",
     "driven_sonine_a2",
     "driven_temperature",
     "driving_interval",
@@ -124,3 +130,55 @@ def viscoelastic_driven_state(heating_rate, prefactor, n, dim=3, sigma=1.0, m=1.
             break
         t = t_new
     return t_new, float(driven_sonine_a2(e, dim)), e
+
+
+def driven_state(gas, heating_rate):
+    """Steady temperature and a2 of a white-noise driven gas with any restitution law.
+
+    The moment equations of :mod:`granulargas.theory.moments` (first Sonine
+    approximation with the exact eps(g), :func:`granulargas.theory.gas.cooling_rates`)
+    with the white-noise heating added: ``dT/dt = -zeta(T, a2) T + H`` and
+
+        da2/dt = (da2/dt)_cooling - 2 a2 H / T
+
+    (the heating ``(H/m) nabla_v^2 f / 2`` adds ``2 (d + 2) H <v^2> / m`` to
+    ``d<v^4>/dt``, and the change of v_T^4 takes ``2 (1 + a2) H / T`` from the
+    scaled moment). Both vanish in the steady state, where ``H / T = zeta(T, a2)``;
+    to first order in a2 (the a2^2 terms dropped, as in the cooling equations) the
+    second reads ``(da2/dt)_cooling - 2 a2 zeta(T, 0) = 0``, linear in a2 at a given
+    T, and the first is then solved for T. For a constant eps this is
+    :func:`driven_temperature` with :func:`driven_sonine_a2` exactly; for a
+    viscoelastic gas it refines the effective-restitution model
+    (:func:`viscoelastic_driven_state`, Dubey et al. 2013), whose a2 is the
+    constant-eps value at eps_eff. Returns (T, a2).
+
+    Parameters
+    ----------
+    gas : granulargas.theory.gas.Gas
+        The gas (its ``temperature`` is not used).
+    heating_rate : float
+        H > 0.
+    """
+    from scipy.optimize import brentq
+
+    from granulargas.theory.gas import cooling_rates
+
+    h = float(heating_rate)
+
+    def a2_at(T):
+        z0, d0, _ = cooling_rates(gas, T, 0.0)
+        _, d1, _ = cooling_rates(gas, T, 1.0)
+        return float(-d0 / ((d1 - d0) - 2.0 * z0))
+
+    def balance(log_t):
+        T = math.exp(log_t)
+        zeta, _, _ = cooling_rates(gas, T, a2_at(T))
+        return math.log(float(zeta) * T / h)
+
+    lo = hi = math.log(max(gas.temperature, 1e-300))
+    while balance(lo) > 0.0:
+        lo -= 2.0
+    while balance(hi) < 0.0:
+        hi += 2.0
+    T = math.exp(brentq(balance, lo, hi, xtol=1e-13, rtol=1e-13))
+    return T, a2_at(T)
