@@ -37,8 +37,12 @@ def _peak_rss_bytes():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
-def run_case(n, packing, dim, rule_name, repeats, seed=1):
-    """One benchmark case in this process; returns a dict."""
+def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
+    """One benchmark case in this process; returns a dict.
+
+    ``scene``: "periodic" (the standard), "walls" (flat walls on the last axis, the
+    same particles), or "driven:H" (white-noise driving at heating rate H, kicks every
+    0.02 / zeta of the steady state: :func:`granulargas.theory.driving_interval`)."""
     import numpy as np
 
     from granulargas.engine import CollisionRule, Simulation
@@ -49,7 +53,8 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
     Simulation(**warm.as_kwargs(), rule=CollisionRule.elastic()).run(0.1)
     rss0 = _peak_rss_bytes()
     t0 = time.perf_counter()
-    st = random_state(n, packing, dim, seed=seed)
+    walls = {"boundary": ("periodic",) * (dim - 1) + ("wall",)} if scene == "walls" else {}
+    st = random_state(n, packing, dim, seed=seed, **walls)
     t_init = time.perf_counter() - t0
     if rule_name == "elastic":
         rule = CollisionRule.elastic()
@@ -66,7 +71,18 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
         rule = CollisionRule.viscoelastic(prefactor=k, table=restitution_table(beta_max))
     else:
         rule = CollisionRule.constant(float(rule_name))
-    sim = Simulation(**st.as_kwargs(), rule=rule)
+    driving = None
+    if scene.startswith("driven:"):
+        from granulargas import theory
+        from granulargas.engine import WhiteNoise
+
+        h = float(scene.partition(":")[2])
+        eps = rule.restitution if rule.kind == "constant" else 0.9
+        nd = theory.number_density(packing, dim)
+        t_ss = float(theory.driven_temperature(h, eps, nd, dim))
+        zeta = float(theory.enskog_cooling_rate(eps, nd, t_ss, dim, a2=theory.driven_sonine_a2(eps, dim)))
+        driving = WhiteNoise(h, theory.driving_interval(zeta), seed=seed)
+    sim = Simulation(**st.as_kwargs(), rule=rule, **({"driving": driving} if driving else {}))
     t0 = time.perf_counter()
     # build + warm-up to a steady state: 5 collisions per particle, so that the timed runs
     # see aged neighbour lists and a memory order that has drifted from the initial sort
@@ -91,7 +107,8 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
         events_per_collision=sim.events / max(1, sim.collisions),
         expiries_per_collision=expiries / max(1, sim.collisions),
         stale_per_collision=stale / max(1, sim.collisions),
-        init_seconds=t_init, build_seconds=t_build, list_width=sim._nb_width,
+        init_seconds=t_init, build_seconds=t_build, list_width=sim._nb_width, scene=scene,
+        wall_collisions_per_collision=getattr(sim, "wall_collisions", 0) / max(1, sim.collisions),
     )
 
 
@@ -155,6 +172,7 @@ def main(argv=None):
     p.add_argument("--no-jit", action="store_true", help="skip the JIT timing")
     p.add_argument("--json", default=None, help="also write the results to this JSON file")
     p.add_argument("--case", nargs=4, default=None, help=argparse.SUPPRESS)
+    p.add_argument("--scene", default="periodic", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     for rule in args.rules or []:
         if not _rule_valid(rule):
@@ -163,7 +181,8 @@ def main(argv=None):
 
     if args.case:
         n, eta, dim, rule = args.case
-        print(json.dumps(run_case(int(float(n)), float(eta), int(dim), rule, args.repeats or 5)))
+        print(json.dumps(run_case(int(float(n)), float(eta), int(dim), rule, args.repeats or 5,
+                                  scene=args.scene)))
         return 0
 
     if args.quick:

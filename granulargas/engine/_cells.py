@@ -99,36 +99,6 @@ def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
 
 
 @kernel(inline="always")
-def _outside(c, n, period):
-    """Whether cell coordinate c lies beyond the walls of a wall axis."""
-    return (c < 0 or c >= n) and period == math.inf
-
-
-@kernel(inline="always")
-def neighbour_cell(cx, cy, cz, k, space):
-    """Flat index of the k-th cell around cell (cx, cy, cz), or -1 beyond a wall.
-
-    k runs over ``stencil_size(ncell)`` cells with x fastest, then y, then z
-    (offsets -1, 0, 1; z offset 0 in 2D); periodic axes wrap. No integer division
-    by the grid size (a run-time divisor costs ~30 cycles, three per cell): one
-    conditional wrap.
-    """
-    ncell = space.ncell
-    period = space.period
-    zr = 1 if ncell[2] >= 3 else 0
-    ux = cx + k % 3 - 1
-    uy = cy + (k // 3) % 3 - 1
-    uz = cz + k // 9 - zr
-    if (_outside(ux, ncell[0], period[0]) or _outside(uy, ncell[1], period[1])
-            or _outside(uz, ncell[2], period[2])):
-        return -1
-    kx = _wrap(ux, ncell[0])
-    ky = _wrap(uy, ncell[1])
-    kz = _wrap(uz, ncell[2])
-    return kx + ncell[0] * (ky + ncell[1] * kz)
-
-
-@kernel(inline="always")
 def slot_insert(i, c, cell_ids, cell_n, cell_of):
     """Append particle i to cell c (the caller has checked the capacity)."""
     q = cell_n[c]
@@ -174,17 +144,6 @@ def _pick(o, lo2, hi2):
     return 0.0
 
 
-@kernel(inline="always")
-def _walled(lo2, hi2, c, n, period):
-    """The gaps to the neighbour cells of an axis, inf on the sides beyond a wall."""
-    if period == math.inf:
-        if c == 0:
-            lo2 = math.inf
-        if c == n - 1:
-            hi2 = math.inf
-    return lo2, hi2
-
-
 @kernel
 def _reach(x, y, z, cut, space, stencil):
     """Cells around (x, y, z) that a sphere of radius ``cut`` can reach, into ``stencil``.
@@ -209,9 +168,15 @@ def _reach(x, y, z, cut, space, stencil):
     xl, xh = _gaps2(x, cx, box[0], ncell[0])
     yl, yh = _gaps2(y, cy, box[1], ncell[1])
     zl, zh = _gaps2(z, cz, box[2], ncell[2])
-    xl, xh = _walled(xl, xh, cx, ncell[0], period[0])
-    yl, yh = _walled(yl, yh, cy, ncell[1], period[1])
-    zl, zh = _walled(zl, zh, cz, ncell[2], period[2])
+    if period[0] == math.inf:  # a wall axis: no cells beyond the walls
+        xl = math.inf if cx == 0 else xl
+        xh = math.inf if cx == ncell[0] - 1 else xh
+    if period[1] == math.inf:
+        yl = math.inf if cy == 0 else yl
+        yh = math.inf if cy == ncell[1] - 1 else yh
+    if period[2] == math.inf:
+        zl = math.inf if cz == 0 else zl
+        zh = math.inf if cz == ncell[2] - 1 else zh
     if zr == 0:
         zl = 0.0
         zh = 0.0
@@ -435,6 +400,7 @@ def build_all_lists(r, rec, lists, cells, space, shell):
     box = space.box
     ncell = space.ncell
     period = space.period
+    zr = 1 if ncell[2] >= 3 else 0
     n = r.shape[0]
     m = nbl.shape[1]
     cell_n[:] = 0
@@ -457,9 +423,15 @@ def build_all_lists(r, rec, lists, cells, space, shell):
         cy = cell_coord(yi, box[1], ncell[1])
         cz = cell_coord(zi, box[2], ncell[2])
         for k in range(stencil_size(ncell)):
-            c = neighbour_cell(cx, cy, cz, k, space)
-            if c < 0:
+            # the k-th neighbour cell (stencil_cell), or none beyond a wall
+            ux = cx + k % 3 - 1
+            uy = cy + (k // 3) % 3 - 1
+            uz = cz + k // 9 - zr
+            if ((ux < 0 or ux >= ncell[0]) and period[0] == math.inf
+                    or (uy < 0 or uy >= ncell[1]) and period[1] == math.inf
+                    or (uz < 0 or uz >= ncell[2]) and period[2] == math.inf):
                 continue
+            c = _wrap(ux, ncell[0]) + ncell[0] * (_wrap(uy, ncell[1]) + ncell[1] * _wrap(uz, ncell[2]))
             for q in range(cell_n[c]):
                 j = cell_ids[c, q]
                 if j > i:

@@ -490,12 +490,13 @@ class Simulation:
         if not self.remove_drift or not axes:
             return False
         v, m = self._vm()
-        mtot = float(np.sum(m))
-        with np.errstate(over="ignore", under="ignore"):
-            vcm = np.sum(m[:, None] * v, axis=0) / mtot
-            c2 = float(np.sum(m[:, None] * (v - vcm) ** 2)) / mtot
+        mtot = float(np.sum(self._masses))
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            vcm = (m @ v) / mtot
+            mv2 = float(np.einsum("i,ij,ij->", m, v, v))  # not the running sum: it loses digits
+            passed = 0.5 * mv2 + self.dissipated_energy + self.injected_energy
             drift2 = float(np.sum(vcm[axes] ** 2))
-            passed = self.kinetic_energy + self.dissipated_energy + self.injected_energy
+            c2 = mv2 / mtot - float(vcm @ vcm)
         if not (self.DRIFT_LIMIT * c2 < drift2 and 0.5 * mtot * drift2 < self.ROUND_OFF * passed):
             return False
         self.synchronise()
