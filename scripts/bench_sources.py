@@ -1,7 +1,7 @@
 """What walls and driving cost: the same gas periodic, between walls, and driven, alternated.
 
 Each round runs, for each size, the three scenes of ``scripts/bench_engine.py --case``
-in fresh processes of this tree (pinned to one core when ``taskset`` exists): the
+in fresh processes of this source tree (pinned to one core when ``taskset`` exists): the
 periodic gas, the same particles with flat walls on the last axis (``--scene
 walls``), and the periodic gas with white-noise driving (``--scene driven:H``,
 kicks every 0.02 / zeta). It prints nanoseconds per pair collision (median over the
@@ -32,7 +32,8 @@ def case(n, packing, dim, rule, scene):
            rule, "--scene", scene]
     if shutil.which("taskset"):
         cmd = ["taskset", "-c", str(os.cpu_count() - 1)] + cmd
-    out = subprocess.run(cmd, capture_output=True, text=True)
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(HERE))  # this source tree
+    out = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if out.returncode != 0:
         sys.exit(f"bench_sources.py: {scene} N = {n}: {out.stderr.strip().splitlines()[-1:]}")
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -68,7 +69,8 @@ def main(argv=None):
             ratio = [b["rate_wall"] / x["rate_wall"] for b, x in zip(base, res[s, n])]
             ev = statistics.median(x["events_per_collision"] for x in res[s, n])
             wc = statistics.median(x["wall_collisions_per_collision"] for x in res[s, n])
-            print(f"N = {int(n):>8d} {s:>12}: {ns:8.0f} ns/collision, x{statistics.median(ratio):.3f} "
+            cpu = statistics.median(1e9 / x["rate_cpu"] for x in res[s, n])
+            print(f"N = {int(n):>8d} {s:>12}: {ns:8.0f} ns/collision ({cpu:.0f} CPU), x{statistics.median(ratio):.3f} "
                   f"(range {min(ratio):.3f}..{max(ratio):.3f}) of periodic; {ev:.3f} events/collision, "
                   f"{wc:.4f} wall collisions per collision")
 
