@@ -77,7 +77,7 @@ _MATERIAL = {"collision": {"model": "viscoelastic", "material": {
 
 _WALLS_CONSTANT = {"system": {"boundary": ["periodic", "periodic", "wall"]},
                    "collision": {"model": "constant", "restitution": 0.9}}
-_DRIVEN = {"driving": {"heating_rate": 0.1}}
+_DRIVEN = {"collision": {"model": "constant", "restitution": 0.9}, "driving": {"heating_rate": 0.1}}
 
 MEANINGS: dict[tuple[str, str], dict] = {
     ("system", "dimension"): dict(meaning="2 (disks) or 3 (spheres)."),
@@ -94,7 +94,7 @@ MEANINGS: dict[tuple[str, str], dict] = {
         meaning="One entry per axis (x, y, z): `\"periodic\"`, or `\"wall\"` for flat hard walls at 0 "
                 "and L (no sphere may start overlapping them; sphere-wall collisions follow the "
                 "collision model with R_eff = R, m_eff = m). A wall axis must be at least 4.15 largest "
-                "diameters long; the packing fraction counts the whole box. See docs/walls-and-driving.md.",
+                "diameters long; the packing fraction counts the whole box ([Walls and driving](walls-and-driving.md)).",
         type="list of strings", allowed='one entry per dimension, each "periodic" or "wall"',
         default=Text("all \"periodic\"")),
     ("particles", "diameter"): dict(
