@@ -26,6 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, special
 
+from granulargas import observables
+
 __all__ = [
     "temperature",
     "peculiar_velocities",
@@ -74,7 +76,8 @@ def sonine_polynomial(p, x, dim):
 
 
 def sonine_coefficients(velocities, masses=None):
-    """Second and third Sonine coefficients of the velocity distribution.
+    """Second and third Sonine coefficients of the velocity distribution
+    (the estimator of :mod:`granulargas.observables`, which the simulations' observables use).
 
     Returns
     -------
@@ -82,17 +85,9 @@ def sonine_coefficients(velocities, masses=None):
         For a Maxwellian both are 0 within sampling error
         (standard error of a2 ~ sqrt(8 / (d (d + 2) N))).
     """
-    c = peculiar_velocities(velocities, masses)
-    n, d = c.shape
-    m = _masses(masses, n)
-    e = m * (c * c).sum(axis=1)  # m c^2
-    T = e.mean() / d
-    x = e / (2.0 * T)
-    x2 = np.mean(x * x)
-    x3 = np.mean(x * x * x)
-    a2 = 4.0 * x2 / (d * (d + 2)) - 1.0
-    a3 = 1.0 + 3.0 * a2 - 8.0 * x3 / (d * (d + 2) * (d + 4))
-    return float(a2), float(a3)
+    v = np.asarray(velocities, dtype=float)
+    m = None if masses is None else np.broadcast_to(np.asarray(masses, dtype=float), (v.shape[0],))
+    return observables.sonine_coefficients(v, m)
 
 
 def maxwell_sonine_pdf(u, dim, a2=0.0, a3=0.0, kind="component"):

@@ -97,3 +97,9 @@ class CollisionRule:
             return rule_params(kind, eps, tc, self.prefactor, float(self.table.inv_h),
                                self.table.coeffs)
         return rule_params(kind, eps, tc, self.prefactor, wall_eps=self.wall_restitution)
+
+    def kernel_arguments(self):
+        """(kind code, eps, tc_time or -1, prefactor, inv_h, coeffs): the first six fields of
+        :meth:`compiled`, for kernels that take them as plain arguments (the DSMC)."""
+        r = self.compiled()
+        return r.kind, r.eps, r.tc_time, r.prefactor, r.inv_h, r.coeffs

@@ -1,0 +1,383 @@
+"""The Python driver of the homogeneous DSMC: :class:`DSMC`.
+
+``DSMC`` owns the velocities (in particle-id order; there are no positions),
+the random state and the speed classes of the majorant, and runs the compiled
+loop of :mod:`granulargas.dsmc._loop` in chunks, calling ``progress`` between
+them and turning status codes into :mod:`granulargas.errors` exceptions. Its
+API mirrors :class:`granulargas.engine.Simulation` where that makes sense.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from granulargas import theory
+from granulargas.dsmc import _loop
+from granulargas.dsmc._majorant import build_histogram, class_edge, new_histogram, top_classes
+from granulargas.dsmc._random import STATE_WORDS, seed_state
+from granulargas.engine.rules import CollisionRule
+from granulargas.errors import ConfigError, SimulationError, TableRangeError
+from granulargas.observables import energy_moments, kinetic_energy_momentum
+
+_INT_MAX = np.iinfo(np.int64).max
+
+
+def collision_solid_angle(dim: int) -> float:
+    """B_d = integral over unit vectors k of Theta(g^.k)(g^.k): pi (3D), 2 (2D)."""
+    return math.pi ** ((dim - 1) / 2.0) / math.gamma((dim + 1) / 2.0)
+
+
+def _aligned_rows(n, width):
+    """Zeroed (n, width) float64 array starting on a 64-byte boundary."""
+    buf = np.zeros(n * width + 8)
+    offset = (-buf.ctypes.data % 64) // 8
+    return buf[offset : offset + n * width].reshape(n, width)
+
+
+class DSMC:
+    """Direct Simulation Monte Carlo of a homogeneous granular gas (d = 2 or 3).
+
+    Solves the homogeneous Enskog-Boltzmann equation with the sequential
+    majorant process (:mod:`granulargas.dsmc._loop`): no time step, every
+    collision at its own time, the engine's collision rules.
+
+    Parameters
+    ----------
+    velocities : array (N, d)
+        Initial velocities; the DSMC works in the centre-of-mass frame, so their
+        mass-weighted mean is subtracted (kept in :attr:`frame_velocity`) unless
+        ``state`` is given (then they are taken as they are).
+    radii, masses : float or array (N,)
+        In units of the reference diameter and mass.
+    rule : CollisionRule
+        Elastic, constant or viscoelastic (the TC model needs pair histories and
+        is not available).
+    number_density, packing_fraction, volume : float
+        Exactly one: the density n = N / V, the packing fraction
+        sum_i v_i / V (v_i the particle volume, or area in 2D), or V itself.
+    chi : float, optional
+        Pair correlation at contact; default the Enskog value
+        :func:`granulargas.theory.contact_value` of the packing fraction
+        (``chi=1`` gives the Boltzmann equation).
+    seed : int
+        Seed of the random streams (ignored when ``state`` is given).
+    time, collisions, dissipated_energy : carried-over counters.
+    state : dict, optional
+        :attr:`state` of an earlier DSMC to continue bit for bit (random words,
+        candidate count, pending collision, frame velocity), together with its
+        :attr:`velocities`, ``time``, ``collisions`` and ``dissipated_energy``.
+
+    Notes
+    -----
+    ``run(until)`` executes every collision with time <= ``until`` and sets
+    ``time = until``; a run to 2t equals a run to t continued to 2t bit for bit.
+    A homogeneous gas is Galilean invariant: :attr:`velocities` are peculiar
+    velocities. Rounding makes their mean drift at ~1e-16 of their size; it is
+    subtracted again every 8N collisions (:func:`granulargas.dsmc._loop.recentre`),
+    so a gas can cool by hundreds of orders of magnitude.
+    Each particle collides at the Enskog frequency of the density (N - 1)/V of its
+    partners, so the collision frequency is (N - 1)/N times Enskog's omega(n).
+    """
+
+    def __init__(self, velocities, radii, masses, rule: CollisionRule, *,
+                 number_density: float | None = None, packing_fraction: float | None = None,
+                 volume: float | None = None, chi: float | None = None, seed: int = 0,
+                 time: float = 0.0, collisions: int = 0, dissipated_energy: float = 0.0,
+                 state: dict | None = None):
+        vel = np.asarray(velocities, dtype=np.float64)
+        if vel.ndim != 2 or vel.shape[1] not in (2, 3):
+            raise ConfigError(f"velocities: shape {vel.shape}, expected (N, 2) or (N, 3)")
+        n, d = vel.shape
+        if n < 2:
+            raise ConfigError(f"velocities: N = {n}, need at least 2 particles")
+        if n >= 2**31:
+            raise ConfigError(f"velocities: N = {n}, at most 2^31 - 1 particles")
+        if not np.all(np.isfinite(vel)):
+            raise ConfigError("velocities: non-finite values")
+        rad = np.asarray(radii, dtype=np.float64)
+        mas = np.asarray(masses, dtype=np.float64)
+        for name, arr in (("radii", rad), ("masses", mas)):
+            if arr.ndim > 1 or (arr.ndim == 1 and arr.shape[0] not in (1, n)):
+                raise ConfigError(f"{name}: shape {arr.shape}, expected a number or ({n},)")
+            if not (np.all(arr > 0) and np.all(np.isfinite(arr))):
+                raise ConfigError(f"{name}: every value must be finite and > 0")
+        if not isinstance(rule, CollisionRule):
+            raise TypeError("rule must be a granulargas.engine.CollisionRule")
+        if rule.tc_time is not None:
+            raise ConfigError(f"tc_time = {rule.tc_time}: the TC model is not available in DSMC "
+                              f"(there is no inelastic collapse to cure; use tc_time=None)")
+        self.dimension = d
+        self.rule = rule
+
+        # density: exactly one of n, packing fraction, V
+        given = [x is not None for x in (number_density, packing_fraction, volume)]
+        if sum(given) != 1:
+            raise ConfigError("DSMC needs exactly one of number_density, packing_fraction, volume")
+        # identical particles keep no per-particle arrays (32 bytes per particle in 3D)
+        self._mono = bool(np.all(rad == rad.flat[0]) and np.all(mas == mas.flat[0]))
+        if self._mono:
+            r0, m0 = float(rad.flat[0]), float(mas.flat[0])
+            solid = n * float(theory.particle_volume(2.0 * r0, d))
+            sigma_max = 2.0 * r0
+            self._rad_k = self._mas_k = np.zeros(1)
+        else:
+            rad = np.ascontiguousarray(np.broadcast_to(rad, (n,)))
+            mas = np.ascontiguousarray(np.broadcast_to(mas, (n,)))
+            r0, m0 = float(rad[0]), float(mas[0])
+            solid = float(np.sum(theory.particle_volume(2.0 * rad, d)))
+            sigma_max = 2.0 * float(rad.max())
+            self._rad_k, self._mas_k = rad, mas
+        self._r0, self._m0 = r0, m0
+        self._mass_arg = np.array([m0]) if self._mono else mas  # for the moment kernels
+        if number_density is not None:
+            value, name = float(number_density), "number_density"
+            vol = n / value if value > 0 else math.nan
+        elif packing_fraction is not None:
+            value, name = float(packing_fraction), "packing_fraction"
+            vol = solid / value if value > 0 else math.nan
+        else:
+            value, name = float(volume), "volume"
+            vol = value
+        if not (vol > 0 and math.isfinite(vol)):
+            raise ConfigError(f"{name} = {value}: must be finite and > 0")
+        self.volume = vol
+        self.number_density = n / vol
+        self.packing_fraction = solid / vol
+        if not self.packing_fraction < 1.0:
+            raise ConfigError(f"{name} = {value}: packing fraction {self.packing_fraction:.4g} "
+                              f"must be < 1")
+        if chi is None:
+            chi = float(theory.contact_value(self.packing_fraction, d))
+        chi = float(chi)
+        if not (chi > 0 and math.isfinite(chi)):
+            raise ConfigError(f"chi = {chi}: must be finite and > 0")
+        self.chi = chi
+
+
+        kind, eps, _, pref, inv_h, coeffs = rule.kernel_arguments()
+        self._kind, self._coeffs = kind, coeffs
+        fpar = np.zeros(_loop.N_FPAR)
+        fpar[_loop.F_EPS] = eps
+        fpar[_loop.F_PREFACTOR] = pref
+        fpar[_loop.F_INV_H] = inv_h
+        fpar[_loop.F_SIGMA_MAX_POW] = sigma_max ** (d - 1)
+        fpar[_loop.F_MASS] = m0
+        fpar[_loop.F_RADIUS] = r0
+        self._fpar = fpar
+
+        width = 4 if d == 3 else 2
+        rec = _aligned_rows(n, width)
+        rec[:, :d] = vel
+        self._rec = rec
+        self._ring = np.zeros((2, _loop.RING), dtype=np.int64)
+        # the rounding drift of the mean velocity is removed every 8 N collisions
+        self._recentre_every = 8 * n
+
+        scal = np.zeros(_loop.N_SCAL)
+        iscal = np.zeros(_loop.N_ISCAL, dtype=np.int64)
+        scal[_loop.S_TIME] = float(time)
+        scal[_loop.S_DISSIPATED] = float(dissipated_energy)
+        scal[_loop.S_RATE] = (0.5 * n * (n - 1) * chi * collision_solid_angle(d)
+                              * sigma_max ** (d - 1) / vol)
+        iscal[_loop.I_COLLISIONS] = int(collisions)
+        iscal[_loop.I_ERR_I] = iscal[_loop.I_ERR_J] = -1
+        iscal[_loop.I_PENDING_I] = iscal[_loop.I_PENDING_J] = -1
+        scal[_loop.S_NEXT] = math.nan
+        if state is None:
+            frame = vel.mean(axis=0) if self._mono else (mas @ vel) / mas.sum()
+            rec[:, :d] -= frame
+            rng = seed_state(seed)
+        else:
+            frame = np.asarray(state["frame_velocity"], dtype=np.float64)
+            rng = np.array(state["rng"], dtype=np.uint64)
+            if frame.shape != (d,) or rng.shape != (STATE_WORDS,):
+                raise ConfigError(f"state: frame_velocity needs shape ({d},) and rng ({STATE_WORDS},)")
+            iscal[_loop.I_CANDIDATES] = int(state["candidates"])
+            pi, pj = (int(x) for x in state["pending_pair"])
+            if pi >= 0:
+                if not (0 <= pi < n and 0 <= pj < n and pi != pj):
+                    raise ConfigError(f"state: pending_pair = {(pi, pj)} is not a pair of the {n} particles")
+                if not float(state["pending_time"]) >= float(time):
+                    raise ConfigError(f"state: pending_time = {state['pending_time']} lies before "
+                                      f"time = {time}")
+                iscal[_loop.I_PENDING_I], iscal[_loop.I_PENDING_J] = pi, pj
+                scal[_loop.S_NEXT] = float(state["pending_time"])
+        self.frame_velocity = frame
+        self._rng = rng
+        self._hist = new_histogram()
+        iscal[_loop.I_TOP] = build_histogram(rec, d, self._hist)
+        self._scal, self._iscal = scal, iscal
+        self._rate_last = float("nan")
+        self._acceptance_last = float("nan")
+
+    # ------------------------------------------------------------------ helpers
+    def _rate(self):
+        """Current majorant rate Lambda (candidates per unit time)."""
+        k1, k2 = top_classes(self._hist, self._iscal[_loop.I_TOP])
+        return self._scal[_loop.S_RATE] * (class_edge(k1) + class_edge(k2))
+
+    # ---------------------------------------------------------------------- run
+    def run(self, until: float, max_collisions: int | None = None, progress=None) -> "DSMC":
+        """Process all candidates with time <= ``until``; then ``time = until``.
+
+        Parameters
+        ----------
+        until : float
+            End time (absolute). ``inf`` is allowed together with ``max_collisions``.
+        max_collisions : int, optional
+            Stop right after this many further collisions; ``time`` is then the
+            time of the last one.
+        progress : callable, optional
+            ``progress(dsmc)`` is called between compiled chunks and at the end.
+
+        Raises
+        ------
+        TableRangeError, SimulationError
+        """
+        until = float(until)
+        if until < self.time:
+            raise ValueError(f"run(until={until}): the simulation is already at time {self.time}")
+        if math.isinf(until) and max_collisions is None:
+            raise ValueError("run(until=inf) needs max_collisions")
+        d = self.dimension
+        vmax = float(np.max(np.abs(self._rec[:, :d])))
+        if not (vmax < 1e150) or (0.0 < vmax < 1e-150):
+            raise SimulationError(f"velocities out of range at t = {self.time:.12g} (max |v_a| = "
+                                  f"{vmax:.3g}): squared speeds must stay within float64; rescale the units")
+        if vmax == 0.0:
+            raise SimulationError(f"all velocities are zero at t = {self.time:.12g}: nothing collides")
+        start_time, start_coll, start_cand = self.time, self.collisions, self.candidates
+        target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
+        chunk = max(1 << 21, 4 * self.n)
+        s = self._scal
+        while True:
+            status = _loop.advance(self._rec, self._rad_k, self._mas_k, self._mono, d, self._hist,
+                                   self._rng, self._kind, self._fpar, self._coeffs, until, target,
+                                   chunk, self._recentre_every, self._ring, s, self._iscal)
+            if status == _loop.BUDGET:
+                if progress is not None:
+                    progress(self)
+                continue
+            if status in (_loop.DONE, _loop.MAX_COLLISIONS):
+                break
+            self._raise(status)
+        dt = self.time - start_time
+        dc = self.collisions - start_coll
+        self._rate_last = 2.0 * dc / (self.n * dt) if dt > 0 else float("nan")
+        cand = self.candidates - start_cand
+        self._acceptance_last = dc / cand if cand > 0 else float("nan")
+        if progress is not None:
+            progress(self)
+        return self
+
+    def _raise(self, status):
+        i, j = int(self._iscal[_loop.I_ERR_I]), int(self._iscal[_loop.I_ERR_J])
+        where = (f"at t = {self.time:.12g} after {self.collisions} collisions "
+                 f"(particles {[k for k in (i, j) if k >= 0]})")
+        if status == _loop.TABLE_RANGE:
+            raise TableRangeError(f"impact beyond the restitution table {where}: build the table "
+                                  f"with a larger beta_max")
+        raise SimulationError(f"DSMC status {status} {where}")
+
+    # ------------------------------------------------------------ public state
+    @property
+    def n(self) -> int:
+        """Number of particles."""
+        return self._rec.shape[0]
+
+    @property
+    def time(self) -> float:
+        return float(self._scal[_loop.S_TIME])
+
+    @property
+    def collisions(self) -> int:
+        """Pair collisions so far."""
+        return int(self._iscal[_loop.I_COLLISIONS])
+
+    @property
+    def candidates(self) -> int:
+        """Candidate pairs drawn since the seed (accepted or not): the position in the pair stream."""
+        return int(self._iscal[_loop.I_CANDIDATES])
+
+    @property
+    def velocities(self) -> np.ndarray:
+        """Peculiar velocities (N, d), centre-of-mass frame (a copy)."""
+        return self._rec[:, : self.dimension].copy()
+
+    @property
+    def radii(self) -> np.ndarray:
+        return np.full(self.n, self._r0) if self._mono else self._rad_k.copy()
+
+    @property
+    def masses(self) -> np.ndarray:
+        return np.full(self.n, self._m0) if self._mono else self._mas_k.copy()
+
+    @property
+    def state(self) -> dict:
+        """What continues this run bit for bit besides velocities, time and counters.
+
+        ``rng`` (uint64 (5,)), ``candidates`` (int, position in the pair stream),
+        ``pending_pair`` ((i, j), or (-1, -1)) and ``pending_time`` (float; nan
+        when there is no pending collision): the next collision, already drawn;
+        ``frame_velocity`` (d,): the mean velocity subtracted at the start.
+        """
+        return {"rng": self._rng.copy(), "candidates": self.candidates,
+                "frame_velocity": self.frame_velocity.copy(),
+                "pending_pair": (int(self._iscal[_loop.I_PENDING_I]), int(self._iscal[_loop.I_PENDING_J])),
+                "pending_time": float(self._scal[_loop.S_NEXT])}
+
+    # ------------------------------------------------------------- observables
+    def _moments(self):
+        return energy_moments(self._rec, self.dimension, self._mass_arg)
+
+    @property
+    def kinetic_energy(self) -> float:
+        """Kinetic energy of the peculiar motion, sum m c^2 / 2."""
+        return float(kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)[0])
+
+    @property
+    def momentum(self) -> np.ndarray:
+        """Total momentum (d,) in the centre-of-mass frame: zero up to rounding."""
+        return np.array(kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)[1:1 + self.dimension])
+
+    @property
+    def temperature(self) -> float:
+        """Granular temperature m <c^2> / d with c the peculiar velocity (k_B = 1)."""
+        return float(self._moments()[0])
+
+    @property
+    def sonine_a2(self) -> float:
+        """Second Sonine coefficient of the peculiar velocities (:mod:`granulargas.observables`)."""
+        return float(self._moments()[1])
+
+    @property
+    def sonine_a3(self) -> float:
+        """Third Sonine coefficient of the peculiar velocities (:mod:`granulargas.observables`)."""
+        return float(self._moments()[2])
+
+    @property
+    def dissipated_energy(self) -> float:
+        """Kinetic energy dissipated in collisions (cumulative)."""
+        return float(self._scal[_loop.S_DISSIPATED])
+
+    @property
+    def collision_rate(self) -> float:
+        """Collisions per particle per unit time (2 x pair collisions / N / dt) during the last run."""
+        return self._rate_last
+
+    @property
+    def acceptance(self) -> float:
+        """Accepted fraction of the candidates of the last run."""
+        return self._acceptance_last
+
+    @property
+    def majorant_rate(self) -> float:
+        """Current candidate rate Lambda of the majorant (per unit time)."""
+        return float(self._rate())
+
+    def __repr__(self):
+        return (f"DSMC(N={self.n}, d={self.dimension}, packing={self.packing_fraction:.4g}, "
+                f"chi={self.chi:.4g}, rule={self.rule.kind}, time={self.time:.6g}, "
+                f"collisions={self.collisions})")

@@ -1,0 +1,141 @@
+"""Observables of a particle sample: kinetic energy, momentum, temperature, Sonine coefficients a2, a3.
+
+With c_i the peculiar velocity (velocity minus the mass-weighted mean) and
+e_i = m_i c_i^2, the temperature is T = <e>/d (k_B = 1) and
+
+    a2 = d/(d+2) <e^2>/<e>^2 - 1,
+    a3 = 1 + 3 a2 - d^2/((d+2)(d+4)) <e^3>/<e>^3,
+
+which for identical particles are the coefficients of the second and third
+Sonine polynomials in the expansion of the velocity distribution about the
+Maxwellian, from <c^(2p)>/<c^(2p)>_Maxwell = sum_k (-1)^k binom(p, k) a_k
+(van Noije & Ernst 1998; Brilliantov & Pöschel 2006, "Breakdown of the Sonine
+expansion for the velocity distribution of granular gases", EPL 74, 424).
+For unequal masses they are the cumulants of the distribution of m c^2.
+
+Finite samples: for N identical particles of fixed energy and momentum (any elastic
+simulation), the exact ensemble averages are a2 = -2/(D+2) and
+a3 = -16/((D+2)(D+4)) with D = d(N - 1), so the a2 estimator is biased by
+about -2/(d N).
+
+A compiled two-pass kernel does the sums without temporary arrays; it reads
+the first ``d`` columns of a (N, >= d) velocity array, so padded layouts need
+no copy.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from granulargas._numba import jit
+
+
+@jit
+def energy_moments(v, dim, masses):
+    """(T, a2, a3) of the velocities ``v[:, :dim]`` with masses (N,) or one shared mass (1,).
+
+    The sums run over velocities divided by the largest component, so moments of
+    gases cooled far below unit speeds neither underflow nor lose precision.
+    """
+    n = v.shape[0]
+    shared = masses.shape[0] == 1
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    msum = 0.0
+    vmax = 0.0
+    for i in range(n):
+        m = masses[0] if shared else masses[i]
+        msum += m
+        p0 += m * v[i, 0]
+        p1 += m * v[i, 1]
+        vmax = max(vmax, abs(v[i, 0]), abs(v[i, 1]))
+        if dim == 3:
+            p2 += m * v[i, 2]
+            vmax = max(vmax, abs(v[i, 2]))
+    if not vmax > 0.0:
+        return 0.0, np.nan, np.nan
+    scale = 1.0 / vmax
+    u0 = p0 / msum * scale
+    u1 = p1 / msum * scale
+    u2 = p2 / msum * scale
+    s1 = 0.0
+    s2 = 0.0
+    s3 = 0.0
+    for i in range(n):
+        m = masses[0] if shared else masses[i]
+        c0 = v[i, 0] * scale - u0
+        c1 = v[i, 1] * scale - u1
+        e = c0 * c0 + c1 * c1
+        if dim == 3:
+            c2 = v[i, 2] * scale - u2
+            e += c2 * c2
+        e *= m
+        s1 += e
+        s2 += e * e
+        s3 += e * e * e
+    if s1 <= 0.0:
+        return 0.0, np.nan, np.nan
+    r2 = s2 * n / (s1 * s1)
+    r3 = s3 * n * n / (s1 * s1 * s1)
+    a2 = dim / (dim + 2.0) * r2 - 1.0
+    a3 = 1.0 + 3.0 * a2 - dim * dim / ((dim + 2.0) * (dim + 4.0)) * r3
+    return s1 * vmax * vmax / (dim * n), a2, a3
+
+
+@jit
+def kinetic_energy_momentum(v, dim, masses):
+    """(sum m v^2 / 2, p_x, p_y, p_z) of the velocities ``v[:, :dim]`` (p_z = 0 in 2D),
+    masses (N,) or one shared mass (1,); no temporary arrays."""
+    shared = masses.shape[0] == 1
+    e = 0.0
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    for i in range(v.shape[0]):
+        m = masses[0] if shared else masses[i]
+        w2 = v[i, 0] * v[i, 0] + v[i, 1] * v[i, 1]
+        p0 += m * v[i, 0]
+        p1 += m * v[i, 1]
+        if dim == 3:
+            w2 += v[i, 2] * v[i, 2]
+            p2 += m * v[i, 2]
+        e += m * w2
+    return 0.5 * e, p0, p1, p2
+
+
+def _arrays(velocities, masses):
+    v = np.ascontiguousarray(velocities, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] not in (2, 3):
+        raise ValueError(f"velocities: shape {v.shape}, expected (N, 2) or (N, 3)")
+    m = np.ones(1) if masses is None else np.ascontiguousarray(np.atleast_1d(masses), dtype=np.float64)
+    if m.shape[0] not in (1, v.shape[0]):
+        raise ValueError(f"masses: shape {m.shape}, expected (1,) or ({v.shape[0]},)")
+    return v, m
+
+
+def sonine_coefficients(velocities, masses=None) -> tuple[float, float]:
+    """(a2, a3) of a velocity sample (N, d); ``masses`` (N,) or None (identical particles)."""
+    v, m = _arrays(velocities, masses)
+    _, a2, a3 = energy_moments(v, v.shape[1], m)
+    return float(a2), float(a3)
+
+
+def sonine_a2(velocities, masses=None) -> float:
+    """Second Sonine coefficient a2 = d/(d+2) <c^4>/<c^2>^2 - 1 of a velocity sample."""
+    return sonine_coefficients(velocities, masses)[0]
+
+
+def sonine_a3(velocities, masses=None) -> float:
+    """Third Sonine coefficient a3 = 1 + 3 a2 - d^2/((d+2)(d+4)) <c^6>/<c^2>^3."""
+    return sonine_coefficients(velocities, masses)[1]
+
+
+def finite_sample_sonine(n: int, dim: int) -> tuple[float, float]:
+    """Exact (a2, a3) of N particles uniformly distributed on their energy-momentum shell.
+
+    The uniform law on the sphere of dimension D = d (N - 1) (elastic equilibrium
+    at fixed energy and zero momentum) gives a2 = -2/(D+2), a3 = -16/((D+2)(D+4)).
+    """
+    big_d = dim * (n - 1)
+    return -2.0 / (big_d + 2.0), -16.0 / ((big_d + 2.0) * (big_d + 4.0))
