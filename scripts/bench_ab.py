@@ -5,7 +5,9 @@ compared by alternating them: each round runs, for each size, tree A and then
 tree B, each in a fresh process of this tree's ``scripts/bench_engine.py
 --case N packing dim rule`` with ``PYTHONPATH`` set to the tree and a numba
 cache directory of its own (pinned to one core when ``taskset`` exists). It
-prints every rate and, per size, the medians and B/A.
+prints every rate and, per size, the medians, B/A of the medians, and the spread
+of the per-round ratios (each round's B over the same round's A: the pairs ran
+back to back, so they share the machine's state).
 
 Usage::
 
@@ -28,7 +30,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def rate(tree, n, packing, dim, rule, cache):
-    """Median collisions/s of one ``bench_engine.py --case`` process run against ``tree``."""
+    """(wall-clock, CPU-time) median collisions/s of one ``bench_engine.py --case`` process
+    run against ``tree``."""
     cmd = [sys.executable, os.path.join(HERE, "bench_engine.py"), "--case", str(n), str(packing),
            str(dim), rule]
     if shutil.which("taskset"):
@@ -37,7 +40,8 @@ def rate(tree, n, packing, dim, rule, cache):
     out = subprocess.run(cmd, env=env, capture_output=True, text=True)
     if out.returncode != 0:
         sys.exit(f"bench_ab.py: {tree}: N = {n}: {out.stderr.strip().splitlines()[-1:]}")
-    return json.loads(out.stdout.strip().splitlines()[-1])["rate_wall"]
+    r = json.loads(out.stdout.strip().splitlines()[-1])
+    return r["rate_wall"], r["rate_cpu"]
 
 
 def main(argv=None):
@@ -62,13 +66,17 @@ def main(argv=None):
             for tree in (args.tree_a, args.tree_b):
                 x = rate(tree, int(n), args.packing, args.dim, args.rule, caches[tree])
                 rates[tree, n].append(x)
-                print(f"round {r + 1} N = {int(n):>8d} {tree}: {x / 1e6:.3f} M collisions/s",
-                      flush=True)
-    print(f"\nmedians (M collisions/s), {args.dim}D, packing {args.packing}, {args.rule}:")
-    for n in args.sizes:
-        a = statistics.median(rates[args.tree_a, n])
-        b = statistics.median(rates[args.tree_b, n])
-        print(f"N = {int(n):>8d}: A {a / 1e6:.3f}  B {b / 1e6:.3f}  B/A {b / a:.3f}")
+                print(f"round {r + 1} N = {int(n):>8d} {tree}: {x[0] / 1e6:.3f} M collisions/s "
+                      f"(CPU time: {x[1] / 1e6:.3f})", flush=True)
+    for k, clock in enumerate(("wall clock", "CPU time of the process")):
+        print(f"\nmedians (M collisions/s, {clock}), {args.dim}D, packing {args.packing}, {args.rule}:")
+        for n in args.sizes:
+            ra = [x[k] for x in rates[args.tree_a, n]]
+            rb = [x[k] for x in rates[args.tree_b, n]]
+            a, b = statistics.median(ra), statistics.median(rb)
+            pairs = [y / x for x, y in zip(ra, rb)]
+            print(f"N = {int(n):>8d}: A {a / 1e6:.3f}  B {b / 1e6:.3f}  B/A {b / a:.3f}  per-round B/A "
+                  f"median {statistics.median(pairs):.3f}, range {min(pairs):.3f}..{max(pairs):.3f}")
 
 
 if __name__ == "__main__":

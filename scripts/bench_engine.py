@@ -37,8 +37,12 @@ def _peak_rss_bytes():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
-def run_case(n, packing, dim, rule_name, repeats, seed=1):
-    """One benchmark case in this process; returns a dict."""
+def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
+    """One benchmark case in this process; returns a dict.
+
+    ``scene``: "periodic" (the standard), "walls" (flat walls on the last axis, the
+    same particles), or "driven:H" (white-noise driving at heating rate H, kicks every
+    0.02 / zeta of the steady state: :func:`granulargas.theory.driving_interval`)."""
     import numpy as np
 
     from granulargas.engine import CollisionRule, Simulation
@@ -49,7 +53,8 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
     Simulation(**warm.as_kwargs(), rule=CollisionRule.elastic()).run(0.1)
     rss0 = _peak_rss_bytes()
     t0 = time.perf_counter()
-    st = random_state(n, packing, dim, seed=seed)
+    walls = {"boundary": ("periodic",) * (dim - 1) + ("wall",)} if scene == "walls" else {}
+    st = random_state(n, packing, dim, seed=seed, **walls)
     t_init = time.perf_counter() - t0
     if rule_name == "elastic":
         rule = CollisionRule.elastic()
@@ -66,7 +71,18 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
         rule = CollisionRule.viscoelastic(prefactor=k, table=restitution_table(beta_max))
     else:
         rule = CollisionRule.constant(float(rule_name))
-    sim = Simulation(**st.as_kwargs(), rule=rule)
+    driving = None
+    if scene.startswith("driven:"):
+        from granulargas import theory
+        from granulargas.engine import WhiteNoise
+
+        h = float(scene.partition(":")[2])
+        eps = rule.restitution if rule.kind == "constant" else 0.9
+        nd = theory.number_density(packing, dim)
+        t_ss = float(theory.driven_temperature(h, eps, nd, dim))
+        zeta = float(theory.enskog_cooling_rate(eps, nd, t_ss, dim, a2=theory.driven_sonine_a2(eps, dim)))
+        driving = WhiteNoise(h, theory.driving_interval(zeta), seed=seed)
+    sim = Simulation(**st.as_kwargs(), rule=rule, **({"driving": driving} if driving else {}))
     t0 = time.perf_counter()
     # build + warm-up to a steady state: 5 collisions per particle, so that the timed runs
     # see aged neighbour lists and a memory order that has drifted from the initial sort
@@ -81,8 +97,7 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
         w1, p1 = time.perf_counter(), time.process_time()
         wall.append((sim.collisions - c0) / (w1 - w0))
         cpu.append((sim.collisions - c0) / (p1 - p0))
-    state_bytes = sum(a.nbytes for a in sim._s.values() if hasattr(a, "nbytes"))
-    iscal = sim._s["iscal"]
+    state_bytes, expiries, stale = _internals(sim)
     return dict(
         n=n, packing=packing, dim=dim, rule=rule_name,
         rate_wall=statistics.median(wall), rate_cpu=statistics.median(cpu),
@@ -90,10 +105,29 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1):
         bytes_per_particle=state_bytes / n,
         peak_rss_per_particle=(_peak_rss_bytes() - rss0) / n,
         events_per_collision=sim.events / max(1, sim.collisions),
-        expiries_per_collision=float(iscal[4]) / max(1, sim.collisions),
-        stale_per_collision=float(iscal[5]) / max(1, sim.collisions),
-        init_seconds=t_init, build_seconds=t_build, list_width=sim._nb_width,
+        expiries_per_collision=expiries / max(1, sim.collisions),
+        stale_per_collision=stale / max(1, sim.collisions),
+        init_seconds=t_init, build_seconds=t_build, list_width=sim._nb_width, scene=scene,
+        wall_collisions_per_collision=getattr(sim, "wall_collisions", 0) / max(1, sim.collisions),
     )
+
+
+def _internals(sim):
+    """(bytes of the engine state, list expiries, stale events) of the current build.
+
+    Reads the named records of ``granulargas.engine._state``; falls back to the
+    earlier layout (a dict of arrays with index-coded counters) so that
+    ``bench_ab.py`` can run this script against an older source tree.
+    """
+    engine = getattr(sim, "_engine", None)
+    if engine is not None:
+        from granulargas.engine._state import nbytes
+
+        c = engine.counters[0]
+        return nbytes(engine), float(c["expiries"]), float(c["stale"])
+    s = sim._s
+    return (sum(a.nbytes for a in s.values() if hasattr(a, "nbytes")), float(s["iscal"][4]),
+            float(s["iscal"][5]))
 
 
 def jit_times():
@@ -138,6 +172,7 @@ def main(argv=None):
     p.add_argument("--no-jit", action="store_true", help="skip the JIT timing")
     p.add_argument("--json", default=None, help="also write the results to this JSON file")
     p.add_argument("--case", nargs=4, default=None, help=argparse.SUPPRESS)
+    p.add_argument("--scene", default="periodic", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     for rule in args.rules or []:
         if not _rule_valid(rule):
@@ -146,7 +181,8 @@ def main(argv=None):
 
     if args.case:
         n, eta, dim, rule = args.case
-        print(json.dumps(run_case(int(float(n)), float(eta), int(dim), rule, args.repeats or 5)))
+        print(json.dumps(run_case(int(float(n)), float(eta), int(dim), rule, args.repeats or 5,
+                                  scene=args.scene)))
         return 0
 
     if args.quick:

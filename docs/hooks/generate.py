@@ -61,6 +61,7 @@ SECTION_TEXT = {
     "collision.material": "Instead of `damping`: the viscoelastic contact from material constants "
                           "(SI; all keys required), converted once to the reduced pair prefactor "
                           "k = (3/2) A (2Y / (3(1 − ν²)))^(2/5) (σ u / m²)^(1/5).",
+    "driving": "Optional: white-noise driving (a heated granular gas in a steady state).",
     "run": "When to stop (at least one key).",
     "output": "The output file and its schedule.",
 }

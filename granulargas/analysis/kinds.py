@@ -13,6 +13,7 @@ in ``run_kind`` and its report and figure there.
 
 from __future__ import annotations
 
+from granulargas.analysis.driven import analyze_driven
 from granulargas.analysis.elastic import analyze_elastic
 from granulargas.analysis.run import RunInfo, analyze_cooling
 
@@ -22,6 +23,7 @@ __all__ = ["ANALYSES", "analyze_file"]
 ANALYSES = {
     "cooling": analyze_cooling,
     "elastic": analyze_elastic,
+    "driven": analyze_driven,
 }
 
 

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-__all__ = ["PLOTS", "plot_analysis", "plot_cooling", "plot_elastic", "plot_sweep"]
+__all__ = ["PLOTS", "plot_analysis", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic", "plot_sweep"]
 
 
 def _plt():
@@ -276,6 +276,90 @@ def plot_sweep(results, summaries, path):
         ax.set_ylabel("$T/T_\\mathrm{theory}$ (mean $\\pm$ s.e. over seeds)")
         ax.set_title("temperature over kinetic theory, seeds averaged (band: standard error)", fontsize=8.5)
         ax.legend(fontsize=7.5)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_driven(analysis, path):
+    """T(t) against the relaxation to the theoretical steady state, and the snapshots' a2.
+
+    Parameters
+    ----------
+    analysis : granulargas.analysis.driven.DrivenAnalysis
+    path : str or Path
+    """
+    plt = _plt()
+    a, info = analysis, analysis.info
+    s = a.summary()
+    fig, axes = plt.subplots(2, 1, figsize=(7.0, 6.5), sharex=True)
+    t, T = a.time, a.history.temperature
+    ax = axes[0]
+    ax.plot(t, T, "-", color="C0", lw=1, label="simulation")
+    ax.plot(t, a.temperature_theory(t), "-", color="k", lw=1.2,
+            label="theory: $dT/dt = H - \\zeta(T)\\,T$")
+    if s.get("T_steady") is not None and math.isfinite(a.theory.temperature):
+        ax.axhline(a.theory.temperature, color="k", lw=0.8, ls="--",
+                   label=f"theory $T_{{ss}}$ = {a.theory.temperature:.4g}")
+        ax.axhspan(s["T_steady"] - (s.get("T_steady_error") or 0), s["T_steady"] + (s.get("T_steady_error") or 0),
+                   color="C0", alpha=0.25, lw=0,
+                   label=f"simulation $T_{{ss}}$ = {s['T_steady']:.4g} $\\pm$ {s.get('T_steady_error') or 0:.2g}")
+    _no_offset(ax)
+    ax.set_ylabel("temperature T")
+    ax.legend(fontsize=7.5, loc="lower right", framealpha=0.7)
+    ax.set_title(_title(info, f"White-noise driven gas, H = {a.heating_rate:.3g}: steady state against "
+                              "kinetic theory"), fontsize=9)
+    ax = axes[1]
+    ts, a2, _ = a.sonine
+    if ts.size:
+        ax.plot(ts, a2, "o", ms=3, color="C0", label="snapshots")
+    if s.get("a2_mean") is not None:
+        ax.axhline(s["a2_mean"], color="C0", lw=1, label=f"mean after relaxation {s['a2_mean']:+.4f} (bias removed)")
+    ax.axhline(a.theory.a2, color="k", lw=1.2, label=f"van Noije & Ernst (driven) {a.theory.a2:+.4f}")
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    _no_offset(ax)
+    ax.set_ylabel("$a_2$")
+    ax.legend(fontsize=7.5, loc="lower right", framealpha=0.7)
+    ax.set_xlabel(f"time t  [$\\sigma\\,(m/T_0)^{{1/2}}$]; steady state from t = {a.t_relaxed:.3g}")
+    for ax in axes:
+        ax.axvline(a.t_relaxed, color="0.8", lw=0.8, ls=":")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+PLOTS["driven"] = plot_driven
+
+
+def plot_density_profiles(info, walls: dict, path):
+    """Density (packing fraction) across each wall axis, with the bulk value.
+
+    Parameters
+    ----------
+    info : granulargas.analysis.run.RunInfo
+    walls : dict
+        :func:`granulargas.analysis.walls.wall_summary`.
+    path : str or Path
+    """
+    from granulargas.analysis.walls import density_profile
+
+    plt = _plt()
+    axes_list = walls["axes"]
+    fig, axes = plt.subplots(len(axes_list), 1, figsize=(7.0, 3.0 * len(axes_list) + 0.5), squeeze=False)
+    t_from = walls.get("t_from", 0.0)
+    for ax, a in zip(axes[:, 0], axes_list):
+        prof = density_profile(info.path, a, t_from=t_from)
+        ax.step(prof.centres, prof.packing, where="mid", color="C0", lw=1,
+                label=f"simulation ({prof.frames} snapshots)")
+        n_b, eta_b = prof.bulk()
+        ax.axhline(eta_b, color="k", lw=1, ls="--", label=f"bulk (middle half): {eta_b:.4g}")
+        ax.set_xlim(0.0, float(info.box[a]))
+        ax.set_xlabel(f"{'xyz'[a]} across the walls at 0 and {float(info.box[a]):.4g}  [$\\sigma$]")
+        ax.set_ylabel("local packing fraction")
+        ax.legend(fontsize=7.5, loc="upper center", framealpha=0.7)
+    axes[0, 0].set_title(_title(info, "Density across the walls (particle centres, time average)"), fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -114,6 +114,7 @@ class RunInfo:
     contact_end: str = "overlap"
     parameters: dict = field(repr=False, default_factory=dict)
     solid_fraction: float = math.nan  # sum of the particle volumes over the box volume
+    boundary: tuple = ()  # "periodic" or "wall" per axis
 
     @classmethod
     def from_file(cls, path) -> "RunInfo":
@@ -137,7 +138,13 @@ class RunInfo:
             parameters=params,
             solid_fraction=float(np.sum(theory.particle_volume(2.0 * radii, int(snap.box.shape[0])))
                                  / float(np.prod(snap.box))),
+            boundary=tuple(snap.boundary) or ("periodic",) * int(snap.box.shape[0]),
         )
+
+    @property
+    def walls(self) -> bool:
+        """Whether the run has walls on some axis."""
+        return "wall" in self.boundary
 
     @property
     def volume(self) -> float:
@@ -199,7 +206,11 @@ def _mean_particle_mass(radii, masses, dim) -> float:
 
 
 def run_kind(info: RunInfo) -> str:
-    """``"elastic"`` (energy conserved: eps = 1 or damping 0) or ``"cooling"``."""
+    """``"driven"`` (white-noise driving), ``"elastic"`` (energy conserved: eps = 1 or
+    damping 0) or ``"cooling"``."""
+    drv = info.parameters.get("driving")
+    if isinstance(drv, dict) and float(drv.get("heating_rate", 0.0)) > 0.0:
+        return "driven"
     if info.model == "constant" and info.restitution is not None and info.restitution < 1.0:
         return "cooling"
     if info.model == "viscoelastic" and info.prefactor:
@@ -213,6 +224,8 @@ def theory_name(info: RunInfo) -> str:
     eos = theory.eos_name(d)
     if info.kind == "elastic":
         return f"Enskog, {eos} equation of state"
+    if info.kind == "driven":
+        return "Enskog, driven steady state (zeta(T) T = H)"
     law = "exact eps(g)" if info.model == "viscoelastic" else "constant eps"
     return f"Enskog-Boltzmann, {law}, first Sonine a2(t); chi from {eos}"
 

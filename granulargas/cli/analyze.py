@@ -4,7 +4,10 @@
 
 PATH is a run's H5MD file (the analysis of its kind, :mod:`granulargas.analysis.kinds`:
 cooling runs against the kinetic theory of :mod:`granulargas.theory.gas`, elastic runs
-against the equation of state and Enskog's collision frequency) or a sweep's output
+against the equation of state and Enskog's collision frequency, driven runs' steady
+state against :mod:`granulargas.theory.driven`; a run with walls also gets the wall
+pressure and the density across the walls, :mod:`granulargas.analysis.walls`, and
+``--plot`` a second figure of the density profile) or a sweep's output
 directory (its ``index.json``: one row per parameter set, mean +- standard error over
 the seeds). ``--json`` prints one JSON object instead of the text report.
 """
@@ -128,6 +131,9 @@ def elastic_report(a, rows: int = 10) -> str:
                  f"largest {s['energy_drift_max']:.3g}")
     lines.append(f"  averages from t = {a.t_equilibrated:.4g} (equilibration left out); errors from "
                  f"block means")
+    if a.info.walls:
+        lines.append("  (walls: Z and the collision frequency below use the mean density of the whole box, "
+                     "depleted next to the walls; the wall pressure against the bulk density is the test)")
     lines.append(f"  Z = P/(nT) = {_pm(s['Z'], s['Z_error'])}; {s['Z_theory_name']} {s['Z_theory']:.5g}"
                  f"{_dev(s['Z'], s['Z_theory'])}; {s['Z_reference_name']} {s['Z_reference']:.5g}"
                  f"{_dev(s['Z'], s['Z_reference'])}")
@@ -164,8 +170,40 @@ def sweep_report(results, summaries) -> str:
     return "\n".join(lines)
 
 
+def driven_report(a, rows: int = 10) -> str:
+    """Text report of a :class:`granulargas.analysis.driven.DrivenAnalysis`."""
+    s = a.summary()
+    lines = _header(a.info)
+    lines.append(f"  driving: white noise, heating rate H = {a.heating_rate:.4g}, kicks every "
+                 f"{a.interval:.4g} (zeta dt_k = {_fmt(s.get('zeta_dt_k'), '.3g')})")
+    lines.append(f"  theory: {a.theory_name}")
+    lines.append(f"  steady state from t = {a.t_relaxed:.4g} (relaxation left out); errors from block means")
+    lines.append(f"  T_ss = {_pm(s.get('T_steady'), s.get('T_steady_error'))}; theory "
+                 f"{_fmt(s.get('T_steady_theory'), '.5g')}{_dev(s.get('T_steady'), s.get('T_steady_theory'))}")
+    if s.get("a2_mean") is not None:
+        lines.append(f"  a2 = {_pm(s['a2_mean'], s.get('a2_error'), '+.4f')} (snapshots, bias -2/(dN) removed); "
+                     f"theory {s['a2_theory']:+.4f}")
+    t, T = a.time, a.history.temperature
+    T_th = a.temperature_theory(t)
+    lines += ["", f"  {'t':>12} {'T':>12} {'T_theory':>12} {'T/T_theory':>10}   (T_theory: dT/dt = H - zeta(T) T)"]
+    for i in np.unique(np.linspace(0, t.size - 1, max(rows, 2)).astype(int)):
+        lines.append(f"  {t[i]:12.5g} {T[i]:12.5g} {T_th[i]:12.5g} {T[i] / T_th[i]:10.4f}")
+    return "\n".join(lines)
+
+
 #: kind -> text report ``f(analysis, rows) -> str``
-REPORTS = {"cooling": cooling_report, "elastic": elastic_report}
+REPORTS = {"cooling": cooling_report, "elastic": elastic_report, "driven": driven_report}
+
+
+def walls_report(w: dict) -> str:
+    """Lines on the walls of a run (:func:`granulargas.analysis.walls.wall_summary`)."""
+    lines = [f"  walls on {', '.join('xyz'[a] for a in w['axes'])}: wall pressure "
+             f"{_pm(w['wall_pressure'], w['wall_pressure_error'])}; bulk (middle half) packing "
+             f"{w['bulk_packing']:.4g}, density {w['bulk_density']:.4g} ({w['profile_frames']} snapshots)"]
+    if w.get("eos_name"):
+        lines.append(f"  equation of state ({w['eos_name']}) at the bulk density and T = {w['temperature']:.5g}: "
+                     f"P = {w['eos_pressure']:.5g}; wall pressure{_dev(w['wall_pressure'], w['eos_pressure'])}")
+    return "\n".join(lines)
 
 
 def report(analysis, rows: int = 10) -> str:
@@ -217,14 +255,27 @@ def run(args) -> int:
                          with_sonine=not args.no_snapshots)
     except (ValueError, ArithmeticError) as exc:  # numbers no run of ours writes (a damaged file)
         raise InputFileError(f"{args.file}: cannot analyse ({exc or type(exc).__name__})") from None
+    walls = None
+    if a.info.walls:
+        from granulargas.analysis.walls import wall_summary
+
+        t_from = getattr(a, "t_equilibrated", getattr(a, "t_relaxed", float(a.time[0])))
+        walls = wall_summary(a.info, t_from)
     if args.json:
-        print(json.dumps(a.summary(), indent=1, ensure_ascii=False))
+        out = a.summary()
+        if walls is not None:
+            out["walls"] = walls
+        print(json.dumps(out, indent=1, ensure_ascii=False, default=float))
     else:
-        print(report(a, rows=args.rows))
+        print(report(a, rows=args.rows) + ("\n" + walls_report(walls) if walls is not None else ""))
     if args.plot:
-        from granulargas.analysis.plots import plot_analysis  # matplotlib only when a plot is asked for
+        from granulargas.analysis.plots import plot_analysis, plot_density_profiles  # matplotlib only when asked
 
         plot_analysis(a, args.plot)
+        extra = []
+        if walls is not None:
+            p = Path(args.plot)
+            extra.append(plot_density_profiles(a.info, walls, p.with_name(p.stem + "_profile" + p.suffix)))
         if not args.json:
-            print(f"  wrote {args.plot}")
+            print("  wrote " + ", ".join(str(x) for x in [args.plot] + extra))
     return 0

@@ -5,7 +5,9 @@ LAMMPS data file and input script that start from the same initial state as
 ``granulargas run CONFIG`` (same seed, same particles, built by
 :func:`granulargas.run.prepare.initial_state`) with the same contact law
 (:mod:`granulargas.dem.lammps`: hertz/material + damping viscoelastic, a
-stiffness whose contact time is a stated fraction of the mean free time).
+stiffness whose contact time is a stated fraction of the mean free time), and
+the same walls (``f`` boundaries and ``fix wall/gran`` of the same contact law).
+A driven run has no LAMMPS counterpart here and is refused.
 """
 
 from __future__ import annotations
@@ -46,6 +48,9 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
             f"{config.source}: collision.model = \"constant\": LAMMPS export needs the viscoelastic "
             "(or elastic) contact law"
         )
+    if config.driving is not None and config.driving.heating_rate > 0.0:
+        raise ConfigError(f"{config.source}: [driving]: LAMMPS export does not write the white-noise "
+                          "driving; export an undriven config")
     end_time = config.run.end_time if end_time is None else end_time
     if end_time is None:
         raise ConfigError(f"{config.source}: run.end_time is not set: LAMMPS runs for a fixed time (use --end-time)")
@@ -68,5 +73,5 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
         directory, state.positions, state.velocities, state.radii, state.masses, state.box, prefactor,
         end=end, end_time=end_time, thermo_interval=interval, contact_fraction=contact_fraction,
         steps_per_contact=steps_per_contact, poisson_ratio=poisson_ratio, name=name, source=config.source,
-        time_origin=state.time,
+        time_origin=state.time, boundary=config.system.boundary,
     )

@@ -124,14 +124,21 @@ class DemContact:
         """Elastic Hertz duration HERTZ_DURATION rho^{-2/5} g^{-1/5} (time units)."""
         return HERTZ_DURATION * self.rho(radius_eff, mass_eff) ** -0.4 * speed**-0.2
 
+    def _model(self, mass_eff: float) -> str:
+        line = (f"hertz/material {self.young_modulus:.17g} {self.eta_n0(mass_eff):.17g} "
+                f"{self.poisson_ratio:.17g} damping viscoelastic tangential linear_nohistory 0.0 0.0")
+        return line + (" limit_damping" if self.end == "force" else "")
+
     def pair_coeff(self, itype, jtype, mass_eff: float) -> str:
         """The ``pair_coeff`` line for one pair of atom types."""
-        line = (
-            f"pair_coeff {itype} {jtype} hertz/material {self.young_modulus:.17g} "
-            f"{self.eta_n0(mass_eff):.17g} {self.poisson_ratio:.17g} damping viscoelastic "
-            "tangential linear_nohistory 0.0 0.0"
-        )
-        return line + (" limit_damping" if self.end == "force" else "")
+        return f"pair_coeff {itype} {jtype} {self._model(mass_eff)}"
+
+    def wall_fix(self, fix_id: str, group: str, mass: float, axis: int, length: float) -> str:
+        """A ``fix wall/gran`` line: flat walls of the same material at 0 and ``length``
+        normal to ``axis`` for the atoms of ``group`` (all of mass ``mass``: the
+        sphere-plane contact has m_eff = m_i, R_eff = R_i, as in the engine)."""
+        return (f"fix {fix_id} {group} wall/gran granular {self._model(mass)} "
+                f"{'xyz'[axis]}plane 0.0 {length:.17g}")
 
     @classmethod
     def from_prefactor(cls, prefactor: float, young_modulus: float, poisson_ratio: float = DEFAULT_POISSON,
@@ -469,7 +476,8 @@ MAX_MASS_TYPES = 32
 
 def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefactor, *, end="overlap",
                      end_time, thermo_interval=None, contact_fraction=0.01, steps_per_contact=50,
-                     poisson_ratio=DEFAULT_POISSON, name="granulargas", source="", time_origin=0.0) -> LammpsExport:
+                     poisson_ratio=DEFAULT_POISSON, name="granulargas", source="", time_origin=0.0,
+                     boundary=None) -> LammpsExport:
     """Write a LAMMPS data file and input script equivalent to one of our runs.
 
     Parameters
@@ -481,7 +489,7 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         Initial state, positions in [0, box).
     radii, masses : float arrays (N,)
     box : float array (d,)
-        Periodic box edges.
+        Box edges.
     prefactor : float
         Our pair prefactor k (beta = k (R_eff g / m_eff^2)^{1/5}).
     end : {"overlap", "force"}
@@ -498,6 +506,10 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         Timestep <= contact time / steps_per_contact, a whole number of steps to end_time.
     time_origin : float
         Our time at the exported state (a restart); LAMMPS's time starts at 0.
+    boundary : sequence of d str, optional
+        "periodic" or "wall" per axis (default all periodic). A wall axis becomes a
+        fixed (``f``) LAMMPS boundary with a ``fix wall/gran`` of the same contact law
+        at 0 and L for each atom type (:meth:`DemContact.wall_fix`).
 
     Notes
     -----
@@ -565,6 +577,9 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
             eta[(i + 1, j + 1)] = float(contact.eta_n0(mi * mj / (mi + mj)))
 
     _write_data_file(data_file, positions, velocities, radii, masses, typeid + 1, ntypes, box, source)
+    boundary = ("periodic",) * d if boundary is None else tuple(boundary)
+    walls = [a for a in range(d) if boundary[a] == "wall"]
+    lammps_boundary = " ".join("f" if a in walls else "p" for a in range(d)) + (" p" if d == 2 else "")
     lines = [
         f"# LAMMPS input written by granulargas export lammps{' from ' + source if source else ''}",
         "# Same contact law as granulargas (Schwager & Pöschel (1997), eq. (2)): hertz/material + damping viscoelastic,",
@@ -578,7 +593,7 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         f"# LAMMPS time 0 is granulargas time {time_origin:.17g}.",
         "units lj",
         f"dimension {d}",
-        "boundary p p p",
+        f"boundary {lammps_boundary}",
         "atom_style sphere",
         "comm_modify vel yes",
         f"read_data {data_file.name}",
@@ -589,6 +604,11 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     for (i, j), _ in eta.items():
         mi, mj = type_masses[i - 1], type_masses[j - 1]
         lines.append(contact.pair_coeff(i, j, mi * mj / (mi + mj)))
+    for k, m in enumerate(type_masses):
+        if walls:
+            lines.append(f"group type{k + 1} type {k + 1}")
+        for a in walls:
+            lines.append(contact.wall_fix(f"wall{k + 1}{'xyz'[a]}", f"type{k + 1}", float(m), a, float(box[a])))
     skin = 0.3 * float(np.max(2.0 * radii))
     lines += [
         f"neighbor {skin:.6g} bin",

@@ -1,11 +1,12 @@
-"""Event-driven engine: hard spheres (3D) and disks (2D) in a periodic box.
+"""Event-driven engine: hard spheres (3D) and disks (2D), periodic or walled per axis.
 
 Public API (contract in ARCHITECTURE.md)::
 
-    from granulargas.engine import Simulation, CollisionRule
+    from granulargas.engine import Simulation, CollisionRule, WhiteNoise
 """
 
+from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
 from granulargas.engine.simulation import Simulation
 
-__all__ = ["Simulation", "CollisionRule"]
+__all__ = ["Simulation", "CollisionRule", "WhiteNoise"]

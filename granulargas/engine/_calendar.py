@@ -56,22 +56,25 @@ events, from the mean event delay (:func:`cal_width`); at the start of a
 N = 10^6) only when w is off from that by more than a factor 2, which keeps w
 matched to a cooling gas. Ties are broken by heap node order, deterministically.
 
-Scalars: ``qi = [small size, B_cur, nb, live events in the ring, free chunk,
-look-ahead chunk]``,
-``qf = [w, t0, ovf_min]``.
+State: :class:`granulargas.engine._state.Calendar` -- ``qt`` (N,) event times,
+``chunks`` (pool, CHUNK) i4, ``where`` (N,) i4, ``small`` (capacity, 2) f8 nodes
+(time, id), ``buckets`` (nb + 1, 2) i4 (newest chunk, ids in it), and ``state``,
+a one-element record (:data:`granulargas.engine._state.CALENDAR_STATE`): ``size``
+of the small heap, ``cur`` = B_cur, ``nb`` ring slots, ``nring`` live events in
+the ring, ``free`` head of the chunk free list, ``look`` the look-ahead chunk,
+``width`` w, ``t0`` and ``ovf_min``.
 """
 
 import math
 
 import numpy as np
 
-from granulargas._numba import jit
+from granulargas._numba import jit, kernel
 from granulargas.engine._prefetch import prefetch
+from granulargas.engine._state import CALENDAR_STATE, Calendar
 
 PER_WINDOW = 48
 CHUNK = 8  # int32 per chunk row: next chunk + 7 ids (32 bytes)
-Q_SIZE, Q_CUR, Q_NB, Q_NRING, Q_FREE, Q_LOOK = 0, 1, 2, 3, 4, 5
-Q_W, Q_T0, Q_OVF = 0, 1, 2
 
 
 def ring_size(n):
@@ -89,8 +92,8 @@ def pool_size(n, nb, stale=True):
     return live + nb + 1 + (live if stale else 0)
 
 
-def allocate_calendar(n, capacity=None, pool=None):
-    """Arrays of an empty calendar for n particles (fill ``qt``, then :func:`cal_build`).
+def allocate_calendar(n, capacity=None, pool=None) -> Calendar:
+    """An empty calendar for n particles (fill ``qt``, then :func:`cal_build`).
 
     ``capacity`` of the small heap: default max(1024, n / 16), some 10^3 times
     what a window holds; when a window would overflow it, the calendar halves
@@ -103,19 +106,20 @@ def allocate_calendar(n, capacity=None, pool=None):
     chunks = pool_size(n, nb) if pool is None else max(int(pool), pool_size(n, nb, stale=False))
     buf = np.zeros(chunks * CHUNK + 16, dtype=np.int32)
     offset = (-buf.ctypes.data % 32) // 4
-    return dict(
+    state = np.zeros(1, dtype=CALENDAR_STATE)
+    state[0] = (0, 0, nb, 0, -1, -1, 1.0, 0.0, np.inf)
+    return Calendar(
         qt=np.full(n, np.inf),
         chunks=buf[offset : offset + chunks * CHUNK].reshape(chunks, CHUNK),
-        qwhere=np.zeros(n, dtype=np.int32),
+        where=np.zeros(n, dtype=np.int32),
         small=np.zeros((min(n, cap), 2)),
         buckets=np.zeros((nb + 1, 2), dtype=np.int32),
-        qi=np.array([0, 0, nb, 0, -1, -1], dtype=np.int64),
-        qf=np.array([1.0, 0.0, np.inf]),
+        state=state,
     )
 
 
 # ----------------------------------------------------------------- small heap
-@jit(inline="always")
+@kernel(inline="always")
 def _sift_up(small, where, k):
     t = small[k, 0]
     p = small[k, 1]
@@ -134,7 +138,7 @@ def _sift_up(small, where, k):
     where[int(p)] = -k - 1
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def _sift_down(small, where, k, n):
     t = small[k, 0]
     p = small[k, 1]
@@ -162,22 +166,22 @@ def _sift_down(small, where, k, n):
     where[int(p)] = -k - 1
 
 
-@jit(inline="always")
-def _small_push(i, t, small, where, qi):
-    k = qi[Q_SIZE]
+@kernel(inline="always")
+def _small_push(i, t, small, where, cs):
+    k = cs.size
     if k >= small.shape[0]:
         return False
-    qi[Q_SIZE] = k + 1
+    cs.size = k + 1
     small[k, 0] = t
     small[k, 1] = i
     _sift_up(small, where, k)
     return True
 
 
-@jit(inline="always")
-def _small_remove(k, small, where, qi):
-    last = qi[Q_SIZE] - 1
-    qi[Q_SIZE] = last
+@kernel(inline="always")
+def _small_remove(k, small, where, cs):
+    last = cs.size - 1
+    cs.size = last
     if k == last:
         return
     old = small[k, 0]
@@ -190,16 +194,16 @@ def _small_remove(k, small, where, qi):
 
 
 # -------------------------------------------------------------------- buckets
-@jit(inline="always")
-def _append(i, b, chunks, buckets, where, qi):
+@kernel(inline="always")
+def _append(i, b, chunks, buckets, where, cs):
     """Put id i into bucket b; False if the chunk pool is empty."""
     c = buckets[b, 0]
     f = buckets[b, 1]
     if c < 0 or f == CHUNK - 1:
-        nc = qi[Q_FREE]
+        nc = cs.free
         if nc < 0:
             return False
-        qi[Q_FREE] = chunks[nc, 0]
+        cs.free = chunks[nc, 0]
         chunks[nc, 0] = c
         c = nc
         f = 0
@@ -210,119 +214,133 @@ def _append(i, b, chunks, buckets, where, qi):
     return True
 
 
-@jit(inline="always")
-def _release(c, chunks, qi):
-    chunks[c, 0] = qi[Q_FREE]
-    qi[Q_FREE] = c
+@kernel(inline="always")
+def _release(c, chunks, cs):
+    chunks[c, 0] = cs.free
+    cs.free = c
 
 
 # insert status
 _OK, _HEAP_FULL, _POOL_EMPTY = 0, 1, 2
 
 
-def _insert_impl(i, t, qt, chunks, where, small, buckets, qi, qf):
+def _insert_impl(i, t, cal, cs):
     """Place the event of particle i at time t; returns _OK, _HEAP_FULL or _POOL_EMPTY."""
-    qt[i] = t
-    x = (t - qf[Q_T0]) / qf[Q_W]
-    cur = qi[Q_CUR]
+    cal.qt[i] = t
+    x = (t - cs.t0) / cs.width
+    cur = cs.cur
     if x < cur + 1:  # B(t) <= B_cur (also for round-off below t0)
-        return _OK if _small_push(i, t, small, where, qi) else _HEAP_FULL
-    nb = qi[Q_NB]
+        return _OK if _small_push(i, t, cal.small, cal.where, cs) else _HEAP_FULL
+    nb = cs.nb
     if x < cur + nb:
-        if not _append(i, int(x) & (nb - 1), chunks, buckets, where, qi):
+        if not _append(i, int(x) & (nb - 1), cal.chunks, cal.buckets, cal.where, cs):
             return _POOL_EMPTY
-        qi[Q_NRING] += 1
+        cs.nring += 1
     else:
-        if not _append(i, nb, chunks, buckets, where, qi):
+        if not _append(i, nb, cal.chunks, cal.buckets, cal.where, cs):
             return _POOL_EMPTY
-        if t < qf[Q_OVF]:
-            qf[Q_OVF] = t
+        if t < cs.ovf_min:
+            cs.ovf_min = t
     return _OK
 
 
 # the hot path inlines it; the cold paths (rebuilds, overflow) share one compiled copy,
 # which keeps the first compile short
-_insert = jit(inline="always")(_insert_impl)
-_insert_call = jit(_insert_impl)
+_insert = kernel(inline="always")(_insert_impl)
+_insert_call = kernel(_insert_impl)
 
 
-@jit
-def _place_all(t0, w, qt, chunks, where, small, buckets, qi, qf):
+@kernel
+def _place_all(t0, w, cal):
     """Empty the calendar and insert every event ``qt`` (windows from t0, width w).
 
     Returns False if the first window overflows the small heap (the pool
     always suffices for live entries alone).
     """
-    qf[Q_W] = w
-    qf[Q_T0] = t0
-    qf[Q_OVF] = math.inf
-    qi[Q_SIZE] = 0
-    qi[Q_CUR] = 0
-    qi[Q_NRING] = 0
-    for b in range(qi[Q_NB] + 1):
+    cs = cal.state[0]
+    cs.width = w
+    cs.t0 = t0
+    cs.ovf_min = math.inf
+    cs.size = 0
+    cs.cur = 0
+    cs.nring = 0
+    buckets = cal.buckets
+    chunks = cal.chunks
+    for b in range(cs.nb + 1):
         buckets[b, 0] = -1
         buckets[b, 1] = 0
     m = chunks.shape[0]
     for c in range(m):
         chunks[c, 0] = c + 1 if c + 1 < m else -1
-    qi[Q_FREE] = 0
-    qi[Q_LOOK] = -1
+    cs.free = 0
+    cs.look = -1
+    qt = cal.qt
     for i in range(qt.shape[0]):
-        if _insert_call(i, qt[i], qt, chunks, where, small, buckets, qi, qf) != _OK:
+        if _insert_call(i, qt[i], cal, cs) != _OK:
             return False
     return True
 
 
-@jit
-def _replace(narrow, qt, chunks, where, small, buckets, qi, qf):
+@kernel
+def _replace(failure, cal):
     """Place all events anew from ``qt`` (which always holds every event time).
 
-    With ``narrow`` (a window overflowed the small heap) the width is halved
-    first, and again until the first window fits; otherwise (the chunk pool ran
-    dry) the width stays and only live entries are kept. Returns False if even a
-    tiny w cannot help (more simultaneous events than the small heap holds).
+    After ``failure`` _HEAP_FULL (a window overflowed the small heap) the width
+    is halved first, and again until the first window fits; after _POOL_EMPTY
+    (the chunk pool ran dry) the width stays and only live entries are kept.
+    Returns False if even a tiny w cannot help (more simultaneous events than the
+    small heap holds). (One compiled signature: ``failure`` is always an int64.)
     """
-    t0 = qf[Q_T0] + qi[Q_CUR] * qf[Q_W]
-    w = qf[Q_W]
-    if not narrow and _place_all(t0, w, qt, chunks, where, small, buckets, qi, qf):
+    narrow = failure == _HEAP_FULL
+    cs = cal.state[0]
+    t0 = cs.t0 + cs.cur * cs.width
+    w = cs.width
+    if not narrow and _place_all(t0, w, cal):
         return True
     for _ in range(200):
         w *= 0.5
-        if _place_all(t0, w, qt, chunks, where, small, buckets, qi, qf):
+        if _place_all(t0, w, cal):
             return True
     return False
 
 
-@jit
-def cal_update(i, t, qt, chunks, where, small, buckets, qi, qf):
+@kernel
+def cal_update(i, t, cal):
     """Set the event time of particle i to t. Returns False on failure (see :func:`_replace`)."""
+    cs = cal.state[0]
+    where = cal.where
+    small = cal.small
     wi = where[i]
     if wi < 0:
         k = -wi - 1
-        if small[k, 0] <= t and (t - qf[Q_T0]) / qf[Q_W] < qi[Q_CUR] + 1:
+        if small[k, 0] <= t and (t - cs.t0) / cs.width < cs.cur + 1:
             # stays in the window, later: adjust in place
             small[k, 0] = t
-            qt[i] = t
-            _sift_down(small, where, k, qi[Q_SIZE])
+            cal.qt[i] = t
+            _sift_down(small, where, k, cs.size)
             return True
-        _small_remove(k, small, where, qi)
-    elif wi < qi[Q_NB]:
-        qi[Q_NRING] -= 1  # its old entry goes stale (lazy deletion)
-    st = _insert(i, t, qt, chunks, where, small, buckets, qi, qf)
+        _small_remove(k, small, where, cs)
+    elif wi < cs.nb:
+        cs.nring -= 1  # its old entry goes stale (lazy deletion)
+    st = _insert(i, t, cal, cs)
     if st != _OK:
-        return _replace(st == _HEAP_FULL, qt, chunks, where, small, buckets, qi, qf)
+        return _replace(st, cal)
     return True
 
 
-@jit
-def _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf):
+@kernel
+def _redistribute_overflow(cal):
     """Place the live overflow events anew; returns an insert status (_OK or the failure)."""
-    nb = qi[Q_NB]
+    cs = cal.state[0]
+    chunks = cal.chunks
+    buckets = cal.buckets
+    where = cal.where
+    nb = cs.nb
     c = buckets[nb, 0]
     f = buckets[nb, 1]
     buckets[nb, 0] = -1
     buckets[nb, 1] = 0
-    qf[Q_OVF] = math.inf
+    cs.ovf_min = math.inf
     while c >= 0:
         nx = chunks[c, 0]
         for q in range(1, f + 1):
@@ -330,18 +348,22 @@ def _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf):
             if where[j] == nb:
                 # a second entry of j (it left the overflow and came back) is placed
                 # again only if j went back to the overflow: one more entry there, no harm
-                st = _insert_call(j, qt[j], qt, chunks, where, small, buckets, qi, qf)
+                st = _insert_call(np.int64(j), cal.qt[j], cal, cs)
                 if st != _OK:
                     return st
-        _release(c, chunks, qi)
+        _release(c, chunks, cs)
         c = nx
         f = CHUNK - 1
     return _OK
 
 
-@jit(inline="always")
-def _open_bucket(slot, qt, chunks, where, small, buckets, qi):
+@kernel(inline="always")
+def _open_bucket(slot, cal, cs):
     """Move the live events of ring bucket ``slot`` into the small heap; False if it fills."""
+    chunks = cal.chunks
+    buckets = cal.buckets
+    where = cal.where
+    qt = cal.qt
     c = buckets[slot, 0]
     f = buckets[slot, 1]
     buckets[slot, 0] = -1
@@ -357,17 +379,17 @@ def _open_bucket(slot, qt, chunks, where, small, buckets, qi):
         for q in range(1, f + 1):
             j = chunks[c, q]
             if where[j] == slot:
-                qi[Q_NRING] -= 1
-                if not _small_push(j, qt[j], small, where, qi):
+                cs.nring -= 1
+                if not _small_push(j, qt[j], cal.small, where, cs):
                     return False
-        _release(c, chunks, qi)
+        _release(c, chunks, cs)
         c = nx
         f = CHUNK - 1
     return True
 
 
-@jit(inline="always")
-def cal_look_ahead(qt, chunks, where, qi):
+@kernel(inline="always")
+def cal_look_ahead(cal):
     """Prefetch hints for one chunk of the next bucket (no effect on results).
 
     Called once per event: while the current window's ~PER_WINDOW events are
@@ -377,58 +399,96 @@ def cal_look_ahead(qt, chunks, where, qi):
     cache instead of waiting on one miss per chunk. Stale or unused slots only
     prefetch lines in vain.
     """
-    c = qi[Q_LOOK]
+    cs = cal.state[0]
+    c = cs.look
     if c >= 0:
+        chunks = cal.chunks
         for q in range(1, CHUNK):
             j = chunks[c, q]
-            prefetch(qt, j)
-            prefetch(where, j)
+            prefetch(cal.qt, j)
+            prefetch(cal.where, j)
         nx = chunks[c, 0]
         if nx >= 0:
             prefetch(chunks, nx)
-        qi[Q_LOOK] = nx
+        cs.look = nx
 
 
-@jit
-def cal_peek(qt, chunks, where, small, buckets, qi, qf):
+@kernel(inline="always")
+def cal_after_next(cal, skip):
+    """Best guess of the particle whose event follows the earliest one, or -1.
+
+    The earliest child of the small heap's root, passing over the event of
+    particle ``skip`` (the next event's partner, which that event re-predicts:
+    often its copy of the same collision, equal in time up to round-off); when
+    ``skip``'s node is a child of the root, its children are candidates too.
+    Only a hint for the prefetch: right for 97-98 % of events
+    (``scripts/profile_loop.py``).
+    """
+    small = cal.small
+    size = cal.state[0].size
+    c2 = -1
+    t2 = math.inf
+    cp = -1
+    for q in range(1, min(5, size)):
+        if small[q, 1] == skip:
+            cp = q
+        elif small[q, 0] < t2:
+            t2 = small[q, 0]
+            c2 = q
+    if cp > 0:
+        for q in range(4 * cp + 1, min(4 * cp + 5, size)):
+            if small[q, 0] < t2:
+                t2 = small[q, 0]
+                c2 = q
+    return int(small[c2, 1]) if c2 > 0 else -1
+
+
+@kernel(inline="always")
+def cal_next_time(cal):
+    """Time of the earliest event after :func:`cal_peek` returned its particle."""
+    return cal.small[0, 0]
+
+
+@kernel
+def cal_peek(cal):
     """Particle with the earliest event (moving the window forward as needed).
 
-    Its time is ``qt[result]``; every other event is at the same time or later.
-    Returns -1 if there is no event (all times inf), -2 on failure (see
-    :func:`_replace`).
+    Its time is ``qt[result]`` (= :func:`cal_next_time`); every other event is at
+    the same time or later. Returns -1 if there is no event (all times inf), -2 on
+    failure (see :func:`_replace`).
     """
-    nb = qi[Q_NB]
-    while qi[Q_SIZE] == 0:
+    cs = cal.state[0]
+    nb = cs.nb
+    while cs.size == 0:
         st = _OK
-        if qi[Q_NRING] == 0:
-            if qf[Q_OVF] == math.inf:
+        if cs.nring == 0:
+            if cs.ovf_min == math.inf:
                 return -1
             # nothing live in the ring: jump to the window before the earliest overflow
             # event (stale entries left in the ring are skipped when their bucket opens)
-            qi[Q_CUR] = int((qf[Q_OVF] - qf[Q_T0]) / qf[Q_W]) - 1
-            st = _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf)
+            cs.cur = int((cs.ovf_min - cs.t0) / cs.width) - 1
+            st = _redistribute_overflow(cal)
         else:
-            cur = qi[Q_CUR] + 1
-            qi[Q_CUR] = cur
-            if not _open_bucket(cur & (nb - 1), qt, chunks, where, small, buckets, qi):
+            cur = cs.cur + 1
+            cs.cur = cur
+            if not _open_bucket(cur & (nb - 1), cal, cs):
                 st = _HEAP_FULL
             elif cur & (nb // 2 - 1) == 0:
                 # every half turn of the ring: overflow events were beyond cur + nb when
                 # placed, so none is due before the next half turn
-                st = _redistribute_overflow(qt, chunks, where, small, buckets, qi, qf)
+                st = _redistribute_overflow(cal)
             if st == _OK:
                 # the look-ahead (cal_look_ahead) walks the next bucket meanwhile
-                head = buckets[(cur + 1) & (nb - 1), 0]
-                qi[Q_LOOK] = head
+                head = cal.buckets[(cur + 1) & (nb - 1), 0]
+                cs.look = head
                 if head >= 0:
-                    prefetch(chunks, head)
-        if st != _OK and not _replace(st == _HEAP_FULL, qt, chunks, where, small, buckets, qi,
-                                      qf):
+                    prefetch(cal.chunks, head)
+        if st != _OK and not _replace(st, cal):
             return -2
-    return int(small[0, 1])
+    return int(cal.small[0, 1])
 
 
-@jit
+@kernel
 def cal_width(now, qt):
     """Window width for events ``qt`` at time ``now``: PER_WINDOW events per window on average."""
     n = qt.shape[0]
@@ -446,33 +506,40 @@ def cal_width(now, qt):
     return w
 
 
-@jit
-def cal_build(now, qt, chunks, where, small, buckets, qi, qf):
+@kernel
+def cal_build(now, cal):
     """Place every particle's event ``qt`` anew (window starts at ``now``; w from the mean delay).
 
     Returns False on failure (see :func:`_replace`).
     """
-    w = cal_width(now, qt)
-    if _place_all(now, w, qt, chunks, where, small, buckets, qi, qf):
+    w = cal_width(now, cal.qt)
+    if _place_all(now, w, cal):
         return True
-    qi[Q_CUR] = 0
-    qf[Q_T0] = now
-    qf[Q_W] = w
-    return _replace(True, qt, chunks, where, small, buckets, qi, qf)
+    cs = cal.state[0]
+    cs.cur = 0
+    cs.t0 = now
+    cs.width = w
+    return _replace(np.int64(_HEAP_FULL), cal)
 
 
-@jit
-def cal_check(qt, chunks, where, small, buckets, qi, qf):
+@jit  # allocates: reference counting on
+def cal_check(cal):
     """Invariant checker: True if every event sits where its time says and no chunk is lost."""
+    qt = cal.qt
+    chunks = cal.chunks
+    where = cal.where
+    small = cal.small
+    buckets = cal.buckets
+    cs = cal.state[0]
     n = qt.shape[0]
-    nb = qi[Q_NB]
-    size = qi[Q_SIZE]
-    cur = qi[Q_CUR]
+    nb = cs.nb
+    size = cs.size
+    cur = cs.cur
     for k in range(size):
         i = int(small[k, 1])
         if where[i] != -k - 1 or small[k, 0] != qt[i]:
             return False
-        if (qt[i] - qf[Q_T0]) / qf[Q_W] >= cur + 1:
+        if (qt[i] - cs.t0) / cs.width >= cur + 1:
             return False
         if k > 0 and small[(k - 1) >> 2, 0] > small[k, 0]:
             return False
@@ -490,7 +557,7 @@ def cal_check(qt, chunks, where, small, buckets, qi, qf):
             c = chunks[c, 0]
             f = CHUNK - 1
     free = 0
-    c = qi[Q_FREE]
+    c = cs.free
     while c >= 0 and free <= chunks.shape[0]:
         free += 1
         c = chunks[c, 0]
@@ -505,13 +572,13 @@ def cal_check(qt, chunks, where, small, buckets, qi, qf):
             continue
         if b > nb or not found[i]:
             return False
-        x = (qt[i] - qf[Q_T0]) / qf[Q_W]
+        x = (qt[i] - cs.t0) / cs.width
         if x < cur + 1:
             return False
         if b < nb:
             if x >= cur + nb or (int(x) & (nb - 1)) != b:
                 return False
             ring += 1
-        elif qt[i] < qf[Q_OVF]:
+        elif qt[i] < cs.ovf_min:
             return False
-    return ring == qi[Q_NRING]
+    return ring == cs.nring

@@ -17,12 +17,18 @@ candidate.
 
 Particle data come as one record per particle, ``rec[i] = (x, y, z, vx, vy,
 vz, t_i, R_i)`` (64 bytes, one cache line): positions at the particle's own
-clock t_i, velocity, clock and radius.
+clock t_i, velocity, clock and radius. The lists and cells are the records
+:class:`~granulargas.engine._state.Lists` and :class:`~granulargas.engine._state.Cells`;
+the geometry is :class:`~granulargas.engine._state.Space`. On a wall axis
+(period inf) the cells do not wrap: the cells beyond the walls do not exist.
 """
+
+import math
+
 
 import numpy as np
 
-from granulargas._numba import jit
+from granulargas._numba import kernel
 from granulargas.engine._geometry import min_image
 from granulargas.engine._prefetch import prefetch
 
@@ -30,7 +36,7 @@ OVERFLOW = 10
 CELL_OVERFLOW = 11
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def cell_coord(x, length, n):
     c = int(x * (n / length))
     if c >= n:
@@ -40,7 +46,7 @@ def cell_coord(x, length, n):
     return c
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def cell_index(x, y, z, box, ncell):
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
@@ -48,13 +54,13 @@ def cell_index(x, y, z, box, ncell):
     return cx + ncell[0] * (cy + ncell[1] * cz)
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def stencil_size(ncell):
     """Cells around a point: 27 in 3D, 9 with a single layer in z (2D)."""
     return 27 if ncell[2] >= 3 else 9
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def stencil_cell(cx, cy, cz, k, ncell):
     """Flat index of the k-th cell around cell (cx, cy, cz), periodic.
 
@@ -69,7 +75,7 @@ def stencil_cell(cx, cy, cz, k, ncell):
     return kx + ncell[0] * (ky + ncell[1] * kz)
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of):
     h = cell_head[c]
     cell_next[i] = h
@@ -80,7 +86,7 @@ def cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of):
     cell_of[i] = c
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
     p = cell_prev[i]
     n = cell_next[i]
@@ -92,7 +98,7 @@ def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
         cell_prev[n] = p
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def slot_insert(i, c, cell_ids, cell_n, cell_of):
     """Append particle i to cell c (the caller has checked the capacity)."""
     q = cell_n[c]
@@ -101,7 +107,7 @@ def slot_insert(i, c, cell_ids, cell_n, cell_of):
     cell_of[i] = c
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def slot_remove(i, cell_ids, cell_n, cell_of):
     """Remove particle i from its cell (the cell's last entry takes its slot).
 
@@ -118,7 +124,7 @@ def slot_remove(i, cell_ids, cell_n, cell_of):
     cell_n[c] = last
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def _gaps2(x, c, length, n):
     """Squared distances from x to the lower and upper faces of its cell c (0 if outside)."""
     w = length / n
@@ -129,7 +135,7 @@ def _gaps2(x, c, length, n):
     return lo * lo, hi * hi
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def _pick(o, lo2, hi2):
     if o < 0:
         return lo2
@@ -138,17 +144,21 @@ def _pick(o, lo2, hi2):
     return 0.0
 
 
-@jit
-def _reach(x, y, z, cut, box, ncell, stencil):
+@kernel
+def _reach(x, y, z, cut, space, stencil):
     """Cells around (x, y, z) that a sphere of radius ``cut`` can reach, into ``stencil``.
 
     Of the 27 (2D: 9) cells of side >= cut around the point's cell, a face
     neighbour is always reached, an edge or corner neighbour only if the
     point is within ``cut`` of the shared edge or corner (on average 20.6 of
-    27 cells in 3D, 8.1 of 9 in 2D, for a cut-off equal to the cell side). The gap test keeps a margin of 1e-9 cut
+    27 cells in 3D, 8.1 of 9 in 2D, for a cut-off equal to the cell side); a cell
+    beyond a wall never. The gap test keeps a margin of 1e-9 cut
     plus 1e-12 box lengths against round-off in the cell assignment. Entries are
     ``32 c + code`` with code = (ox + 1) + 3 (oy + 1) + 9 (oz + 1); returns their number.
     """
+    box = space.box
+    ncell = space.ncell
+    period = space.period
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
@@ -158,6 +168,15 @@ def _reach(x, y, z, cut, box, ncell, stencil):
     xl, xh = _gaps2(x, cx, box[0], ncell[0])
     yl, yh = _gaps2(y, cy, box[1], ncell[1])
     zl, zh = _gaps2(z, cz, box[2], ncell[2])
+    if period[0] == math.inf:  # a wall axis: no cells beyond the walls
+        xl = math.inf if cx == 0 else xl
+        xh = math.inf if cx == ncell[0] - 1 else xh
+    if period[1] == math.inf:
+        yl = math.inf if cy == 0 else yl
+        yh = math.inf if cy == ncell[1] - 1 else yh
+    if period[2] == math.inf:
+        zl = math.inf if cz == 0 else zl
+        zh = math.inf if cz == ncell[2] - 1 else zh
     if zr == 0:
         zl = 0.0
         zh = 0.0
@@ -179,9 +198,8 @@ def _reach(x, y, z, cut, box, ncell, stencil):
     return ns
 
 
-@jit(inline="always")
-def _collect(i, x, y, z, ri, rmax, m, centre, rec, shell, box, ncell, cell_ids, cell_n, scratch,
-             stencil):
+@kernel(inline="always")
+def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     """Particles j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
 
     Passes, so that the cache misses of one pass overlap: (1) the cells around
@@ -196,13 +214,21 @@ def _collect(i, x, y, z, ri, rmax, m, centre, rec, shell, box, ncell, cell_ids, 
     number found, or -1 if more than ``m`` are found or ``scratch`` is shorter
     than the candidates (the caller enlarges both).
     """
+    scratch = lists.scratch
+    stencil = lists.stencil
+    centre = lists.centre
+    cell_ids = cells.ids
+    cell_n = cells.n
+    box = space.box
+    ncell = space.ncell
+    period = space.period
     cap = scratch.shape[0]
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
     cut_max = ri + rmax + shell
     cut_max2 = cut_max * cut_max
-    ns = _reach(x, y, z, cut_max, box, ncell, stencil)
+    ns = _reach(x, y, z, cut_max, space, stencil)
     for k in range(ns):
         prefetch(cell_ids, stencil[k] >> 5)
     for k in range(ns):
@@ -231,9 +257,9 @@ def _collect(i, x, y, z, ri, rmax, m, centre, rec, shell, box, ncell, cell_ids, 
         j = scratch[k]
         cut = ri + rec[j, 7] + shell
         if cut < cut_max:
-            dx = min_image(x - centre[j, 0], box[0])
-            dy = min_image(y - centre[j, 1], box[1])
-            dz = min_image(z - centre[j, 2], box[2])
+            dx = min_image(x - centre[j, 0], period[0])
+            dy = min_image(y - centre[j, 1], period[1])
+            dz = min_image(z - centre[j, 2], period[2])
             if dx * dx + dy * dy + dz * dz >= cut * cut:
                 continue
         if found >= m:
@@ -243,21 +269,21 @@ def _collect(i, x, y, z, ri, rmax, m, centre, rec, shell, box, ncell, cell_ids, 
     return found
 
 
-@jit
-def prefetch_cells(x, y, z, cut, box, ncell, cell_ids, cell_n, stencil):
+@kernel
+def prefetch_cells(x, y, z, cut, space, cells, stencil):
     """Prefetch hints for the cell rows a list rebuild around (x, y, z) will read.
 
     (x, y, z) may lie up to shell/2 outside the box; cell_coord clamps it.
     ``stencil`` is scratch space.
     """
-    ns = _reach(x, y, z, cut, box, ncell, stencil)
+    ns = _reach(x, y, z, cut, space, stencil)
     for k in range(ns):
         c = stencil[k] >> 5
-        prefetch(cell_ids, c)
-        prefetch(cell_n, c)
+        prefetch(cells.ids, c)
+        prefetch(cells.n, c)
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def _wrap(c, n):
     if c < 0:
         return c + n
@@ -266,7 +292,7 @@ def _wrap(c, n):
     return c
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def _shift(c, n, length):
     """Periodic offset of unwrapped cell coordinate c: the cell's contents sit at x + shift."""
     if c < 0:
@@ -276,7 +302,7 @@ def _shift(c, n, length):
     return 0.0
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def _contains(a, row, n, v):
     for k in range(n):
         if a[row, k] == v:
@@ -284,7 +310,7 @@ def _contains(a, row, n, v):
     return False
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def _in(a, n, v):
     for k in range(n):
         if a[k] == v:
@@ -292,9 +318,8 @@ def _in(a, n, v):
     return False
 
 
-@jit
-def rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell_of,
-                 nbl, nbn, scratch, stencil):
+@kernel
+def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     """New list centre c_i = r_i and a new neighbour list for particle i.
 
     Only the differences to the old list touch other particles' lists: i is
@@ -303,16 +328,22 @@ def rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell
     list or a cell would overflow (returns OVERFLOW or CELL_OVERFLOW); the
     caller enlarges ``nbl`` or ``cell_ids`` and calls again. Returns 0 on success.
     """
+    centre = lists.centre
+    nbl = lists.nbl
+    nbn = lists.nbn
+    scratch = lists.scratch
+    cell_ids = cells.ids
+    cell_n = cells.n
+    cell_of = cells.of
     # the new centre, rounded as stored: the cell, the candidates and the expiry all use it
     x = np.float64(np.float32(rec[i, 0]))
     y = np.float64(np.float32(rec[i, 1]))
     z = np.float64(np.float32(rec[i, 2]))
-    c = cell_index(x, y, z, box, ncell)
+    c = cell_index(x, y, z, space.box, space.ncell)
     if c != cell_of[i] and cell_n[c] >= cell_ids.shape[1]:
         return CELL_OVERFLOW
     m = nbl.shape[1]
-    count = _collect(i, x, y, z, rec[i, 7], rmax, m, centre, rec, shell, box, ncell, cell_ids,
-                     cell_n, scratch, stencil)
+    count = _collect(i, x, y, z, rec[i, 7], rmax, m, shell, rec, lists, cells, space)
     if count < 0:  # more than m found (or scratch too short)
         return OVERFLOW
     nold = nbn[i]
@@ -353,14 +384,23 @@ def rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell
     return 0
 
 
-@jit
-def build_all_lists(r, centre, rec, shell, box, ncell, cell_ids, cell_n, cell_of,
-                    nbl, nbn):
+@kernel
+def build_all_lists(r, rec, lists, cells, space, shell):
     """Centres = positions ``r`` (= rec[:, :3], stored as float32), cells and all lists from scratch.
 
-    Returns 0, CELL_OVERFLOW if some cell holds more than ``cell_ids.shape[1]``
-    particles, or OVERFLOW if some list exceeds ``nbl.shape[1]``.
+    Returns 0, CELL_OVERFLOW if some cell holds more than ``cells.ids.shape[1]``
+    particles, or OVERFLOW if some list exceeds ``lists.nbl.shape[1]``.
     """
+    centre = lists.centre
+    nbl = lists.nbl
+    nbn = lists.nbn
+    cell_ids = cells.ids
+    cell_n = cells.n
+    cell_of = cells.of
+    box = space.box
+    ncell = space.ncell
+    period = space.period
+    zr = 1 if ncell[2] >= 3 else 0
     n = r.shape[0]
     m = nbl.shape[1]
     cell_n[:] = 0
@@ -383,13 +423,21 @@ def build_all_lists(r, centre, rec, shell, box, ncell, cell_ids, cell_n, cell_of
         cy = cell_coord(yi, box[1], ncell[1])
         cz = cell_coord(zi, box[2], ncell[2])
         for k in range(stencil_size(ncell)):
-            c = stencil_cell(cx, cy, cz, k, ncell)
+            # the k-th neighbour cell (stencil_cell), or none beyond a wall
+            ux = cx + k % 3 - 1
+            uy = cy + (k // 3) % 3 - 1
+            uz = cz + k // 9 - zr
+            if ((ux < 0 or ux >= ncell[0]) and period[0] == math.inf
+                    or (uy < 0 or uy >= ncell[1]) and period[1] == math.inf
+                    or (uz < 0 or uz >= ncell[2]) and period[2] == math.inf):
+                continue
+            c = _wrap(ux, ncell[0]) + ncell[0] * (_wrap(uy, ncell[1]) + ncell[1] * _wrap(uz, ncell[2]))
             for q in range(cell_n[c]):
                 j = cell_ids[c, q]
                 if j > i:
-                    dx = min_image(xi - centre[j, 0], box[0])
-                    dy = min_image(yi - centre[j, 1], box[1])
-                    dz = min_image(zi - centre[j, 2], box[2])
+                    dx = min_image(xi - centre[j, 0], period[0])
+                    dy = min_image(yi - centre[j, 1], period[1])
+                    dz = min_image(zi - centre[j, 2], period[2])
                     cut = rec[i, 7] + rec[j, 7] + shell
                     if dx * dx + dy * dy + dz * dz < cut * cut:
                         if nbn[i] >= m or nbn[j] >= m:

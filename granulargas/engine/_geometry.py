@@ -1,8 +1,11 @@
-"""Compiled geometry of free flight in a periodic box (numba leaf module).
+"""Compiled geometry of free flight between events (numba leaf module).
 
 Particles move on straight lines between events. Internally every system is
 three-dimensional: a 2D system has z = 0, v_z = 0 and one cell layer, so the
-same kernels (one compiled signature) serve disks and spheres.
+same kernels (one compiled signature) serve disks and spheres. Each axis is
+periodic (period L: minimum image, wrap) or bounded by flat hard walls at 0 and
+L; a wall axis has period inf, for which the minimum image and the wrap are the
+identity, so the same code serves both at no cost.
 
 Pair collision time (free flight, relative position dr, relative velocity dv,
 contact distance sigma = R_i + R_j): the smallest s >= 0 with
@@ -19,10 +22,10 @@ that overlaps and recedes is left alone: it separates.
 
 import math
 
-from granulargas._numba import jit
+from granulargas._numba import kernel
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def min_image(dx, length):
     """Nearest periodic image of a coordinate difference with |dx| < 1.5 L."""
     half = 0.5 * length
@@ -33,7 +36,7 @@ def min_image(dx, length):
     return dx
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def collision_delay(dx, dy, dz, ux, uy, uz, sigma):
     """Time until contact of a pair, or inf.
 
@@ -68,7 +71,7 @@ def collision_delay(dx, dy, dz, ux, uy, uz, sigma):
     return s if hit else math.inf
 
 
-@jit(inline="always")
+@kernel(inline="always")
 def exit_delay(dx, dy, dz, vx, vy, vz, radius):
     """Time until a particle at offset d from its list centre is at distance ``radius``.
 
@@ -86,3 +89,21 @@ def exit_delay(dx, dy, dz, vx, vy, vz, radius):
     if b >= 0.0:
         return c / (b + q)
     return (q - b) / v2
+
+
+@kernel(inline="always")
+def wall_delay(x, v, radius, length):
+    """Time until a sphere at coordinate x, moving at v along a wall axis, touches a wall.
+
+    The walls are the planes 0 and ``length``; contact at x = R (lower, v < 0) or
+    x = L - R (upper, v > 0). Returns (delay, side) with side 0 (lower) or 1
+    (upper); delay inf for v = 0, 0 for a sphere already touching (round-off)
+    and moving into the wall.
+    """
+    if v < 0.0:
+        gap = x - radius
+        return (gap / -v if gap > 0.0 else 0.0), 0
+    if v > 0.0:
+        gap = length - radius - x
+        return (gap / v if gap > 0.0 else 0.0), 1
+    return math.inf, 0

@@ -1,13 +1,33 @@
-"""The compiled event loop (numba): pop, validate, execute, re-predict.
+"""The compiled event loop (numba): pop, validate, dispatch; one place per event kind.
 
 One event per particle (Smallenburg 2022; Paul 2007): particle i stores the
-earliest of (a) its predicted collision with a particle of its neighbour list
-and (b) the moment it leaves the sphere of radius shell/2 around its list
-centre ("list expiry"). The event records the partner's collision counter at
-prediction time; a popped event whose partner has collided since is stale and
-is simply re-predicted. A pair collision needs to be scheduled by only one of
-the two: whichever changes its velocity first re-predicts against all its
-neighbours, the other included.
+earliest of its own events -- a collision with a particle of its neighbour
+list, the moment it leaves the sphere of radius shell/2 around its list centre
+("list expiry"), or a collision with a wall -- in its slot of
+:class:`~granulargas.engine._state.Events`: ``partner[i]`` is the partner's slot
+(>= 0) or the kind code of a one-particle event (< 0), ``tag[i]`` the partner's
+collision counter at prediction time (pair) or the wall index (wall). A popped
+pair event whose partner has collided since is stale and is simply
+re-predicted. A pair collision needs to be scheduled by only one of the two:
+whichever changes its velocity first re-predicts against all its neighbours,
+the other included. The white-noise driving is a global event source: every
+particle is kicked at the times (k + 1/2) dt_k; :func:`advance_driven` runs the
+loop up to each driving step and executes it, so that the loop of an undriven run
+carries no trace of it.
+
+Event kinds, each with one predict and one execute function here:
+
+=========  ====  =======================  ==========================
+kind       code  predict                  execute
+=========  ====  =======================  ==========================
+PAIR       >= 0  :func:`predict_pair`     :func:`execute_pair`
+EXPIRY     -1    :func:`predict_expiry`   :func:`execute_expiry`
+WALL       -2    :func:`predict_wall`     :func:`execute_wall`
+KICK       -3    :func:`predict_kick`     :func:`execute_kick`
+=========  ====  =======================  ==========================
+
+(STALE, -4, is what validation makes of a pair event whose partner changed
+course.) :func:`predict` keeps the earliest of a particle's own kinds.
 
 Particles stream lazily: each carries its own clock and is moved to the
 current time only when it takes part in an event. The data a prediction reads
@@ -20,18 +40,17 @@ misses, and the design counts cache lines: the event calendar
 (:mod:`granulargas.engine._calendar`) updates in O(1) lines instead of a heap's
 O(log N) dependent misses; a list rebuild reads cell rows and centres in
 independent passes (:mod:`granulargas.engine._cells`); and after each event
-the loop issues prefetch hints (:mod:`granulargas.engine._prefetch`, no effect
-on results) for every per-particle row of the next event's particle and its
-partner, the records of its neighbours, and the rows of the likely event after
-it (the earliest child of the small heap's root, passing over the event of the
-next particle's partner, which the next collision re-predicts: that guess is
-right for 97-98 % of events, ``scripts/profile_loop.py``), so that
-these misses overlap with the current work; before a list expiry it also
-prefetches the cell rows around the particle and its neighbours' list rows.
-Where the time goes per part of the loop: ``python scripts/profile_loop.py 1e4
-1e6`` (cycle counters); two source trees compared by alternated runs:
-``python scripts/bench_ab.py OTHER_TREE . --sizes 1e4 1e6``; the numbers are in
-docs/performance.md.
+:func:`prefetch_next` issues prefetch hints (no effect on results) for every
+per-particle row of the next event's particle and its partner, the records of
+its neighbours, and the rows of the likely event after it
+(:func:`granulargas.engine._calendar.cal_after_next`: right for 97-98 % of
+events, ``scripts/profile_loop.py``), so that these misses overlap with the
+current work; before a list expiry it also prefetches the cell rows around the
+particle and its neighbours' list rows. Where the time goes per part of the
+loop: ``python scripts/profile_loop.py 1e4 1e6`` (cycle counters compiled into
+a second build of this loop, :mod:`granulargas.engine._probe`); two source
+trees compared by alternated runs: ``python scripts/bench_ab.py OTHER_TREE .
+--sizes 1e4 1e6``; the numbers are in docs/performance.md.
 
 Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 0 reached ``until``; 1 event budget of this chunk used (call again);
@@ -47,13 +66,36 @@ import math
 
 import numpy as np
 
-from granulargas._numba import jit
+from granulargas._numba import kernel
+from granulargas.engine._calendar import (
+    cal_after_next,
+    cal_build,
+    cal_look_ahead,
+    cal_next_time,
+    cal_peek,
+    cal_update,
+)
 from granulargas.engine._cells import prefetch_cells, rebuild_list
-from granulargas.engine._collide import restitution
-from granulargas.engine._geometry import collision_delay, exit_delay, min_image
+from granulargas.engine._collide import pair_collision, restitution, wall_collision
+from granulargas.engine._drive import kick_velocities
+from granulargas.engine._geometry import collision_delay, exit_delay, min_image, wall_delay
 from granulargas.engine._prefetch import prefetch
-from granulargas.engine._calendar import cal_look_ahead, cal_peek, cal_update
+from granulargas.engine._probe import (
+    COLLIDE,
+    PEEK,
+    POP,
+    PREDICT,
+    PREFETCH,
+    REBUILD,
+    STALE as P_STALE,
+    UPDATE,
+    WALL as P_WALL,
+    probe as tick,
+    probe_guess,
+    probe_start,
+)
 
+# status codes
 DONE = 0
 BUDGET = 1
 MAX_COLLISIONS = 2
@@ -62,55 +104,46 @@ TABLE_RANGE = 21
 WATCHDOG = 30
 CALENDAR = 31
 
-# indices into the float and int scalar arrays
-S_TIME, S_DISSIPATED, S_VIRIAL, S_KIN_INT, S_SUM_MV2 = 0, 1, 2, 3, 4
-I_COLLISIONS, I_EVENTS, I_ERR_I, I_ERR_J, I_EXPIRIES, I_STALE = 0, 1, 2, 3, 4, 5
-# indices into the float parameter array
-P_EPS, P_TC, P_PREFACTOR, P_INV_H, P_SHELL, P_COLLAPSE_DT, P_RMAX = 0, 1, 2, 3, 4, 5, 6
-# columns of a particle record
-T_COL, R_COL = 6, 7
+# event kinds
+PAIR = 0
+EXPIRY = -1
+WALL = -2
+KICK = -3
+STALE = -4
 
 
-@jit(inline="always")
-def stream(i, t, rec, img, box):
-    """Move particle i on its straight line to time t, wrapping into the box."""
+@kernel(inline="always")
+def stream(i, t, rec, img, period):
+    """Move particle i on its straight line to time t, wrapping on periodic axes."""
     dt = t - rec[i, 6]
     for a in range(3):
         x = rec[i, a] + rec[i, 3 + a] * dt
-        if x >= box[a]:
-            x -= box[a]
+        if x >= period[a]:
+            x -= period[a]
             img[i, a] += 1
         elif x < 0.0:
-            x += box[a]
+            x += period[a]
             img[i, a] -= 1
         rec[i, a] = x
     rec[i, 6] = t
 
 
-@jit(inline="always")
-def _prefetch_particle(i, rec, img, centre, mass, count, pcount, lastcoll, rapid, nbl, nbn,
-                       partner, qt, qwhere):
-    """Prefetch hints for the per-particle rows an event of particle i touches (not
-    ``img``, which only a wrap through the box writes)."""
-    prefetch(rec, i)
-    prefetch(centre, i)
-    prefetch(mass, i)
-    prefetch(count, i)
-    prefetch(pcount, i)
-    prefetch(lastcoll, i)
-    prefetch(rapid, i)
-    prefetch(nbl, i)
-    prefetch(nbn, i)
-    prefetch(partner, i)
-    prefetch(qt, i)
-    prefetch(qwhere, i)
+# --------------------------------------------------------------------- predict
+@kernel(inline="always")
+def predict_expiry(i, t, rec, centre, period, half_shell):
+    """Time at which particle i (streamed to t) is ``half_shell`` from its list centre."""
+    return t + exit_delay(min_image(rec[i, 0] - centre[i, 0], period[0]),
+                          min_image(rec[i, 1] - centre[i, 1], period[1]),
+                          min_image(rec[i, 2] - centre[i, 2], period[2]),
+                          rec[i, 3], rec[i, 4], rec[i, 5], half_shell)
 
 
-@jit
-def predict(i, t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell):
-    """Earliest event of particle i (streamed to t): collision or list expiry.
+@kernel(inline="always")
+def predict_pair(i, t, before, rec, nbl, nbn, period):
+    """Earliest collision of particle i (streamed to t) with its neighbours before ``before``.
 
-    Sets ``partner[i]`` (-1 for expiry) and ``pcount[i]``; returns the time.
+    Returns (time, partner slot), or (``before``, -1) if there is none. Branch-free
+    over the neighbours (see :func:`granulargas.engine._geometry.collision_delay`).
     """
     xi = rec[i, 0]
     yi = rec[i, 1]
@@ -119,271 +152,461 @@ def predict(i, t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell
     vy = rec[i, 4]
     vz = rec[i, 5]
     ri = rec[i, 7]
-    best = t + exit_delay(min_image(xi - centre[i, 0], box[0]),
-                          min_image(yi - centre[i, 1], box[1]),
-                          min_image(zi - centre[i, 2], box[2]), vx, vy, vz, half_shell)
+    best = before
     p = -1
     for k in range(nbn[i]):
         j = nbl[i, k]
         dtj = t - rec[j, 6]
-        s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), box[0]),
-                            min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), box[1]),
-                            min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), box[2]),
+        s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), period[0]),
+                            min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), period[1]),
+                            min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), period[2]),
                             vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
         tc = t + s
         better = tc < best
         best = tc if better else best
         p = j if better else p
-    partner[i] = p
-    pcount[i] = count[p] if p >= 0 else 0
+    return best, p
+
+
+@kernel(inline="always")
+def predict_wall(i, t, rec, space):
+    """Earliest wall collision of particle i (streamed to t): (time, wall index 2 a + side).
+
+    (inf, 0) without wall axes.
+    """
+    best = math.inf
+    wall = 0
+    axes = space.wall_axes
+    for k in range(axes.shape[0]):
+        a = axes[k]
+        s, side = wall_delay(rec[i, a], rec[i, 3 + a], rec[i, 7], space.box[a])
+        if s < best:
+            best = s
+            wall = 2 * a + side
+    return t + best, wall
+
+
+@kernel(inline="always")
+def predict_kick(c, prm):
+    """Time of the next driving step, (k + 1/2) dt_k (inf without driving)."""
+    return (c.kick_step + 0.5) * prm.kick_interval if prm.kick_interval < math.inf else math.inf
+
+
+@kernel
+def predict(i, t, rec, count, events, lists, space, half_shell):
+    """Earliest event of particle i (streamed to t); sets its slot and returns the time."""
+    best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
+    best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
+    tag = count[p] if p >= 0 else 0
+    tw, wall = predict_wall(i, t, rec, space)
+    if tw < best:
+        best = tw
+        p = WALL
+        tag = wall
+    events.partner[i] = p
+    events.tag[i] = tag
     return best
 
 
-@jit
-def predict_all(t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell, times):
+@kernel
+def predict_all(t, rec, count, events, lists, space, half_shell, times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
     for i in range(rec.shape[0]):
-        times[i] = predict(i, t, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
+        times[i] = predict(i, t, rec, count, events, lists, space, half_shell)
 
 
-@jit
-def advance(rec, img, centre, mass, count, partner, pcount, lastcoll, rapid,
-            nbl, nbn, scratch, stencil, cell_ids, cell_n, cell_of,
-            qt, chunks, qwhere, small, buckets, qi, qf,
-            box, ncell, kind, fpar, coeffs, collapse_count, until, max_events, max_collisions,
-            scal, iscal):
+# --------------------------------------------------------------------- execute
+@kernel(inline="always")
+def _collapse_watch(i, te, p, prm):
+    """Count runs of ever faster re-collisions of particle i; note the collision time."""
+    if te - p.lastcoll[i] < prm.collapse_dt:
+        p.rapid[i] += 1
+    else:
+        p.rapid[i] = 0
+    p.lastcoll[i] = te
+
+
+@kernel(inline="always")
+def execute_pair(i, j, te, p, ev, lists, cal, c, prm):
+    """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
+
+    Returns DONE, or TABLE_RANGE / COLLAPSE / CALENDAR (``c.err_i``, ``c.err_j`` set).
+    """
+    rec = p.rec
+    period = prm.space.period
+    rule = prm.rule
+    nbl = lists.nbl
+    for k in range(lists.nbn[j]):  # j's list row is in cache: start the misses of predict(j)
+        prefetch(rec, nbl[j, k])
+    stream(i, te, rec, p.img, period)
+    stream(j, te, rec, p.img, period)
+    dx = min_image(rec[i, 0] - rec[j, 0], period[0])
+    dy = min_image(rec[i, 1] - rec[j, 1], period[1])
+    dz = min_image(rec[i, 2] - rec[j, 2], period[2])
+    ux = rec[i, 3] - rec[j, 3]
+    uy = rec[i, 4] - rec[j, 4]
+    uz = rec[i, 5] - rec[j, 5]
+    b = dx * ux + dy * uy + dz * uz
+    if b >= 0.0:  # receding (round-off): nothing happens
+        return DONE
+    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+    inv = 1.0 / dist
+    nx = dx * inv
+    ny = dy * inv
+    nz = dz * inv
+    un = b * inv  # normal relative velocity, < 0
+    mi = p.mass[i]
+    mj = p.mass[j]
+    lastcoll = p.lastcoll
+    if rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time):
+        eps = 1.0
+    else:
+        r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
+        eps = restitution(rule.kind, rule.eps, rule.prefactor, rule.inv_h, rule.coeffs, -un,
+                          r_eff, mi * mj / (mi + mj))
+        if eps < 0.0:
+            c.err_i = i
+            c.err_j = j
+            return TABLE_RANGE
+    fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
+    rec[i, 3] -= fi * nx
+    rec[i, 4] -= fi * ny
+    rec[i, 5] -= fi * nz
+    rec[j, 3] += fj * nx
+    rec[j, 4] += fj * ny
+    rec[j, 5] += fj * nz
+    c.dissipated += loss
+    c.sum_mv2 -= 2.0 * loss
+    c.virial -= impulse * dist
+    p.count[i] += 1
+    p.count[j] += 1
+    c.collisions += 1
+    _collapse_watch(i, te, p, prm)
+    _collapse_watch(j, te, p, prm)
+    tj = predict(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+    if not cal_update(j, tj, cal):
+        return CALENDAR
+    if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
+        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+        status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
+        c.events += 1
+        c.err_i = i
+        c.err_j = j
+        return status
+    return DONE
+
+
+@kernel(inline="always")
+def execute_expiry(i, te, p, lists, cells, c, prm):
+    """List expiry of i at te: a new list centre and neighbour list (OVERFLOW/CELL_OVERFLOW
+    if a list or a cell is full: nothing changed, the driver enlarges and calls again)."""
+    stream(i, te, p.rec, p.img, prm.space.period)
+    st = rebuild_list(i, p.rec, lists, cells, prm.space, prm.rmax, prm.shell)
+    if st != 0:
+        c.err_i = i
+        c.err_j = -1
+        return st
+    c.expiries += 1
+    return DONE
+
+
+@kernel(inline="always")
+def execute_wall(i, wall, te, p, c, walls, prm):
+    """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
+    m_eff = m_i. Returns DONE or TABLE_RANGE."""
+    rec = p.rec
+    rule = prm.rule
+    stream(i, te, rec, p.img, prm.space.period)
+    a = wall >> 1
+    side = wall & 1
+    vn = rec[i, 3 + a]
+    if (vn < 0.0) if side == 0 else (vn > 0.0):  # moving into the wall
+        mi = p.mass[i]
+        if rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time:
+            eps = 1.0
+        else:
+            eps = restitution(rule.kind, rule.wall_eps, rule.prefactor, rule.inv_h, rule.coeffs,
+                              abs(vn), rec[i, 7], mi)
+            if eps < 0.0:
+                c.err_i = i
+                c.err_j = -1
+                return TABLE_RANGE
+        v_new, loss, impulse = wall_collision(vn, mi, eps)
+        rec[i, 3 + a] = v_new
+        c.dissipated += loss
+        c.sum_mv2 -= 2.0 * loss
+        walls.impulse[a, side] += impulse
+        p.count[i] += 1
+        c.wall_collisions += 1
+        _collapse_watch(i, te, p, prm)
+        if p.rapid[i] >= prm.collapse_count:
+            c.err_i = i
+            c.err_j = -1
+            return COLLAPSE
+    return DONE
+
+
+@kernel
+def execute_kick(t, p, ev, lists, cal, c, prm):
+    """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1);
+    every event predicted anew and the calendar rebuilt (O(N))."""
+    rec = p.rec
+    n = rec.shape[0]
+    for i in range(n):
+        stream(i, t, rec, p.img, prm.space.period)
+    c.injected += kick_velocities(rec, 3, p.mass, p.ident, prm.space.dims, prm.kick_seed,
+                                  c.kick_step, prm.kick_scale)
+    s = 0.0
+    for i in range(n):
+        s += p.mass[i] * (rec[i, 3] * rec[i, 3] + rec[i, 4] * rec[i, 4] + rec[i, 5] * rec[i, 5])
+    c.sum_mv2 = s
+    c.kick_step += 1
+    c.kicks += 1
+    predict_all(t, rec, p.count, ev, lists, prm.space, prm.half_shell, cal.qt)
+    return DONE if cal_build(t, cal) else CALENDAR
+
+
+# -------------------------------------------------------------------- prefetch
+@kernel(inline="always")
+def _prefetch_particle(i, p, ev, lists, cal):
+    """Prefetch hints for the per-particle rows an event of particle i touches (not
+    ``img``, which only a wrap through the box writes)."""
+    prefetch(p.rec, i)
+    prefetch(lists.centre, i)
+    prefetch(p.mass, i)
+    prefetch(p.count, i)
+    prefetch(ev.tag, i)
+    prefetch(p.lastcoll, i)
+    prefetch(p.rapid, i)
+    prefetch(lists.nbl, i)
+    prefetch(lists.nbn, i)
+    prefetch(ev.partner, i)
+    prefetch(cal.qt, i)
+    prefetch(cal.where, i)
+
+
+@kernel(inline="always")
+def prefetch_next(i1, p, ev, lists, cells, cal, prm):
+    """Prefetch hints for the next event, particle i1 (no effect on results).
+
+    The rows of its partner, the records of its neighbours, for a list expiry the
+    cell rows around it and its neighbours' list rows (the rebuild rewrites the
+    lists of neighbours that leave or join, mostly among the present ones), and
+    the rows of the likely event after it (:func:`cal_after_next`), so that their
+    cache misses overlap with work. Returns the guessed particle of the event
+    after next (-1: none), for the profiler.
+    """
+    rec = p.rec
+    nbl = lists.nbl
+    nbn = lists.nbn
+    p1 = ev.partner[i1]
+    if p1 >= 0:
+        _prefetch_particle(p1, p, ev, lists, cal)
+        prefetch(p.mass, i1)  # the rows only a collision of i1 touches
+        prefetch(p.lastcoll, i1)
+        prefetch(p.rapid, i1)
+        prefetch(p.count, i1)
+    elif p1 == EXPIRY:
+        dt1 = cal_next_time(cal) - rec[i1, 6]
+        prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
+                       rec[i1, 2] + rec[i1, 5] * dt1,
+                       rec[i1, 7] + prm.rmax + prm.shell, prm.space, cells, lists.stencil)
+        for k in range(nbn[i1]):
+            prefetch(nbl, nbl[i1, k])
+            prefetch(nbn, nbl[i1, k])
+        prefetch(cells.of, i1)
+    for k in range(nbn[i1]):
+        prefetch(rec, nbl[i1, k])
+    prefetch(cal.where, i1)
+    i2 = cal_after_next(cal, p1)
+    if i2 >= 0:
+        prefetch(rec, i2)
+        prefetch(nbl, i2)
+        prefetch(nbn, i2)
+        prefetch(ev.partner, i2)
+        prefetch(ev.tag, i2)
+        prefetch(lists.centre, i2)
+    return i2
+
+
+# ------------------------------------------------------------------------ loop
+@kernel
+def advance(engine, prm, until, max_events, max_collisions, probe):
     """Process events in time order until ``until`` (or a budget); see module doc.
 
-    ``scal`` = [time, dissipated energy, collisional virial sum, integral of
-    sum m v^2 dt, sum m v^2]; ``iscal`` = [collisions, events, i, j of an
-    error, list expiries, stale events]. Returns a status code.
+    Parameters
+    ----------
+    engine : Engine
+        The state (:mod:`granulargas.engine._state`), changed in place; its
+        counters record carries the time, observables sums and event counts.
+    prm : Params
+        Rule, geometry, list and driving parameters.
+    until : float
+        Process every event with time <= until; then time = until (status DONE).
+    max_events : int
+        Event budget of this call (status BUDGET when used).
+    max_collisions : int
+        Stop right after the pair collision that makes ``collisions`` reach it.
+    probe : None or int64 array
+        None: the production build. An array of :data:`_probe.PROBE_SIZE`
+        compiles the cycle counters in (``scripts/profile_loop.py``).
+
+    Returns
+    -------
+    int
+        Status code (module doc).
     """
-    eps_const = fpar[P_EPS]
-    tc_time = fpar[P_TC]
-    prefactor = fpar[P_PREFACTOR]
-    inv_h = fpar[P_INV_H]
-    shell = fpar[P_SHELL]
-    half_shell = 0.5 * shell * (1.0 - 1e-9)  # margin against round-off in |r - c|
-    collapse_dt = fpar[P_COLLAPSE_DT]
-    rmax = fpar[P_RMAX]
-    time = scal[S_TIME]
+    p = engine.particles
+    ev = engine.events
+    lists = engine.lists
+    cells = engine.cells
+    cal = engine.calendar
+    c = engine.counters[0]
+    walls = engine.walls
+    rec = p.rec
+    time = c.time
     zero_advance = 0
     zero_limit = 1000 + rec.shape[0]
-    events_end = iscal[I_EVENTS] + max_events
+    events_end = c.events + max_events
     status = DONE
+    clock = probe_start(probe)
+    guess = -1  # the prefetch's guess of the event after next (checked by the profiler)
+    pending = -1
     while True:
-        if iscal[I_EVENTS] >= events_end:
+        if c.events >= events_end:
             status = BUDGET
             break
-        i = cal_peek(qt, chunks, qwhere, small, buckets, qi, qf)
+        # ---- pop
+        i = cal_peek(cal)
         if i < 0:
             if i == -2:
                 status = CALENDAR
             break
-        te = small[0, 0]  # = qt[i]: the heap root's copy, in cache
+        te = cal_next_time(cal)  # = qt[i]: the heap root's copy
         if te > until or te == math.inf:
             break
+        # ---- validate: time order, no endless zero-time streaks
         if te <= time:
             if te < time:
-                iscal[I_ERR_I] = i
-                iscal[I_ERR_J] = partner[i]
+                c.err_i = i
+                c.err_j = ev.partner[i]
                 status = WATCHDOG
                 break
             zero_advance += 1
             if zero_advance > zero_limit:
-                iscal[I_ERR_I] = i
-                iscal[I_ERR_J] = partner[i]
+                c.err_i = i
+                c.err_j = ev.partner[i]
                 status = WATCHDOG
                 break
         else:
             zero_advance = 0
-        scal[S_KIN_INT] += scal[S_SUM_MV2] * (te - time)
+        c.kin_int += c.sum_mv2 * (te - time)
         time = te
-        j = np.int64(partner[i])  # one signature for the callees (partner is int32)
-        if j >= 0 and count[j] == pcount[i]:
-            # ---- pair collision: validate, execute, re-predict both
-            for k in range(nbn[j]):  # j's list row is in cache: start the misses of predict(j)
-                prefetch(rec, nbl[j, k])
-            stream(i, te, rec, img, box)
-            stream(j, te, rec, img, box)
-            dx = min_image(rec[i, 0] - rec[j, 0], box[0])
-            dy = min_image(rec[i, 1] - rec[j, 1], box[1])
-            dz = min_image(rec[i, 2] - rec[j, 2], box[2])
-            ux = rec[i, 3] - rec[j, 3]
-            uy = rec[i, 4] - rec[j, 4]
-            uz = rec[i, 5] - rec[j, 5]
-            b = dx * ux + dy * uy + dz * uz
-            if b < 0.0:
-                dist = math.sqrt(dx * dx + dy * dy + dz * dz)
-                inv = 1.0 / dist
-                nx = dx * inv
-                ny = dy * inv
-                nz = dz * inv
-                un = b * inv  # normal relative velocity, < 0
-                mi = mass[i]
-                mj = mass[j]
-                msum = mi + mj
-                m_eff = mi * mj / msum
-                if tc_time > 0.0 and (te - lastcoll[i] < tc_time or te - lastcoll[j] < tc_time):
-                    eps = 1.0
-                else:
-                    r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
-                    eps = restitution(kind, eps_const, prefactor, inv_h, coeffs, -un, r_eff,
-                                      m_eff)
-                    if eps < 0.0:
-                        iscal[I_ERR_I] = i
-                        iscal[I_ERR_J] = j
-                        status = TABLE_RANGE
-                        break
-                f = (1.0 + eps) * un / msum
-                fi = f * mj
-                fj = f * mi
-                rec[i, 3] -= fi * nx
-                rec[i, 4] -= fi * ny
-                rec[i, 5] -= fi * nz
-                rec[j, 3] += fj * nx
-                rec[j, 4] += fj * ny
-                rec[j, 5] += fj * nz
-                de = 0.5 * (1.0 - eps * eps) * m_eff * un * un
-                scal[S_DISSIPATED] += de
-                scal[S_SUM_MV2] -= 2.0 * de
-                scal[S_VIRIAL] -= (1.0 + eps) * m_eff * un * dist
-                count[i] += 1
-                count[j] += 1
-                iscal[I_COLLISIONS] += 1
-                # inelastic collapse watch: runs of ever faster re-collisions
-                if te - lastcoll[i] < collapse_dt:
-                    rapid[i] += 1
-                else:
-                    rapid[i] = 0
-                if te - lastcoll[j] < collapse_dt:
-                    rapid[j] += 1
-                else:
-                    rapid[j] = 0
-                lastcoll[i] = te
-                lastcoll[j] = te
-                tj = predict(j, te, rec, centre, count, nbl, nbn, partner, pcount, box,
-                             half_shell)
-                if not cal_update(j, tj, qt, chunks, qwhere, small, buckets, qi, qf):
-                    status = CALENDAR
-                    break
-                if rapid[i] >= collapse_count or rapid[j] >= collapse_count:
-                    ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box,
-                                 half_shell)
-                    if not cal_update(i, ti, qt, chunks, qwhere, small, buckets, qi, qf):
-                        status = CALENDAR
-                    iscal[I_EVENTS] += 1
-                    iscal[I_ERR_I] = i
-                    iscal[I_ERR_J] = j
-                    status = COLLAPSE
-                    break
-        elif j < 0:
-            # ---- list expiry: new centre and list for i
-            stream(i, te, rec, img, box)
-            st = rebuild_list(i, rec, centre, rmax, shell, box, ncell, cell_ids, cell_n, cell_of,
-                              nbl, nbn, scratch, stencil)
-            if st != 0:
-                iscal[I_ERR_I] = i
-                iscal[I_ERR_J] = -1
-                status = st
+        j = np.int64(ev.partner[i])  # one signature for the callees (partner is int32)
+        probe_guess(probe, i == pending)
+        clock = tick(probe, POP, clock)
+        # ---- dispatch
+        if j >= 0 and p.count[j] == ev.tag[i]:
+            status = execute_pair(i, j, te, p, ev, lists, cal, c, prm)
+            clock = tick(probe, COLLIDE, clock)
+            if status != DONE:
                 break
-            iscal[I_EXPIRIES] += 1
+        elif j == EXPIRY:
+            status = execute_expiry(i, te, p, lists, cells, c, prm)
+            clock = tick(probe, REBUILD, clock)
+            if status != DONE:
+                break
+        elif j == WALL:
+            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm)
+            clock = tick(probe, P_WALL, clock)
+            if status != DONE:
+                if status == COLLAPSE:
+                    ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+                    if not cal_update(i, ti, cal):
+                        status = CALENDAR
+                    c.events += 1
+                break
         else:
             # ---- stale event: the partner changed course; just re-predict
-            stream(i, te, rec, img, box)
-            iscal[I_STALE] += 1
-        ti = predict(i, te, rec, centre, count, nbl, nbn, partner, pcount, box, half_shell)
-        if not cal_update(i, ti, qt, chunks, qwhere, small, buckets, qi, qf):
+            stream(i, te, rec, p.img, prm.space.period)
+            c.stale += 1
+            clock = tick(probe, P_STALE, clock)
+        # ---- re-predict the particle of the event
+        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+        clock = tick(probe, PREDICT, clock)
+        if not cal_update(i, ti, cal):
             status = CALENDAR
             break
-        iscal[I_EVENTS] += 1
-        # ---- prefetch hints (no effect on results): the next event's partner and
-        # neighbour records, and the rows of the likely event after it (the earliest
-        # child of the root), so that their cache misses overlap with work
-        i1 = cal_peek(qt, chunks, qwhere, small, buckets, qi, qf)
+        c.events += 1
+        clock = tick(probe, UPDATE, clock)
+        # ---- prefetch hints for the next events (no effect on results)
+        i1 = cal_peek(cal)
+        clock = tick(probe, PEEK, clock)
         if i1 == -2:
             status = CALENDAR
             break
-        cal_look_ahead(qt, chunks, qwhere, qi)
+        cal_look_ahead(cal)
+        pending = guess
+        guess = -1
         if i1 >= 0:
-            p1 = partner[i1]
-            if p1 >= 0:
-                _prefetch_particle(p1, rec, img, centre, mass, count, pcount, lastcoll, rapid,
-                                   nbl, nbn, partner, qt, qwhere)
-                prefetch(mass, i1)  # the rows only a collision of i1 touches
-                prefetch(lastcoll, i1)
-                prefetch(rapid, i1)
-                prefetch(count, i1)
-            else:
-                dt1 = small[0, 0] - rec[i1, 6]  # small[0, 0] = qt[i1]
-                prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
-                               rec[i1, 2] + rec[i1, 5] * dt1,
-                               rec[i1, 7] + rmax + shell, box, ncell, cell_ids, cell_n, stencil)
-                # the rebuild rewrites the lists of neighbours that leave or join, mostly
-                # among the present ones, and moves i1's cell slot
-                for k in range(nbn[i1]):
-                    prefetch(nbl, nbl[i1, k])
-                    prefetch(nbn, nbl[i1, k])
-                prefetch(cell_of, i1)
-            for k in range(nbn[i1]):
-                prefetch(rec, nbl[i1, k])
-            prefetch(qwhere, i1)
-            # the event after i1: the earliest child of the root, except the event of
-            # i1's partner, which i1's collision re-predicts (often the partner's copy of
-            # the same collision, equal in time up to round-off); then that node's
-            # children are candidates too
-            size = qi[0]
-            c2 = -1
-            t2 = math.inf
-            cp = -1
-            for q in range(1, min(5, size)):
-                if small[q, 1] == p1:
-                    cp = q
-                elif small[q, 0] < t2:
-                    t2 = small[q, 0]
-                    c2 = q
-            if cp > 0:
-                for q in range(4 * cp + 1, min(4 * cp + 5, size)):
-                    if small[q, 0] < t2:
-                        t2 = small[q, 0]
-                        c2 = q
-            if c2 > 0:
-                i2 = int(small[c2, 1])
-                prefetch(rec, i2)
-                prefetch(nbl, i2)
-                prefetch(nbn, i2)
-                prefetch(partner, i2)
-                prefetch(pcount, i2)
-                prefetch(centre, i2)
-        if iscal[I_COLLISIONS] >= max_collisions:
+            guess = prefetch_next(i1, p, ev, lists, cells, cal, prm)
+        clock = tick(probe, PREFETCH, clock)
+        if c.collisions >= max_collisions:
             status = MAX_COLLISIONS
             break
-    scal[S_TIME] = time
+    c.time = time
     if status == DONE and until < math.inf:
-        scal[S_KIN_INT] += scal[S_SUM_MV2] * (until - time)
-        scal[S_TIME] = until
+        c.kin_int += c.sum_mv2 * (until - time)
+        c.time = until
     return status
 
 
-@jit
-def synchronised(rec, img, box, t, out_r, out_img):
+@kernel
+def advance_driven(engine, prm, until, max_events, max_collisions, probe):
+    """:func:`advance` with the white-noise driving: the driving step is a global event.
+
+    Runs :func:`advance` up to the next driving step (k + 1/2) dt_k (:func:`predict_kick`;
+    events at the same time come first), executes it (:func:`execute_kick`, one
+    event) and goes on, until ``until`` or a budget. A step due at ``until``
+    itself is executed. Same arguments and status codes as :func:`advance`.
+    """
+    c = engine.counters[0]
+    events_end = c.events + max_events
+    while True:
+        t_kick = predict_kick(c, prm)
+        stop = t_kick if t_kick < until else until
+        status = advance(engine, prm, stop, events_end - c.events, max_collisions, probe)
+        if status != DONE or t_kick > until:
+            return status
+        status = execute_kick(c.time, engine.particles, engine.events, engine.lists,
+                              engine.calendar, c, prm)
+        c.events += 1
+        if status != DONE or c.time >= until:
+            return status
+        if c.events >= events_end:
+            return BUDGET
+
+
+@kernel
+def synchronised(rec, img, period, t, out_r, out_img):
     """Positions and images of all particles streamed to time t (no side effect).
 
-    Positions land in [0, L): one wrap suffices because no particle is more than
-    shell/2 from its list centre, which lies in the box.
+    Positions land in [0, L) on periodic axes: one wrap suffices because no
+    particle is more than shell/2 from its list centre, which lies in the box.
+    Wall axes (period inf) are not wrapped.
     """
     for i in range(rec.shape[0]):
         dt = t - rec[i, 6]
         for a in range(3):
             x = rec[i, a] + rec[i, 3 + a] * dt
             k = img[i, a]
-            if x >= box[a]:
-                x -= box[a]
+            if x >= period[a]:
+                x -= period[a]
                 k += 1
             elif x < 0.0:
-                x += box[a]
+                x += period[a]
                 k -= 1
-                if x >= box[a]:  # -tiny + L rounds to L
+                if x >= period[a]:  # -tiny + L rounds to L
                     x = 0.0
                     k += 1
             out_r[i, a] = x

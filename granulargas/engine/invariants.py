@@ -4,8 +4,9 @@
 event calendar order and index; every particle within shell/2 of its list centre; the
 neighbour lists symmetric and complete (every pair with nearest-image centre
 distance below R_i + R_j + shell listed both ways); no two particles
-overlapping beyond round-off; each particle's scheduled event not later than
-its true next collision with any neighbour.
+overlapping beyond round-off; no particle overlapping a wall beyond round-off,
+none with a nonzero image count on a wall axis; each wall event scheduled for
+a particle moving into that wall.
 """
 
 from __future__ import annotations
@@ -15,40 +16,58 @@ import numpy as np
 from granulargas.engine._calendar import cal_check
 
 
-def _min_image(d, box):
-    return d - box * np.round(d / box)
+def _min_image(d, period):
+    """Nearest image of coordinate differences d (..., 3); period inf leaves an axis alone."""
+    finite = np.isfinite(period)
+    p = np.where(finite, period, 1.0)
+    return np.where(finite, d - p * np.round(d / p), d)
 
 
 def check(sim, overlap_tol: float = 1e-9) -> list[str]:
     """Problems found in ``sim``'s internal state (it is built if needed)."""
     if not sim._built:
         sim._build()
-    s = sim._s
-    box = sim._box3
-    t = float(s["scal"][0])
+    e = sim._engine
+    period = sim._space.period
+    t = float(e.counters[0]["time"])
     problems = []
-    if not cal_check(s["qt"], s["chunks"], s["qwhere"], s["small"], s["buckets"], s["qi"], s["qf"]):
+    if not cal_check(e.calendar):
         problems.append("event calendar broken")
-    rec = s["rec"]
+    rec = e.particles.rec
     r = rec[:, :3] + rec[:, 3:6] * (t - rec[:, 6])[:, None]
-    centre = s["centre"].astype(np.float64)
-    off = np.linalg.norm(_min_image(r - centre, box), axis=1)
+    centre = e.lists.centre.astype(np.float64)
+    off = np.linalg.norm(_min_image(r - centre, period), axis=1)
     if np.any(off > 0.5 * sim.shell * (1 + 1e-6)):
         problems.append(f"particle beyond shell/2 of its list centre: max {off.max():.6g}")
     n = len(r)
     rad = rec[:, 7]
-    lists = [set(s["nbl"][i, : s["nbn"][i]].tolist()) for i in range(n)]
+    nbl, nbn = e.lists.nbl, e.lists.nbn
+    lists = [set(nbl[i, : nbn[i]].tolist()) for i in range(n)]
     for i in range(n):
-        dc = np.linalg.norm(_min_image(centre[i] - centre, box), axis=1)
+        dc = np.linalg.norm(_min_image(centre[i] - centre, period), axis=1)
         want = set(np.flatnonzero(dc < rad[i] + rad + sim.shell).tolist()) - {i}
         if not want <= lists[i]:
             problems.append(f"list of {i} misses {sorted(want - lists[i])[:5]}")
         for j in lists[i]:
             if i not in lists[j]:
                 problems.append(f"list asymmetric: {j} in list of {i} but not vice versa")
-        dr = np.linalg.norm(_min_image(r[i] - r, box), axis=1)
+        dr = np.linalg.norm(_min_image(r[i] - r, period), axis=1)
         dr[i] = np.inf
         bad = np.flatnonzero(dr < (rad[i] + rad) * (1 - overlap_tol))
         if len(bad):
             problems.append(f"overlap of {i} with {bad[:5].tolist()}")
+    for a in sim._space.wall_axes:
+        a = int(a)
+        gap = np.minimum(r[:, a] - rad, sim._space.box[a] - rad - r[:, a])
+        bad = np.flatnonzero(gap < -overlap_tol * rad)
+        if len(bad):
+            problems.append(f"overlap with a wall of axis {a}: particles {bad[:5].tolist()}")
+        if np.any(e.particles.img[:, a] != 0):
+            problems.append(f"nonzero image count on wall axis {a}")
+    partner, tag = e.events.partner, e.events.tag
+    for i in np.flatnonzero(partner == -2):
+        a, side = int(tag[i]) >> 1, int(tag[i]) & 1
+        v = rec[i, 3 + a]
+        if not (v < 0 if side == 0 else v > 0):
+            problems.append(f"wall event of {i} for a wall it moves away from")
     return problems

@@ -7,8 +7,10 @@ memory. The internal state (list centres, neighbour lists, cells, one event per
 particle, event calendar) is built from the public state alone at the start of the first
 ``run`` after construction or :meth:`Simulation.synchronise`, which is what
 makes a restart from a file written at a synchronised time bit-identical to
-the uninterrupted run. The driver never loops over particles; between compiled
-chunks it calls ``progress``, grows full neighbour lists and turns status codes
+the uninterrupted run. The compiled state is a set of named records
+(:mod:`granulargas.engine._state`). The driver never loops over particles;
+between compiled chunks it calls ``progress``, grows full neighbour lists,
+removes the centre-of-mass drift that round-off leaves and turns status codes
 into :mod:`granulargas.errors` exceptions.
 """
 
@@ -18,9 +20,11 @@ import math
 
 import numpy as np
 
-from granulargas.engine import _loop
-from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
+from granulargas.engine import _loop, _state
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
+from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
+from granulargas.engine._drive import kick_scale
+from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import (
     ConfigError,
@@ -30,6 +34,8 @@ from granulargas.errors import (
 )
 
 _INT_MAX = np.iinfo(np.int64).max
+#: boundary conditions of an axis
+BOUNDARIES = ("periodic", "wall")
 
 #: Smallest box side in largest diameters: 3 cells per side (so that the 27
 #: neighbour cells are distinct), each one diameter wide plus a neighbour-list
@@ -85,23 +91,27 @@ def morton_order(positions3, box3, ncell):
 
 
 class Simulation:
-    """Event-driven hard spheres (d = 3) or disks (d = 2) in a periodic box.
+    """Event-driven hard spheres (d = 3) or disks (d = 2) in a box, periodic or walled per axis.
 
     Parameters
     ----------
     positions : array (N, d)
-        Positions in units of the reference diameter; wrapped into [0, L).
+        Positions in units of the reference diameter; wrapped into [0, L) on
+        periodic axes; on a wall axis every sphere must lie within
+        [R_i, L - R_i] (no overlap with a wall).
     velocities : array (N, d)
     radii, masses : array (N,)
     box : array (d,)
         Box side lengths L.
     rule : CollisionRule
+        Collision rule of sphere-sphere and sphere-wall collisions.
     time : float
         Current time.
     collisions : int
         Pair collisions so far (a counter carried over on restart).
     images : int array (N, d), optional
-        Periodic image counters (unwrapped position = position + images * L).
+        Periodic image counters (unwrapped position = position + images * L);
+        zero on wall axes.
     last_collision : array (N,), optional
         Time of each particle's last collision (-inf: none); used by the TC model.
     shell : float, optional
@@ -115,6 +125,22 @@ class Simulation:
         Events processed so far (counter carried over on restart).
     dissipated_energy : float
         Energy dissipated so far (carried over on restart).
+    boundary : sequence of str, optional
+        One entry per axis: "periodic" (default) or "wall" (flat hard walls at 0 and L).
+    wall_collisions : int
+        Sphere-wall collisions so far (carried over on restart).
+    driving : WhiteNoise, optional
+        White-noise driving (:class:`granulargas.engine.driving.WhiteNoise`):
+        kicks at the times (k + 1/2) * interval.
+    kick_step : int, optional
+        Index k of the next driving step (carried over on restart; default: the
+        first k with (k + 1/2) * interval > time).
+    injected_energy : float
+        Energy put in by the driving so far (carried over on restart).
+    remove_drift : bool
+        Remove the centre-of-mass velocity that round-off accumulates on the
+        periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
+        e.g. a mean flow given on purpose.
 
     Notes
     -----
@@ -125,10 +151,18 @@ class Simulation:
     the public state.
     """
 
+    #: the centre-of-mass velocity is removed once V^2 exceeds this fraction of <c^2> ...
+    DRIFT_LIMIT = 1e-8
+    #: ... if its kinetic energy is below this fraction of the energy that has passed
+    #: through the gas (kinetic + dissipated + injected), as round-off drift always is
+    ROUND_OFF = 1e-20
+
     def __init__(self, positions, velocities, radii, masses, box, rule: CollisionRule,
                  time: float = 0.0, collisions: int = 0, images=None, last_collision=None,
                  *, events: int = 0, dissipated_energy: float = 0.0, shell: float | None = None,
-                 collapse_count: int = 100):
+                 collapse_count: int = 100, boundary=None, wall_collisions: int = 0,
+                 driving: WhiteNoise | None = None, kick_step: int | None = None,
+                 injected_energy: float = 0.0, remove_drift: bool = True):
         pos = np.array(positions, dtype=np.float64, order="C", copy=True)
         if pos.ndim != 2 or pos.shape[1] not in (2, 3):
             raise ConfigError(f"positions: shape {pos.shape}, expected (N, 2) or (N, 3)")
@@ -152,27 +186,63 @@ class Simulation:
             raise ConfigError("positions/velocities: non-finite values")
         if not isinstance(rule, CollisionRule):
             raise TypeError("rule must be a granulargas.engine.CollisionRule")
+        self.boundary = _boundary(boundary, d)
+        wall = np.array([b == "wall" for b in self.boundary])
         img = np.zeros((n, d), dtype=np.int64) if images is None else np.array(images, dtype=np.int64, order="C")
         if img.shape != (n, d):
             raise ConfigError(f"images: shape {img.shape}, expected {(n, d)}")
+        if np.any(img[:, wall] != 0):
+            raise ConfigError("images: must be 0 on wall axes")
+        for a in np.flatnonzero(wall):
+            low = pos[:, a] - rad
+            high = bx[a] - rad - pos[:, a]
+            tol = 1e-9 * rad
+            bad = np.flatnonzero((low < -tol) | (high < -tol))
+            if len(bad):
+                k = int(bad[0])
+                raise ConfigError(f"positions: particle {k} at {'xyz'[a]} = {pos[k, a]:.6g} overlaps a "
+                                  f"wall (radius {rad[k]:.6g}, walls at 0 and {bx[a]:.6g}); every "
+                                  f"sphere must lie within [R, L - R] on a wall axis")
         shift = np.floor(pos / bx).astype(np.int64)
+        shift[:, wall] = 0
         pos -= shift * bx
         img += shift
-        pos[pos >= bx] = 0.0  # guard against -tiny + L rounding to L
+        wrapped = pos >= bx
+        wrapped[:, wall] = False
+        pos[wrapped] = 0.0  # guard against -tiny + L rounding to L
         lc = np.full(n, -np.inf) if last_collision is None else np.array(last_collision, dtype=np.float64, order="C")
         if lc.shape != (n,):
             raise ConfigError(f"last_collision: shape {lc.shape}, expected ({n},)")
+        if driving is not None and not isinstance(driving, WhiteNoise):
+            raise TypeError("driving must be a granulargas.engine.driving.WhiteNoise or None")
 
         self._positions, self._velocities, self._images, self._last_collision = pos, vel, img, lc
         self._radii, self._masses, self._box = rad, mas, bx
         self.rule = rule
+        self.driving = driving
+        self.remove_drift = bool(remove_drift)
         self._time = float(time)
         self._collisions = int(collisions)
         self._events = int(events)
+        self._wall_collisions = int(wall_collisions)
         self._dissipated = float(dissipated_energy)
+        self._injected = float(injected_energy)
+        if driving is None:
+            self._kick_step = 0
+        elif kick_step is None:
+            self._kick_step = max(0, int(math.floor(self._time / driving.interval - 0.5)))
+            while (self._kick_step + 0.5) * driving.interval <= self._time:  # round-off in the floor
+                self._kick_step += 1
+        else:
+            self._kick_step = int(kick_step)
+            if not (self._kick_step + 0.5) * driving.interval > self._time:
+                raise ConfigError(f"kick_step = {kick_step}: the next driving step k must come after the "
+                                  f"current time ((k + 1/2) interval > {self._time:.17g})")
         self._virial = 0.0
         self._kin_int = 0.0
+        self._wall_impulse = np.zeros((3, 2))
         self._window_start = self._time
+        self._wall_window_start = self._time
         self._rate = float("nan")
         self.collapse_count = int(collapse_count)
 
@@ -186,17 +256,24 @@ class Simulation:
         # at least 3 cells per side so that the 27 neighbour cells are distinct
         fit = float(bx.min()) / 3.0 - dmax
         if float(bx.min()) < MIN_BOX_DIAMETERS * dmax:
+            short = [f"{'xyz'[a]} ({self.boundary[a]})" for a in range(d)
+                     if bx[a] < MIN_BOX_DIAMETERS * dmax]
             raise ConfigError(f"box = {bx.tolist()}: too small for the cell grid, each side must be "
-                              f">= {MIN_BOX_DIAMETERS * dmax:.4g} ({MIN_BOX_DIAMETERS:g} largest diameters)")
+                              f">= {MIN_BOX_DIAMETERS * dmax:.4g} ({MIN_BOX_DIAMETERS:g} largest "
+                              f"diameters); too short: {', '.join(short)}")
         self.shell = min(want * dmax, fit)
         cut = dmax + self.shell
-        self._box3 = np.ones(3)
-        self._box3[:d] = bx
-        self._ncell = np.ones(3, dtype=np.int64)
-        self._ncell[:d] = np.floor(bx / cut).astype(np.int64)
+        box3 = np.ones(3)
+        box3[:d] = bx
+        period3 = box3.copy()
+        period3[:d][wall] = np.inf
+        ncell = np.ones(3, dtype=np.int64)
+        ncell[:d] = np.floor(bx / cut).astype(np.int64)
+        self._space = _state.space(box3, period3, ncell, np.flatnonzero(wall), d)
         self._built = False
+        self._engine = None
         self._nb_width = self._initial_list_width(n, volume, cut)
-        mean = n / float(np.prod(self._ncell))
+        mean = n / float(np.prod(ncell))
         self._cell_width = 16 * max(1, math.ceil((mean + 5.0 * math.sqrt(mean) + 2) / 16))
 
     # ------------------------------------------------------------------ build
@@ -209,39 +286,38 @@ class Simulation:
     def _build(self):
         """Internal state from the public state (a pure function of it)."""
         n, d = self._positions.shape
+        spc = self._space
         p3 = np.zeros((n, 3))
         p3[:, :d] = self._positions
-        order = morton_order(p3, self._box3, self._ncell)
+        order = morton_order(p3, spc.box, spc.ncell)
         self._order = order
-        s = {}
         rec = _aligned_records(n)
         rec[:, :3] = p3[order]
         rec[:, 3:6] = 0.0
         rec[:, 3 : 3 + d] = self._velocities[order]
         rec[:, 6] = self._time
         rec[:, 7] = self._radii[order]
-        s["rec"] = rec
         img = np.zeros((n, 3), dtype=np.int32)
         img[:, :d] = self._images[order]
-        s["img"] = img
-        s["centre"] = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
-        s["mass"] = np.ascontiguousarray(self._masses[order])
-        s["count"] = np.zeros(n, dtype=np.int32)
-        s["partner"] = np.full(n, -1, dtype=np.int32)
-        s["pcount"] = np.zeros(n, dtype=np.int32)
-        s["lastcoll"] = np.ascontiguousarray(self._last_collision[order])
-        s["rapid"] = np.zeros(n, dtype=np.int32)
-        ncells = int(np.prod(self._ncell))
-        s["cell_n"] = np.zeros(ncells, dtype=np.int32)
-        s["cell_of"] = np.empty(n, dtype=np.int32)
-        s["nbn"] = np.zeros(n, dtype=np.int32)
+        particles = _state.Particles(
+            rec=rec, img=img, mass=np.ascontiguousarray(self._masses[order]),
+            count=np.zeros(n, dtype=np.int32),
+            lastcoll=np.ascontiguousarray(self._last_collision[order]),
+            rapid=np.zeros(n, dtype=np.int32), ident=order.astype(np.int32))
+        events = _state.Events(partner=np.full(n, -1, dtype=np.int32),
+                               tag=np.zeros(n, dtype=np.int32))
+        ncells = int(np.prod(spc.ncell))
+        centre = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
         pos = np.ascontiguousarray(rec[:, :3])
+        stencil = np.empty(27, dtype=np.int64)
         while True:
-            s["nbl"] = np.empty((n, self._nb_width), dtype=np.int32)
-            s["cell_ids"] = _aligned_int_rows(ncells, self._cell_width)
-            st = build_all_lists(pos, s["centre"], rec, self.shell, self._box3, self._ncell,
-                                 s["cell_ids"], s["cell_n"], s["cell_of"],
-                                 s["nbl"], s["nbn"])
+            lists = _state.Lists(centre=centre, nbl=np.empty((n, self._nb_width), dtype=np.int32),
+                                 nbn=np.zeros(n, dtype=np.int32), scratch=np.empty(1, np.int32),
+                                 stencil=stencil)
+            cells = _state.Cells(ids=_aligned_int_rows(ncells, self._cell_width),
+                                 n=np.zeros(ncells, dtype=np.int32),
+                                 of=np.empty(n, dtype=np.int32))
+            st = build_all_lists(pos, rec, lists, cells, spc, self.shell)
             if st == OVERFLOW:
                 self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
             elif st == CELL_OVERFLOW:
@@ -249,30 +325,44 @@ class Simulation:
             else:
                 break
         # compact the lists to what this state needs (+ a margin; they grow on demand)
-        width = min(n - 1, int(s["nbn"].max()) + 6)
+        width = min(n - 1, int(lists.nbn.max()) + 6)
+        nbl = lists.nbl
         if width < self._nb_width:
-            s["nbl"] = np.ascontiguousarray(s["nbl"][:, :width])
+            nbl = np.ascontiguousarray(nbl[:, :width])
             self._nb_width = width
-        s["scratch"] = self._new_scratch()
-        s["stencil"] = np.empty(27, dtype=np.int64)
-        s.update(allocate_calendar(n))
-        _loop.predict_all(self._time, rec, s["centre"], s["count"], s["nbl"], s["nbn"],
-                          s["partner"], s["pcount"], self._box3, 0.5 * self.shell * (1.0 - 1e-9),
-                          s["qt"])
-        self._place_events(s, self._time)
+        lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
+        calendar = allocate_calendar(n)
+        _loop.predict_all(self._time, rec, particles.count, events, lists, spc,
+                          0.5 * self.shell * (1.0 - 1e-9), calendar.qt)
+        counters = np.zeros(1, dtype=_state.COUNTERS)
+        c = counters[0]
         with np.errstate(over="ignore", under="ignore"):
-            mv2 = float(np.sum(self._masses[:, None] * self._velocities**2))
-        s["scal"] = np.array([self._time, self._dissipated, self._virial, self._kin_int, mv2])
-        s["iscal"] = np.array([self._collisions, self._events, -1, -1, 0, 0], dtype=np.int64)
-        self._s = s
+            c["sum_mv2"] = float(np.sum(self._masses[:, None] * self._velocities**2))
+        c["time"] = self._time
+        c["dissipated"] = self._dissipated
+        c["virial"] = self._virial
+        c["kin_int"] = self._kin_int
+        c["injected"] = self._injected
+        c["collisions"] = self._collisions
+        c["events"] = self._events
+        c["wall_collisions"] = self._wall_collisions
+        c["kick_step"] = self._kick_step
+        c["err_i"] = c["err_j"] = -1
+        walls = _state.Walls(impulse=self._wall_impulse.copy())
+        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls)
+        self._place_events(self._time)
         self._built = True
 
-    def _place_events(self, s, now):
-        """(Re)build the event calendar from the event times ``s["qt"]`` at time ``now``."""
-        if not cal_build(now, s["qt"], s["chunks"], s["qwhere"], s["small"], s["buckets"], s["qi"],
-                         s["qf"]):
+    @property
+    def _counters(self):
+        return self._engine.counters[0]
+
+    def _place_events(self, now):
+        """(Re)build the event calendar from the event times ``qt`` at time ``now``."""
+        cal = self._engine.calendar
+        if not cal_build(now, cal):
             raise SimulationError(f"event calendar overflow at t = {now:.12g}: more simultaneous "
-                                  f"events than its window holds ({s['small'].shape[0]})")
+                                  f"events than its window holds ({cal.small.shape[0]})")
         self._calendar_time = now
 
     def _new_scratch(self):
@@ -280,29 +370,54 @@ class Simulation:
         return np.empty(max(self._nb_width, 27 * self._cell_width), dtype=np.int32)
 
     def _grow_cells(self):
-        s = self._s
-        old = s["cell_ids"]
+        e = self._engine
+        old = e.cells.ids
         self._cell_width += 16
         new = _aligned_int_rows(old.shape[0], self._cell_width)
         new[:, : old.shape[1]] = old
-        s["cell_ids"] = new
-        s["scratch"] = self._new_scratch()
+        self._engine = e._replace(cells=e.cells._replace(ids=new),
+                                  lists=e.lists._replace(scratch=self._new_scratch()))
 
     def _grow_lists(self):
-        s = self._s
+        e = self._engine
         n = self.n
         new = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.2)))
         if new <= self._nb_width:
             raise SimulationError("neighbour list cannot grow further (internal error)")
         nbl = np.empty((n, new), dtype=np.int32)
-        nbl[:, : self._nb_width] = s["nbl"]
-        s["nbl"] = nbl
+        nbl[:, : self._nb_width] = e.lists.nbl
         self._nb_width = new
-        s["scratch"] = self._new_scratch()
+        self._engine = e._replace(lists=e.lists._replace(nbl=nbl, scratch=self._new_scratch()))
+
+    def _params(self):
+        """The read-only parameters of the compiled loop for the coming run."""
+        c = self._counters
+        v2 = float(c["sum_mv2"]) / float(np.sum(self._masses))
+        scale = 2.0 * float(self._radii.min()) / math.sqrt(v2) if v2 > 0 else 1.0
+        drv = self.driving
+        kick = {} if drv is None else dict(
+            kick_interval=drv.interval, kick_scale=kick_scale(drv.heating_rate, drv.interval, self.n),
+            kick_seed=drv.seed)
+        return _state.params(self.rule.compiled(), self._space, self.shell, float(self._radii.max()),
+                             1e-10 * scale, self.collapse_count, **kick)
 
     # -------------------------------------------------------------------- run
     def run(self, until: float, max_collisions: int | None = None, progress=None) -> "Simulation":
         """Process all events with time <= ``until``; then ``time = until``.
+
+        With ``remove_drift`` (default), at the start of the call and between
+        compiled chunks the centre-of-mass velocity V on the periodic axes is
+        compared with the thermal speed. Collisions conserve momentum and driving
+        kicks sum to zero, but round-off leaves a drift of ~1e-16 of the initial
+        speeds, which a cooling gas keeps while its thermal speeds fall; below
+        T/T0 ~ 1e-30 it dominates, and list expiries would outnumber collisions by
+        orders of magnitude. Once V^2 > ``DRIFT_LIMIT`` <c^2> and the drift's
+        kinetic energy M V^2 / 2 is below ``ROUND_OFF`` times the energy that has
+        passed through the gas (kinetic + dissipated + injected: a drift round-off
+        can explain, not a mean flow given on purpose), the state is synchronised, V
+        (an exactly rounded mass-weighted sum, in particle-id order) is subtracted
+        from every velocity and the internal state rebuilt. The decision depends on
+        the state alone, so that restarts stay bit-identical.
 
         Parameters
         ----------
@@ -324,38 +439,34 @@ class Simulation:
             raise ValueError(f"run(until={until}): the simulation is already at time {self.time}")
         if math.isinf(until) and max_collisions is None:
             raise ValueError("run(until=inf) needs max_collisions")
+        self._remove_drift()
         if not self._built:
             self._build()
-        s = self._s
         start_time, start_coll = self.time, self.collisions
         target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
-        vmax = float(np.max(np.abs(s["rec"][:, 3:6])))
+        vmax = float(np.max(np.abs(self._engine.particles.rec[:, 3:6])))
         if not (vmax < 1e150) or (0.0 < vmax < 1e-150):
             raise SimulationError(f"velocities out of range at t = {self.time:.12g} (max |v_a| = "
                                   f"{vmax:.3g}): squared speeds must stay within float64; rescale "
                                   f"the units")
-        kind, eps, tc, pref, inv_h, coeffs = self.rule.kernel_arguments()
-        v2 = s["scal"][4] / float(np.sum(s["mass"]))
-        scale = 2.0 * float(self._radii.min()) / math.sqrt(v2) if v2 > 0 else 1.0
-        fpar = np.array([eps, tc, pref, inv_h, self.shell, 1e-10 * scale, float(self._radii.max())])
+        prm = self._params()
         chunk = max(1_000_000, 2 * self.n)
         if self._calendar_time != self.time:
             # the window width must stay matched to the event rate (a cooling gas slows
             # down): the events are placed anew when it is off by more than a factor 2
-            ratio = cal_width(self.time, s["qt"]) / float(s["qf"][0])
+            cal = self._engine.calendar
+            ratio = cal_width(self.time, cal.qt) / float(cal.state[0]["width"])
             if not 0.5 <= ratio <= 2.0:
-                self._place_events(s, self.time)
+                self._place_events(self.time)
+        advance = _loop.advance if self.driving is None else _loop.advance_driven
         while True:
-            status = _loop.advance(
-                s["rec"], s["img"], s["centre"], s["mass"], s["count"],
-                s["partner"], s["pcount"], s["lastcoll"], s["rapid"], s["nbl"], s["nbn"], s["scratch"],
-                s["stencil"],
-                s["cell_ids"], s["cell_n"], s["cell_of"],
-                s["qt"], s["chunks"], s["qwhere"], s["small"], s["buckets"], s["qi"], s["qf"], self._box3, self._ncell, kind, fpar, coeffs,
-                self.collapse_count, until, chunk, target, s["scal"], s["iscal"])
+            status = advance(self._engine, prm, until, chunk, target, None)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
+                if self._remove_drift() or not self._built:
+                    self._build()
+                    prm = self._params()
                 continue
             if status == OVERFLOW:
                 self._grow_lists()
@@ -372,11 +483,35 @@ class Simulation:
             progress(self)
         return self
 
+    def _remove_drift(self) -> bool:
+        """Subtract the centre-of-mass velocity on periodic axes once it exceeds
+        ``DRIFT_LIMIT`` of the thermal speed (see :meth:`run`); True if it did."""
+        axes = [a for a in range(self.dimension) if self.boundary[a] == "periodic"]
+        if not self.remove_drift or not axes:
+            return False
+        v, m = self._vm()
+        mtot = float(np.sum(self._masses))
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            vcm = (m @ v) / mtot
+            mv2 = float(np.einsum("i,ij,ij->", m, v, v))  # not the running sum: it loses digits
+            passed = 0.5 * mv2 + self.dissipated_energy + self.injected_energy
+            drift2 = float(np.sum(vcm[axes] ** 2))
+            c2 = mv2 / mtot - float(vcm @ vcm)
+        if not (self.DRIFT_LIMIT * c2 < drift2 and 0.5 * mtot * drift2 < self.ROUND_OFF * passed):
+            return False
+        self.synchronise()
+        vel = self._velocities
+        mtot = math.fsum(self._masses)
+        for a in axes:
+            va = math.fsum((self._masses * vel[:, a]).tolist()) / mtot
+            vel[:, a] -= va
+        return True
+
     def _raise(self, status):
-        s = self._s
-        i, j = int(s["iscal"][2]), int(s["iscal"][3])
+        c = self._counters
+        i, j = int(c["err_i"]), int(c["err_j"])
         ids = [int(self._order[k]) for k in (i, j) if k >= 0]
-        where = f"at t = {s['scal'][0]:.12g} after {int(s['iscal'][0])} collisions (particles {ids})"
+        where = f"at t = {float(c['time']):.12g} after {int(c['collisions'])} collisions (particles {ids})"
         if status == _loop.COLLAPSE:
             if self.rule.kind == "constant":
                 raise InelasticCollapseError(
@@ -391,36 +526,41 @@ class Simulation:
                                   f"run of zero-time events")
         if status == _loop.CALENDAR:
             raise SimulationError(f"event calendar overflow {where}: more simultaneous events than "
-                                  f"its window holds ({self._s['small'].shape[0]})")
+                                  f"its window holds ({self._engine.calendar.small.shape[0]})")
         raise SimulationError(f"engine status {status} {where}")
 
     def synchronise(self) -> "Simulation":
         """Stream all particles to ``time`` and wrap; the next run rebuilds the queue."""
         if self._built:
-            s = self._s
+            e = self._engine
             self._positions, self._images = self._synchronised()
             n, d = self._positions.shape
             inv = self._order
             vel = np.empty((n, d))
-            vel[inv] = s["rec"][:, 3 : 3 + d]
+            vel[inv] = e.particles.rec[:, 3 : 3 + d]
             self._velocities = vel
             lc = np.empty(n)
-            lc[inv] = s["lastcoll"]
+            lc[inv] = e.particles.lastcoll
             self._last_collision = lc
-            sc = s["scal"]
-            self._time = float(sc[0])
-            self._dissipated, self._virial, self._kin_int = float(sc[1]), float(sc[2]), float(sc[3])
-            self._collisions, self._events = int(s["iscal"][0]), int(s["iscal"][1])
+            c = self._counters
+            self._time = float(c["time"])
+            self._dissipated, self._virial, self._kin_int = (float(c["dissipated"]), float(c["virial"]),
+                                                             float(c["kin_int"]))
+            self._injected = float(c["injected"])
+            self._collisions, self._events = int(c["collisions"]), int(c["events"])
+            self._wall_collisions = int(c["wall_collisions"])
+            self._kick_step = int(c["kick_step"])
+            self._wall_impulse = e.walls.impulse.copy()
             self._built = False
-            self._s = None
+            self._engine = None
         return self
 
     def _synchronised(self):
-        s = self._s
+        e = self._engine
         n, d = self._positions.shape
         r = np.empty((n, 3))
         img = np.empty((n, 3), dtype=np.int32)
-        _loop.synchronised(s["rec"], s["img"], self._box3, s["scal"][0], r, img)
+        _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, r, img)
         pos = np.empty((n, d))
         pos[self._order] = r[:, :d]
         im = np.empty((n, d), dtype=np.int64)
@@ -435,19 +575,31 @@ class Simulation:
 
     @property
     def time(self) -> float:
-        return float(self._s["scal"][0]) if self._built else self._time
+        return float(self._counters["time"]) if self._built else self._time
 
     @property
     def collisions(self) -> int:
-        return int(self._s["iscal"][0]) if self._built else self._collisions
+        """Pair collisions so far."""
+        return int(self._counters["collisions"]) if self._built else self._collisions
 
     @property
     def events(self) -> int:
-        return int(self._s["iscal"][1]) if self._built else self._events
+        """Events processed so far (every kind, a driving step counting as one)."""
+        return int(self._counters["events"]) if self._built else self._events
+
+    @property
+    def wall_collisions(self) -> int:
+        """Sphere-wall collisions so far."""
+        return int(self._counters["wall_collisions"]) if self._built else self._wall_collisions
+
+    @property
+    def kick_step(self) -> int:
+        """Index k of the next driving step (at time (k + 1/2) * interval); 0 without driving."""
+        return int(self._counters["kick_step"]) if self._built else self._kick_step
 
     @property
     def positions(self) -> np.ndarray:
-        """Positions (N, d) at ``time``, wrapped into [0, L) (a copy)."""
+        """Positions (N, d) at ``time``, wrapped into [0, L) on periodic axes (a copy)."""
         return self._synchronised()[0] if self._built else self._positions.copy()
 
     @property
@@ -464,7 +616,7 @@ class Simulation:
         if not self._built:
             return self._velocities.copy()
         out = np.empty_like(self._velocities)
-        out[self._order] = self._s["rec"][:, 3 : 3 + self.dimension]
+        out[self._order] = self._engine.particles.rec[:, 3 : 3 + self.dimension]
         return out
 
     @property
@@ -472,7 +624,7 @@ class Simulation:
         if not self._built:
             return self._last_collision.copy()
         out = np.empty(self.n)
-        out[self._order] = self._s["lastcoll"]
+        out[self._order] = self._engine.particles.lastcoll
         return out
 
     @property
@@ -490,7 +642,7 @@ class Simulation:
     # ------------------------------------------------------------ observables
     def _vm(self):
         if self._built:
-            return self._s["rec"][:, 3 : 3 + self.dimension], self._s["mass"]
+            return self._engine.particles.rec[:, 3 : 3 + self.dimension], self._engine.particles.mass
         return self._velocities, self._masses
 
     @property
@@ -515,8 +667,13 @@ class Simulation:
 
     @property
     def dissipated_energy(self) -> float:
-        """Kinetic energy dissipated in collisions since construction (cumulative)."""
-        return float(self._s["scal"][1]) if self._built else self._dissipated
+        """Kinetic energy dissipated in collisions (pairs and walls) since construction (cumulative)."""
+        return float(self._counters["dissipated"]) if self._built else self._dissipated
+
+    @property
+    def injected_energy(self) -> float:
+        """Kinetic energy put in by the driving (cumulative)."""
+        return float(self._counters["injected"]) if self._built else self._injected
 
     @property
     def collision_rate(self) -> float:
@@ -527,13 +684,16 @@ class Simulation:
         """Mean pressure since the previous call (or construction), then reset.
 
         P = [ integral of sum_i m_i c_i^2 dt + sum_coll r_ij . Delta p_ij ] / (d V Delta t)
-        (kinetic plus collisional virial; c is the peculiar velocity).
+        (kinetic plus collisional virial; c is the peculiar velocity). With walls
+        the sphere-wall forces are not included: this is then the volume average of
+        the trace of the kinetic and collisional stress, and
+        :meth:`wall_pressure_window` is the pressure on the walls.
         """
         if self._built:
-            sc = self._s["scal"]
-            kin, vir = float(sc[3]), float(sc[2])
-            sc[2] = 0.0
-            sc[3] = 0.0
+            c = self._counters
+            kin, vir = float(c["kin_int"]), float(c["virial"])
+            c["virial"] = 0.0
+            c["kin_int"] = 0.0
         else:
             kin, vir = self._kin_int, self._virial
         self._virial = 0.0
@@ -547,6 +707,49 @@ class Simulation:
         kin -= float(p @ p) / float(np.sum(self._masses)) * dt
         return (kin + vir) / (self.dimension * float(np.prod(self._box)) * dt)
 
+    def wall_impulse(self) -> np.ndarray:
+        """Normal momentum (d, 2) delivered to the lower / upper wall of each axis since the
+        last :meth:`wall_pressure_window` (zero on periodic axes)."""
+        imp = self._engine.walls.impulse if self._built else self._wall_impulse
+        return imp[: self.dimension].copy()
+
+    def wall_pressure_window(self) -> float:
+        """Mean pressure on the walls since the previous call (or construction), then reset.
+
+        Normal momentum delivered to all walls / (their total area x elapsed time);
+        NaN without walls or for an empty interval.
+        """
+        imp = self._engine.walls.impulse if self._built else self._wall_impulse
+        total = float(np.sum(imp))
+        imp[:] = 0.0
+        t = self.time
+        dt = t - self._wall_window_start
+        self._wall_window_start = t
+        axes = [a for a in range(self.dimension) if self.boundary[a] == "wall"]
+        if dt <= 0 or not axes:
+            return float("nan")
+        volume = float(np.prod(self._box))
+        area = sum(2.0 * volume / float(self._box[a]) for a in axes)
+        return total / (area * dt)
+
     def __repr__(self):
+        walls = "" if "wall" not in self.boundary else f", boundary={self.boundary}"
         return (f"Simulation(N={self.n}, d={self.dimension}, packing={self.packing_fraction:.4g}, "
-                f"rule={self.rule.kind}, time={self.time:.6g}, collisions={self.collisions})")
+                f"rule={self.rule.kind}{walls}, time={self.time:.6g}, collisions={self.collisions})")
+
+
+def _boundary(boundary, d):
+    """The boundary tuple (one of "periodic", "wall" per axis) or ConfigError."""
+    if boundary is None:
+        return ("periodic",) * d
+    if isinstance(boundary, str):
+        raise ConfigError(f"boundary = {boundary!r}: give one entry per axis, e.g. "
+                          f"{('periodic',) * (d - 1) + ('wall',)}")
+    b = tuple(str(x) for x in boundary)
+    if len(b) != d:
+        raise ConfigError(f"boundary = {list(b)}: {len(b)} entries for a {d}D system, need {d} "
+                          f"(one per axis)")
+    for x in b:
+        if x not in BOUNDARIES:
+            raise ConfigError(f"boundary = {list(b)}: {x!r} is not one of {', '.join(BOUNDARIES)}")
+    return b

@@ -272,8 +272,13 @@ def maxwell_velocities(masses, dimension, temperature=1.0, seed=0, rng=None):
     return v
 
 
+#: smallest wall axis in largest diameters: the placement box is one diameter shorter
+#: than the wall axis and needs the engine's 3.15 (three cells) itself
+MIN_WALL_AXIS_DIAMETERS = 4.15
+
+
 def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, masses=None,
-                 aspect=None, sweeps=None, rng=None) -> InitialState:
+                 aspect=None, sweeps=None, rng=None, boundary=None) -> InitialState:
     """A random homogeneous initial state: box, positions, velocities (in this order from one generator).
 
     Parameters
@@ -281,7 +286,8 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
     n : int
         Number of particles.
     packing : float
-        Packing fraction (3D: sum of sphere volumes / V; 2D: disk areas / A).
+        Packing fraction (3D: sum of sphere volumes / V; 2D: disk areas / A), V the
+        whole box also between walls.
     dimension : {2, 3}
     temperature : float
         Granular temperature T (k_B = 1).
@@ -297,6 +303,13 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
     rng : numpy.random.Generator, optional
         Generator to draw from instead of ``default_rng(seed)`` (a config run draws
         its polydisperse radii from it first).
+    boundary : sequence of d str, optional
+        "periodic" or "wall" per axis (default all periodic). On a wall axis of length
+        L the positions are placed as on a periodic axis of length L - 2 R_max and
+        shifted by R_max: no sphere overlaps a wall (every centre lies within
+        [R_max, L - R_max]); the density next to the walls relaxes to its steady
+        profile within a few collision times. A wall axis must be at least
+        ``MIN_WALL_AXIS_DIAMETERS`` largest diameters long.
     """
     if dimension not in (2, 3):
         raise ConfigError(f"dimension = {dimension}: allowed values are 2 and 3")
@@ -305,6 +318,7 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
         raise ConfigError(f"number of particles = {n}: need at least 2")
     if not 0.0 < packing < (0.74 if dimension == 3 else 0.9):
         raise ConfigError(f"packing fraction = {packing}: allowed range is (0, {0.74 if dimension == 3 else 0.9})")
+    walls = [] if boundary is None else [a for a in range(dimension) if boundary[a] == "wall"]
     rng = np.random.default_rng(seed) if rng is None else rng
     radii = np.array(np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)))
     if np.any(radii <= 0):
@@ -312,6 +326,17 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
     masses = (2.0 * radii) ** dimension if masses is None else np.array(
         np.broadcast_to(np.asarray(masses, dtype=np.float64), (n,)))
     box = box_for_packing(radii, packing, dimension, aspect)
-    pos = random_positions(radii, box, sweeps=sweeps, rng=rng)
+    placement = box.copy()
+    rmax = float(radii.max())
+    for a in walls:
+        if box[a] < MIN_WALL_AXIS_DIAMETERS * 2.0 * rmax:
+            raise ConfigError(f"wall axis {'xyz'[a]}: length {box[a]:.4g} is too short for the particles: "
+                              f"it must be >= {MIN_WALL_AXIS_DIAMETERS:g} largest diameters "
+                              f"(= {MIN_WALL_AXIS_DIAMETERS * 2.0 * rmax:.4g}); use more particles or a "
+                              f"lower packing fraction")
+        placement[a] -= 2.0 * rmax
+    pos = random_positions(radii, placement, sweeps=sweeps, rng=rng)
+    pos[:, walls] += rmax
     vel = maxwell_velocities(masses, dimension, temperature, rng=rng)
-    return InitialState(pos, vel, radii, masses, box)
+    bnd = None if boundary is None else tuple(boundary)
+    return InitialState(pos, vel, radii, masses, box, boundary=bnd)

@@ -16,13 +16,18 @@ class InitialState:
     positions, velocities : arrays (N, d)
     radii, masses : arrays (N,)
     box : array (d,)
-        Periodic box sides.
+        Box sides.
+    boundary : tuple of str, optional
+        One entry per axis, "periodic" or "wall" (default all periodic).
     species : array (N,) int32, optional
         Species index of each particle (default all 0).
     images : array (N, d) int64, optional
         Periodic images (a restart continues the unwrapped trajectories).
     time, collisions, events, dissipated_energy :
         Clock and counters to continue from (0 for a fresh state).
+    wall_collisions, injected_energy, kick_step :
+        Sphere-wall collisions, energy put in by the driving, index of the next driving
+        step (restarts; None: the first step after ``time``).
     last_collision : array (N,), optional
         Time of each particle's last collision (TC model restarts).
     source : str, optional
@@ -34,12 +39,16 @@ class InitialState:
     radii: np.ndarray
     masses: np.ndarray
     box: np.ndarray
+    boundary: tuple | None = None
     species: np.ndarray | None = None
     images: np.ndarray | None = None
     time: float = 0.0
     collisions: int = 0
     events: int = 0
     dissipated_energy: float = 0.0
+    wall_collisions: int = 0
+    injected_energy: float = 0.0
+    kick_step: int | None = None
     last_collision: np.ndarray | None = None
     source: str | None = None
 
@@ -50,5 +59,8 @@ class InitialState:
     def as_kwargs(self) -> dict:
         """The particle arrays and the box as keyword arguments of
         :class:`granulargas.engine.Simulation` (a fresh start)."""
-        return dict(positions=self.positions, velocities=self.velocities, radii=self.radii,
-                    masses=self.masses, box=self.box)
+        out = dict(positions=self.positions, velocities=self.velocities, radii=self.radii,
+                   masses=self.masses, box=self.box)
+        if self.boundary is not None and "wall" in self.boundary:
+            out["boundary"] = tuple(self.boundary)
+        return out

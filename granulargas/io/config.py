@@ -1,8 +1,8 @@
 """TOML run configuration -> frozen dataclasses, validated by one declarative schema.
 
 A config file has the sections ``[system]``, ``[particles]``, ``[initial]``,
-``[collision]`` (with the optional sub-table ``[collision.material]``), ``[run]``
-and ``[output]``; :func:`load_config` reads it with :mod:`tomllib`, applies
+``[collision]`` (with the optional sub-table ``[collision.material]``),
+``[driving]`` (optional), ``[run]`` and ``[output]``; :func:`load_config` reads it with :mod:`tomllib`, applies
 optional dotted-key overrides, and returns a :class:`RunConfig`.
 
 The schema
@@ -65,6 +65,8 @@ from granulargas.errors import ConfigError
 MAX_PACKING = {3: math.pi / (3.0 * math.sqrt(2.0)), 2: math.pi / (2.0 * math.sqrt(3.0))}
 MODELS = ("elastic", "constant", "viscoelastic")
 CONTACT_ENDS = ("overlap", "force")
+BOUNDARIES = ("periodic", "wall")
+DRIVING_MODELS = ("white_noise",)
 DEFAULT_SNAPSHOTS = 20
 
 #: largest particle count: the engine indexes particles (neighbour lists, cells) with int32
@@ -85,12 +87,20 @@ SI_RANGE = (1e-100, 1e100)
 
 @dataclass(frozen=True)
 class SystemConfig:
-    """``[system]``: dimension, particle count, packing fraction, RNG seed."""
+    """``[system]``: dimension, particle count, packing fraction, RNG seed, and the
+    boundary of each axis: "periodic" or "wall" (flat hard walls at 0 and L; the
+    packing fraction counts the whole box)."""
 
     dimension: int = 3
     particles: int = 1000
     packing_fraction: float = 0.1
     seed: int = 1
+    boundary: tuple = ("periodic", "periodic", "periodic")
+
+    @property
+    def walls(self) -> bool:
+        """Whether any axis has walls."""
+        return "wall" in self.boundary
 
 
 @dataclass(frozen=True)
@@ -144,7 +154,10 @@ class CollisionConfig:
     It is a positive time; without the key (None) the TC model is off.
     ``damping``: beta at normal impact speed g = 1 for two reference particles
     (diameter 1, mass 1); :func:`granulargas.run.prepare.reduced_prefactor`
-    turns it (or ``[collision.material]``) into the pair prefactor k."""
+    turns it (or ``[collision.material]``) into the pair prefactor k.
+    ``wall_restitution`` (constant model, with walls): the constant eps of
+    sphere-wall collisions (default: ``restitution``); elastic runs have elastic
+    walls, viscoelastic runs the sphere-plane contact of the same material."""
 
     model: str = "viscoelastic"
     restitution: float | None = None
@@ -152,6 +165,20 @@ class CollisionConfig:
     material: MaterialConfig | None = None
     contact_end: str = "overlap"
     tc_time: float | None = None
+    wall_restitution: float | None = None
+
+
+@dataclass(frozen=True)
+class DrivingConfig:
+    """``[driving]`` (optional): white-noise driving, every particle kicked by independent
+    Gaussian velocity kicks (momentum-conserving) that raise the temperature at
+    ``heating_rate`` (dT/dt of the driving alone, T0 per time unit); ``interval``
+    between kicks (default: 0.02 of the theoretical steady state's cooling time,
+    :func:`granulargas.theory.driving_interval`)."""
+
+    model: str = "white_noise"
+    heating_rate: float = 0.0
+    interval: float | None = None
 
 
 @dataclass(frozen=True)
@@ -196,6 +223,7 @@ class RunConfig:
     output: OutputConfig
     source: str = "<config>"
     text: str = ""
+    driving: DrivingConfig | None = None
 
     def to_toml(self) -> str:
         """The resolved configuration (defaults filled in) as TOML text."""
@@ -220,7 +248,8 @@ class Key:
     key : str
         The TOML key; a key of an inline table is dotted (``"diameter.min"``).
     type : str
-        ``"integer"``, ``"number"``, ``"string"``, ``"table"`` or ``"number or table"``.
+        ``"integer"``, ``"number"``, ``"string"``, ``"table"``, ``"number or table"`` or
+        ``"list of strings"`` (one entry per axis; ``choices`` apply to each entry).
     meaning : str
         One or two sentences (Markdown code spans allowed).
     default : TOML value or None
@@ -278,6 +307,9 @@ class Key:
 
     def range_text(self, dimension: int | None = None) -> str:
         """What the validator accepts, as one phrase (the error messages use it)."""
+        if self.type == "list of strings":
+            n = f"{dimension} " if dimension is not None else ""
+            return f"a list of {n}strings (one per axis), each one of " + ", ".join(f'"{c}"' for c in self.choices)
         if self.choices is not None:
             if all(isinstance(c, str) for c in self.choices):
                 return "one of " + ", ".join(f'"{c}"' for c in self.choices)
@@ -348,6 +380,11 @@ SCHEMA: tuple[Key, ...] = (
     Key("system", "seed", "integer",
         "Seed of all randomness (diameters, positions, velocities); a seed gives the same initial "
         "state on every machine.", default=1, low=0, high=2**63 - 1, reason="any TOML integer >= 0"),
+    Key("system", "boundary", "list of strings",
+        'One entry per axis (x, y, z): `"periodic"`, or `"wall"` for flat hard walls at 0 and L on '
+        "that axis (the packing fraction counts the whole box).",
+        default_text='"periodic" on every axis', choices=BOUNDARIES,
+        run_check="a wall axis must be at least 4.15 largest diameters long"),
     # [particles]
     Key("particles", "diameter", "number or table",
         "Particle diameter, or `{ min = ..., max = ... }` for a uniform polydisperse mix (the "
@@ -397,6 +434,10 @@ SCHEMA: tuple[Key, ...] = (
         "of either particle's previous one is elastic, which guards against inelastic collapse. "
         "Leave the key out for no TC model.",
         unit="reduced time", low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
+    Key("collision", "wall_restitution", "number",
+        '`model = "constant"` with walls only: the constant ε of particle–wall collisions (default: '
+        "`restitution`). Elastic runs have elastic walls; viscoelastic runs the sphere–plane contact "
+        "of the same material.", low=0.0, low_open=True, high=1.0),
     Key("collision", "material", "table",
         "Instead of `damping`: the viscoelastic contact from material constants "
         "(`[collision.material]`, below)."),
@@ -418,6 +459,18 @@ SCHEMA: tuple[Key, ...] = (
     Key("collision.material", "speed_unit", "number",
         "The reduced velocity unit √(T0/m); time is then in diameter / speed_unit.", unit="m/s",
         low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
+    # [driving]
+    Key("driving", "model", "string",
+        "White-noise driving: every particle receives independent Gaussian velocity kicks "
+        "(total momentum conserved) at regular intervals.", default="white_noise", choices=DRIVING_MODELS),
+    Key("driving", "heating_rate", "number",
+        "dT/dt of the driving alone; the gas settles where it equals the collisional cooling. Required "
+        "whenever `[driving]` is given.", unit="T0 per reduced time", low=0.0, high=SCALE_RANGE[1],
+        reason="a heating rate; 0 switches the kicks off"),
+    Key("driving", "interval", "number",
+        "Time between kicks; observables are sampled half-way between kicks.",
+        default_text="0.02 of the cooling time of the theoretical steady state", unit="reduced time",
+        low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
     # [run]
     Key("run", "end_time", "number",
         "Stop at this time (give `end_time`, `collisions_per_particle` or both; the first reached stops).",
@@ -455,9 +508,12 @@ SCHEMA: tuple[Key, ...] = (
 #: section -> its dataclass (sub-tables: the dataclass of the table)
 SECTION_CLASSES = {
     "system": SystemConfig, "particles": ParticlesConfig, "initial": InitialConfig,
-    "collision": CollisionConfig, "collision.material": MaterialConfig, "run": RunSection, "output": OutputConfig,
+    "collision": CollisionConfig, "collision.material": MaterialConfig, "driving": DrivingConfig,
+    "run": RunSection, "output": OutputConfig,
 }
-SECTIONS = ("system", "particles", "initial", "collision", "run", "output")
+SECTIONS = ("system", "particles", "initial", "collision", "driving", "run", "output")
+#: sections that may be left out as a whole (absent: None in RunConfig)
+OPTIONAL_SECTIONS = ("driving",)
 #: keys whose value is a sub-table with its own section in SCHEMA
 SUBTABLES = {"collision.material": "collision.material"}
 #: keys that take a number or an inline table of sub-keys (dotted in SCHEMA)
@@ -519,6 +575,7 @@ class Values:
         self.value: dict[str, Any] = {}
         self.given: set[str] = set()
         self.raw: dict[str, Any] = {}
+        self.sections: set[str] = set()
 
     def origin(self, dotted: str) -> str:
         return "override" if dotted in self.overridden else self.source
@@ -537,6 +594,9 @@ class Values:
 
     def has(self, dotted: str) -> bool:
         return dotted in self.given
+
+    def section_given(self, section: str) -> bool:
+        return section in self.sections
 
 
 def _check_type(key: Key, v: Any, values: Values, dimension: int):
@@ -561,12 +621,26 @@ def _check_type(key: Key, v: Any, values: Values, dimension: int):
         if not isinstance(v, dict):
             values.fail(d, "must be a table")
         return v
+    if key.type == "list of strings":
+        if not isinstance(v, list) or not all(isinstance(b, str) for b in v):
+            values.fail(d, f"must be {key.range_text(dimension)}")
+        return tuple(v)
     raise AssertionError(key.type)
 
 
 def _check_range(key: Key, v: Any, values: Values, dimension: int):
     d = key.dotted
     ok = True
+    if key.type == "list of strings":
+        axes = "x, y, z" if dimension == 3 else "x, y"
+        allowed = ", ".join(f'"{c}"' for c in key.choices)
+        if len(v) != dimension:
+            values.fail(d, f"{len(v)} entries for a {dimension}D system: give one per axis ({axes}), "
+                           f"each one of {allowed}")
+        bad = [b for b in v if b not in key.choices]
+        if bad:
+            values.fail(d, f'"{bad[0]}" is not one of {allowed}')
+        return
     if key.choices is not None:
         ok = v in key.choices
     elif key.type == "string":
@@ -690,6 +764,17 @@ def _check_collision_count(v: Values):
                f"(exact in float64)")
 
 
+def _check_wall_restitution_needs_walls(v: Values):
+    boundary = v.get("system.boundary")
+    if v.has("collision.wall_restitution") and (boundary is None or "wall" not in boundary):
+        v.fail("collision.wall_restitution", 'is only used with walls (system.boundary with a "wall" entry)')
+
+
+def _check_driving_needs_heating_rate(v: Values):
+    if v.section_given("driving") and not v.has("driving.heating_rate"):
+        v.fail("driving.heating_rate", "missing; [driving] needs heating_rate >= 0 (dT/dt of the driving alone)")
+
+
 RULES: tuple[Rule, ...] = (
     Rule('`model = "constant"` needs `restitution`.', _check_constant_needs_restitution),
     _only_with("collision.restitution", ("constant",)),
@@ -711,6 +796,10 @@ RULES: tuple[Rule, ...] = (
     Rule("Without `end_time` the output is scheduled in collisions: `snapshot_interval`, `first_snapshot` "
          "and `observables_interval` need `end_time`.", _check_needs_end_time),
     Rule("`first_snapshot` lies below `end_time`.", _check_first_snapshot_below_end),
+    _only_with("collision.wall_restitution", ("constant",)),
+    Rule('`wall_restitution` is used only with walls (a `"wall"` entry in `boundary`).',
+         _check_wall_restitution_needs_walls),
+    Rule("`[driving]` needs `heating_rate`.", _check_driving_needs_heating_rate),
 )
 
 
@@ -849,6 +938,7 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
     """Validate a parsed TOML document (nested dict) into a :class:`RunConfig` (module docstring)."""
     values = Values(source, set(overridden))
     _check_structure(data, values)
+    values.sections = set(data)
     dimension = 3
     for key in SCHEMA:
         dotted = key.dotted
@@ -901,6 +991,8 @@ def _assemble(values: Values, source: str, text: str) -> RunConfig:
         v["particles.mass"] = 1.0
     if v.get("output.file") is None:
         v["output.file"] = default_output(source)
+    if v.get("system.boundary") is None:
+        v["system.boundary"] = ("periodic",) * v["system.dimension"]
     material = None
     if values.has("collision.material"):
         material = MaterialConfig(**{k.attribute: v[k.dotted] for k in SCHEMA if k.section == "collision.material"})
@@ -911,7 +1003,8 @@ def _assemble(values: Values, source: str, text: str) -> RunConfig:
             kwargs["material"] = material
         return SECTION_CLASSES[name](**kwargs)
 
-    return RunConfig(*(section(s) for s in SECTIONS), source=source, text=text)
+    parts = {s: section(s) if s not in OPTIONAL_SECTIONS or s in values.sections else None for s in SECTIONS}
+    return RunConfig(**parts, source=source, text=text)
 
 
 def default_output(source: str) -> str:
@@ -952,6 +1045,8 @@ def dump_toml(config: RunConfig) -> str:
                 lines.append(f"{key.key} = {{ {subs} }}")
                 continue
             value = getattr(obj, key.attribute)
-            if value is not None:
+            if isinstance(value, tuple):
+                lines.append(f"{key.key} = [{', '.join(_toml_value(x) for x in value)}]")
+            elif value is not None:
                 lines.append(f"{key.key} = {_toml_value(value)}")
     return "\n".join(lines) + "\n"

@@ -6,12 +6,13 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         author/                attrs name
         creator/               attrs name = "granulargas", version
     particles/all/
-        box/                   attrs dimension = d, boundary = ["periodic"] * d
+        box/                   attrs dimension = d, boundary = "periodic" or "none" per axis
+                               ("none": flat walls at 0 and the edge, H5MD 1.1)
             edges/             step, time -> hard links to position/step, time
                 value          (F, d) float64 box edge lengths
         position/  step (F,) int64 (event count), time (F,) float64, value (F, N, d) in [0, L)
         velocity/  step, time (links), value (F, N, d)
-        image/     step, time (links), value (F, N, d) int64 periodic image counts
+        image/     step, time (links), value (F, N, d) int64 periodic image counts (0 on wall axes)
         last_collision/        (TC model only) value (F, N): time of each particle's last collision
         mass       (N,) float64         time-independent
         radius     (N,) float64         time-independent, non-standard element
@@ -19,6 +20,8 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
     observables/
         temperature, kinetic_energy, collisions, dissipated_energy, events,
         momentum (d,), pressure:        step (S,), time (S,) shared, value (S, ...)
+        wall_collisions, wall_pressure  (runs with walls)
+        injected_energy, kick_step      (driven runs: energy put in, index of the next kick)
     parameters/
         config (resolved TOML text), config_source (file text), attrs
         version, seed, model, units, prefactor, ...; restitution_table/ (the
@@ -26,7 +29,8 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
 
 All elements with an explicit ``step`` and ``time``. ``pressure`` is the mean
 over the sampling interval that ends at ``time`` (kinetic plus collisional
-virial), NaN at the first sample of a run. All observables share one clock
+virial), NaN at the first sample of a run; ``wall_pressure`` likewise the
+normal momentum delivered to the walls per unit wall area and time. All observables share one clock
 (hard-linked ``step``/``time``) and are sampled at every snapshot time too, so
 frame-indexed readers (MDAnalysis ``ts.data``) never run past their end; use
 :func:`read_observables` for the right times. The unwrapped position is
@@ -73,7 +77,12 @@ from granulargas.errors import InputFileError
 CREATOR = "granulargas"
 _wall = _time.monotonic
 SCALAR_OBSERVABLES = ("temperature", "kinetic_energy", "collisions", "events", "dissipated_energy", "pressure")
-_INT_OBSERVABLES = ("collisions", "events")
+#: observables of runs with walls / with driving (written only by such runs)
+WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
+DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
+_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step")
+#: H5MD box boundary of each axis kind
+_H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
 
 
 def _frame_chunks(n: int, d: int) -> tuple:
@@ -102,7 +111,7 @@ class H5MDWriter:
     """
 
     def __init__(self, path, box, radii, masses, species=None, *, parameters=None,
-                 last_collision=False, overwrite=False, author=None):
+                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False):
         self.path = Path(path)
         box = np.ascontiguousarray(box, dtype=np.float64)
         self.d = int(box.shape[0])
@@ -114,8 +123,10 @@ class H5MDWriter:
         except (OSError, ValueError) as exc:
             raise InputFileError(f"{self.path}: cannot create output file ({_short(exc)})") from None
         self.file = f
+        self.boundary = ("periodic",) * self.d if boundary is None else tuple(boundary)
+        extra = (WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
         try:
-            self._create(box, radii, masses, species, parameters or {}, last_collision, author)
+            self._create(box, radii, masses, species, parameters or {}, last_collision, author, extra)
         except BaseException:
             self.file.close()
             self.path.unlink(missing_ok=True)
@@ -148,6 +159,7 @@ class H5MDWriter:
                 self.path, self.file, self.n, self.d = path, f, particles, dimension
                 part = f["particles/all"]
                 self.box = np.ascontiguousarray(part["box/edges/value"][frames - 1], dtype=np.float64)
+                self.boundary = read_boundary(f)
                 names = ["position", "velocity", "image", "box/edges"] + (["last_collision"] if last_collision else [])
                 self._frame_groups = [part[name] for name in names]
                 for g in self._frame_groups:
@@ -183,7 +195,7 @@ class H5MDWriter:
         self.file.flush()
 
     # ----------------------------------------------------------------- layout
-    def _create(self, box, radii, masses, species, parameters, last_collision, author):
+    def _create(self, box, radii, masses, species, parameters, last_collision, author, extra):
         f, n, d = self.file, self.n, self.d
         h = f.create_group("h5md")
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
@@ -195,7 +207,8 @@ class H5MDWriter:
         part = f.create_group("particles/all")
         b = part.create_group("box")
         b.attrs["dimension"] = np.int32(d)
-        b.attrs["boundary"] = np.array(["periodic"] * d, dtype=h5py.string_dtype("ascii", 8))
+        b.attrs["boundary"] = np.array([_H5MD_BOUNDARY[x] for x in self.boundary],
+                                       dtype=h5py.string_dtype("ascii", 8))
         self.box = box
 
         pos = part.create_group("position")
@@ -227,7 +240,7 @@ class H5MDWriter:
         obs = f.create_group("observables")
         self._obs = {}
         step = time = None
-        for name in SCALAR_OBSERVABLES + ("momentum",):
+        for name in SCALAR_OBSERVABLES + ("momentum",) + tuple(extra):
             shape = (d,) if name == "momentum" else ()
             dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
             g = obs.create_group(name)
@@ -244,6 +257,11 @@ class H5MDWriter:
             "mean pressure (kinetic + collisional virial) over the sampling interval ending at time; "
             "NaN at the first sample of a run"
         )
+        if "wall_pressure" in obs:
+            obs["wall_pressure"].attrs["description"] = (
+                "normal momentum delivered to the walls per unit wall area per unit time over the sampling "
+                "interval ending at time; NaN at the first sample of a run"
+            )
         _write_parameters(f.create_group("parameters"), parameters)
 
     # ----------------------------------------------------------------- frames
@@ -403,6 +421,7 @@ class Snapshot:
     masses: np.ndarray  # (N,)
     species: np.ndarray  # (N,)
     last_collision: np.ndarray | None = None  # (N,) TC model only
+    boundary: tuple = ()  # "periodic" or "wall" per axis
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
@@ -521,9 +540,9 @@ def _frame_count(f) -> int:
 
 def _snapshot(f, k, static) -> Snapshot:
     part = f["particles/all"]
-    radii, masses, species = static
+    radii, masses, species, boundary = static
     lc = part["last_collision/value"][k] if "last_collision" in part else None
-    snap = _read_snapshot(part, k, radii, masses, species, lc)
+    snap = _read_snapshot(part, k, radii, masses, species, lc, boundary)
     for name in ("positions", "velocities", "box"):
         if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")
@@ -532,7 +551,7 @@ def _snapshot(f, k, static) -> Snapshot:
     return snap
 
 
-def _read_snapshot(part, k, radii, masses, species, lc) -> Snapshot:
+def _read_snapshot(part, k, radii, masses, species, lc, boundary) -> Snapshot:
     return Snapshot(
         index=k,
         time=float(part["position/time"][k]),
@@ -545,6 +564,7 @@ def _read_snapshot(part, k, radii, masses, species, lc) -> Snapshot:
         masses=masses,
         species=species,
         last_collision=lc,
+        boundary=boundary,
     )
 
 
@@ -555,7 +575,18 @@ def _static(f):
         if not np.all(np.isfinite(values) & (values > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: particles/all/{name} holds non-finite or "
                                  "non-positive values")
-    return radii, masses, part["species"][()]
+    return radii, masses, part["species"][()], read_boundary(f)
+
+
+def read_boundary(f) -> tuple:
+    """The boundary of each axis ("periodic" or "wall") from an open file's box attributes."""
+    box = f["particles/all/box"]
+    d = int(box.attrs.get("dimension", f["particles/all/position/value"].shape[-1]))
+    raw = box.attrs.get("boundary", None)
+    if raw is None:
+        return ("periodic",) * d
+    names = [x.decode() if isinstance(x, bytes) else str(x) for x in np.atleast_1d(raw)]
+    return tuple("wall" if x == "none" else "periodic" for x in names)
 
 
 def iter_snapshots(path) -> Iterator[Snapshot]:

@@ -231,8 +231,11 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
 def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
     """One line for the run summary: the eps spread and whether a constant eps would do.
 
-    Returns None for elastic runs.
+    Returns None for elastic and driven runs (the advice compares cooling curves).
     """
+    driving = getattr(config, "driving", None)
+    if driving is not None and driving.heating_rate > 0.0:
+        return None
     adv = advise(config, tolerance)
     if adv.model == "elastic" or adv.eps_best is None:
         return None

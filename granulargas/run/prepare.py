@@ -30,15 +30,19 @@ import numpy as np
 
 from granulargas import __version__
 from granulargas.contact import material, restitution_table
-from granulargas.engine import CollisionRule
+from granulargas import theory
+from granulargas.engine import CollisionRule, WhiteNoise
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
 from granulargas.initial import InitialState, box_for_packing, random_state
-from granulargas.initial.lattice_gas import RANDOM_PLACEMENT_MAX
+from granulargas.initial.lattice_gas import MIN_WALL_AXIS_DIAMETERS, RANDOM_PLACEMENT_MAX
 from granulargas.io.config import TABLE_BETA_MAX, RunConfig
-from granulargas.io.h5md import load_snapshot, read_observables, snapshot_count
+from granulargas.io.h5md import load_snapshot, open_run, read_boundary, read_observables, snapshot_count
 from granulargas.run.resources import check_memory
 from granulargas.theory import particle_volume
+
+#: observables samples of a run without [output] observables_interval (run.schedule uses it)
+DEFAULT_OBSERVABLE_SAMPLES = 200
 
 
 @dataclass
@@ -52,6 +56,7 @@ class Setup:
     table: object = None
     parameters: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
+    driving: object = None
 
 
 # ------------------------------------------------------------------- particles
@@ -97,9 +102,17 @@ def fresh_state(config: RunConfig) -> InitialState:
             f"{MIN_BOX_DIAMETERS:g} largest diameters (= {MIN_BOX_DIAMETERS * dmax:.4g}); use more particles "
             "or a higher packing_fraction"
         )
+    for a, kind in enumerate(s.boundary):
+        if kind == "wall" and box[a] < MIN_WALL_AXIS_DIAMETERS * dmax:
+            raise ConfigError(
+                f"{config.source}: system.boundary = [{', '.join(repr(b) for b in s.boundary)}]: the wall "
+                f"axis {'xyz'[a]} is {box[a]:.4g} long, too short for the particles: it must be >= "
+                f"{MIN_WALL_AXIS_DIAMETERS:g} largest diameters (= {MIN_WALL_AXIS_DIAMETERS * dmax:.4g}); "
+                "use more particles or a higher packing_fraction"
+            )
     try:
         return random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
-                            radii=radii, masses=masses, rng=rng)
+                            radii=radii, masses=masses, rng=rng, boundary=s.boundary)
     except ConfigError as exc:
         limit = RANDOM_PLACEMENT_MAX[s.dimension]
         raise ConfigError(f"{config.source}: system.packing_fraction = {s.packing_fraction:g}: {exc}; random "
@@ -119,6 +132,8 @@ def restart_state(config: RunConfig) -> InitialState:
     try:
         snap = load_snapshot(path, -1)
         obs = read_observables(path)
+        with open_run(path) as f:
+            boundary = read_boundary(f)
     except InputFileError as exc:
         raise InputFileError(f"{where}: {str(exc).split(': ', 1)[-1]}") from None
     for name in ("collisions", "dissipated_energy"):
@@ -129,8 +144,12 @@ def restart_state(config: RunConfig) -> InitialState:
     if len(hits) == 0:
         raise InputFileError(f"{where}: no observables sample at its last snapshot (t = {snap.time:g})")
     k = int(hits[-1])
-    if k >= len(obs["dissipated_energy"][2]):
-        raise InputFileError(f"{where}: damaged H5MD file: observables/dissipated_energy ends before its last snapshot")
+    counters = {}
+    for name in ("dissipated_energy", "wall_collisions", "injected_energy", "kick_step"):
+        if name in obs and k >= len(obs[name][2]):
+            raise InputFileError(f"{where}: damaged H5MD file: observables/{name} ends before its last snapshot")
+        if name in obs and name != "dissipated_energy":
+            counters[name] = obs[name][2][k]
     collisions = int(obs["collisions"][2][k])
     dissipated = float(obs["dissipated_energy"][2][k])
     n, dim = snap.positions.shape
@@ -147,6 +166,11 @@ def restart_state(config: RunConfig) -> InitialState:
                              f"{', '.join(bad) or 'radii, masses or box'}")
     packing = float(particle_volume(2.0 * snap.radii, dim).sum() / np.prod(snap.box))
     check_memory(config, n=n, packing=packing, fresh=False)
+    if boundary != tuple(config.system.boundary):
+        raise ConfigError(
+            f"{config.source}: system.boundary = [{', '.join(repr(b) for b in config.system.boundary)}]: "
+            f"restart file {path} has [{', '.join(repr(b) for b in boundary)}]"
+        )
     return InitialState(
         positions=np.ascontiguousarray(snap.positions, dtype=np.float64),
         velocities=np.ascontiguousarray(snap.velocities, dtype=np.float64),
@@ -159,6 +183,10 @@ def restart_state(config: RunConfig) -> InitialState:
         collisions=collisions,
         events=snap.step,
         dissipated_energy=dissipated,
+        boundary=boundary,
+        wall_collisions=int(counters.get("wall_collisions", 0)),
+        injected_energy=float(counters.get("injected_energy", 0.0)),
+        kick_step=int(counters["kick_step"]) if "kick_step" in counters else None,
         last_collision=None if snap.last_collision is None else np.ascontiguousarray(snap.last_collision),
         source=str(path),
     )
@@ -183,10 +211,14 @@ def reference_mass_si(material) -> float:
     return material.density * float(particle_volume(material.diameter, 3))
 
 
-def beta_bound(prefactor: float, state: InitialState) -> float:
-    """Largest beta any pair can reach in the run (rigorous; module docstring)."""
+def beta_bound(prefactor: float, state: InitialState, energy: float | None = None) -> float:
+    """Largest beta any pair can reach in the run (rigorous; module docstring).
+
+    ``energy``: the largest total kinetic energy the run reaches (default: the
+    initial one, which collisions never raise; a driven run passes its own bound)."""
     m = state.masses
-    energy = 0.5 * float((m[:, None] * state.velocities**2).sum())
+    if energy is None:
+        energy = 0.5 * float((m[:, None] * state.velocities**2).sum())
     m_min = float(m.min())
     g_max = 2.0 * math.sqrt(2.0 * energy / m_min)
     r_max = float(state.radii.max())
@@ -228,6 +260,22 @@ def validity_warnings(config: RunConfig, prefactor: float, state: InitialState) 
                                                                           speed_of_sound=sound)]
 
 
+def driven_energy_bound(config: RunConfig, prefactor: float, state: InitialState) -> float:
+    """Total kinetic energy the restitution table of a driven viscoelastic run must cover.
+
+    Kicks are Gaussian, so no bound is rigorous: twice the larger of the initial energy
+    and the energy N d T_ss / 2 of the theoretical steady state (the total energy of N
+    particles fluctuates by ~ (2 / (d N))^(1/2) of itself); all of it in one pair, as in
+    :func:`beta_bound`. A run that goes beyond stops with a TableRangeError."""
+    s = config.system
+    sigma, m = mean_particle(config)
+    n = float(len(state.radii)) / float(np.prod(state.box))
+    t_ss = theory.viscoelastic_driven_state(config.driving.heating_rate, prefactor, n, s.dimension, sigma,
+                                            m, end=config.collision.contact_end)[0]
+    e0 = 0.5 * float((state.masses[:, None] * state.velocities**2).sum())
+    return 2.0 * max(e0, 0.5 * s.dimension * len(state.masses) * t_ss)
+
+
 def make_rule(config: RunConfig, state: InitialState):
     """(rule, name, prefactor, table, warnings, parameters) for the config."""
     c = config.collision
@@ -235,14 +283,17 @@ def make_rule(config: RunConfig, state: InitialState):
     if c.model == "elastic":
         return CollisionRule.elastic(), "elastic", None, None, [], params
     if c.model == "constant":
-        params.update(restitution=c.restitution, tc_time=c.tc_time)
-        return CollisionRule.constant(c.restitution, tc_time=c.tc_time), "constant", None, None, [], params
+        params.update(restitution=c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution)
+        rule = CollisionRule.constant(c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution)
+        return rule, "constant", None, None, [], params
     k = reduced_prefactor(config)
-    bmax = beta_bound(k, state)
+    driven = config.driving is not None and config.driving.heating_rate > 0.0
+    bmax = beta_bound(k, state, driven_energy_bound(config, k, state) if driven else None)
     if not bmax <= TABLE_BETA_MAX:
         key = (f"collision.damping = {c.damping:g}" if c.material is None else "collision.material")
+        energy = "the driving's energy bound" if driven else "the run's kinetic energy"
         raise ConfigError(
-            f"{config.source}: {key}: the fastest impact the run's kinetic energy allows reaches beta = {bmax:.3g}, "
+            f"{config.source}: {key}: the fastest impact {energy} allows reaches beta = {bmax:.3g}, "
             f"beyond the restitution table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well below 3); "
             "lower the damping")
     table = restitution_table(max(bmax, 1e-6), end=c.contact_end)
@@ -256,6 +307,51 @@ def make_rule(config: RunConfig, state: InitialState):
     return CollisionRule.viscoelastic(prefactor=k, table=table), "viscoelastic", k, table, warns, params
 
 
+def make_driving(config: RunConfig, prefactor: float | None, state: InitialState):
+    """(WhiteNoise or None, parameters) of the config's ``[driving]``.
+
+    The kick interval, unless given, is at most 0.02 of the shortest time over which
+    the temperature changes by its own size: the steady state's cooling time
+    1 / zeta(T_ss) (:func:`granulargas.theory.driving_interval`), the initial cooling
+    time 1 / zeta(T0), or the heating time T0 / H of a gas starting colder. zeta is
+    the Enskog rate (constant eps with the driven a2; viscoelastic with the effective
+    restitution of :func:`granulargas.theory.effective_restitution`; 0 when elastic).
+    It is then shortened to a whole fraction of the observables interval, so that every
+    observables sample falls half-way between two kicks (the engine kicks at
+    (k + 1/2) dt_k), where T equals its kick-interval average.
+    The kicks' random stream is seeded with ``system.seed``. A heating rate of 0
+    means no driving.
+    """
+    drv = config.driving
+    if drv is None or drv.heating_rate == 0.0:
+        return None, None
+    s, c = config.system, config.collision
+    sigma, m = mean_particle(config)
+    n = float(len(state.radii)) / float(np.prod(state.box))
+    d, h = s.dimension, drv.heating_rate
+    t0 = float((state.masses[:, None] * state.velocities**2).sum()) / (d * len(state.masses))
+    if c.model == "elastic":
+        rates = [h / t0]
+    else:
+        if c.model == "constant":
+            eps_ss = eps0 = c.restitution
+            t_ss = float(theory.driven_temperature(h, eps_ss, n, d, sigma, m))
+        else:
+            t_ss, _, eps_ss = theory.viscoelastic_driven_state(h, prefactor, n, d, sigma, m, end=c.contact_end)
+            eps0 = theory.effective_restitution(prefactor, t0, d, sigma, m, c.contact_end)
+        rates = [h / t_ss, h / t0,
+                 float(theory.enskog_cooling_rate(eps0, n, t0, d, sigma, m, a2=theory.driven_sonine_a2(eps0, d)))]
+    if drv.interval is not None:
+        interval = drv.interval
+    else:
+        interval = theory.driving_interval(max(rates))
+        if config.run.end_time is not None:
+            obs_dt = config.output.observables_interval or config.run.end_time / DEFAULT_OBSERVABLE_SAMPLES
+            interval = obs_dt / math.ceil(obs_dt / interval * (1.0 - 1e-12))
+    params = {"model": drv.model, "heating_rate": h, "interval": interval, "seed": s.seed}
+    return WhiteNoise(h, interval, seed=s.seed), params
+
+
 def initial_state(config: RunConfig) -> InitialState:
     """The state a run of ``config`` starts from: the restart file's last snapshot
     (``initial.from``) or a fresh random state."""
@@ -266,6 +362,7 @@ def prepare(config: RunConfig) -> Setup:
     """Build rule, table and initial state; raise before any file is written."""
     state = initial_state(config)
     rule, name, k, table, warns, rule_params = make_rule(config, state)
+    driving, driving_params = make_driving(config, k, state)
     s = config.system
     vol = particle_volume(2.0 * state.radii, s.dimension).sum()
     parameters = {
@@ -281,7 +378,10 @@ def prepare(config: RunConfig) -> Setup:
                  "energy: initial temperature T0 (k_B = 1) unless [collision.material] sets speed_unit; "
                  "time: diameter * sqrt(mass / T0)",
         "collision": rule_params,
+        "boundary": " ".join(s.boundary),
     }
+    if driving_params is not None:
+        parameters["driving"] = driving_params
     if config.collision.material is not None:
         m = config.collision.material
         parameters["units_si"] = {"length_m": m.diameter, "mass_kg": reference_mass_si(m),
@@ -289,4 +389,4 @@ def prepare(config: RunConfig) -> Setup:
     if state.source:
         parameters["restart"] = {"file": state.source, "time": state.time, "step": state.events,
                                  "collisions": state.collisions}
-    return Setup(rule, name, state, k, table, parameters, warns)
+    return Setup(rule, name, state, k, table, parameters, warns, driving)

@@ -266,6 +266,11 @@ def check_same_physics(config: RunConfig, path: Path) -> None:
     if old is None:
         raise InputFileError(f"{path}: parameters/config is missing or not a valid config; --append needs the "
                              "file's config")
+    if (config.driving is None) != (old.driving is None):
+        given = "has no [driving]" if config.driving is None else "has [driving]"
+        raise ConfigError(f"{config.source}: {given}, but the file {path} was run "
+                          f"{'with' if old.driving is not None else 'without'} it; --append continues the same "
+                          "physics (write a new file with --output instead)")
     for section in _SAME_PHYSICS:
         new_s, old_s = getattr(config, section), getattr(old, section)
         for f in fields(new_s):
@@ -283,7 +288,7 @@ def _plain(v):
 
 
 def _observables(sim, pressure: bool) -> dict:
-    return {
+    out = {
         "temperature": float(sim.temperature),
         "kinetic_energy": float(sim.kinetic_energy),
         "collisions": int(sim.collisions),
@@ -292,6 +297,13 @@ def _observables(sim, pressure: bool) -> dict:
         "momentum": np.asarray(sim.momentum, dtype=np.float64),
         "pressure": float(sim.pressure_window()) if pressure else math.nan,
     }
+    if "wall" in sim.boundary:
+        out["wall_collisions"] = int(sim.wall_collisions)
+        out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
+    if sim.driving is not None:
+        out["injected_energy"] = float(sim.injected_energy)
+        out["kick_step"] = int(sim.kick_step)
+    return out
 
 
 def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True, progress=None,
@@ -351,7 +363,9 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     sim = Simulation(
         st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
         time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
-        events=st.events, dissipated_energy=st.dissipated_energy,
+        events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
+        wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
+        injected_energy=st.injected_energy,
     )
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
@@ -374,7 +388,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
-                            last_collision=tc, overwrite=overwrite)
+                            last_collision=tc, overwrite=overwrite, boundary=sim.boundary,
+                            driven=sim.driving is not None)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached

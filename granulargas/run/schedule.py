@@ -18,11 +18,9 @@ import numpy as np
 from granulargas import theory
 from granulargas.errors import ConfigError
 from granulargas.io.config import RunConfig
-from granulargas.run.prepare import mean_particle
+from granulargas.run.prepare import DEFAULT_OBSERVABLE_SAMPLES, mean_particle
 from granulargas.run.resources import available_memory, format_bytes
 
-#: default number of evenly spaced observables samples (plus every snapshot time)
-DEFAULT_OBSERVABLE_SAMPLES = 200
 #: memory of the schedule per output time (the arrays output_schedule builds and merges)
 SCHEDULE_BYTES_PER_TARGET = 64.0
 

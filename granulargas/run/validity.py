@@ -218,10 +218,15 @@ class RunValidity:
     tc_ratio: float | None = None
     warnings: list = field(default_factory=list)
     errors: list = field(default_factory=list)
+    driven: bool = False
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
-        out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (predicted by t = {self.t_end:.4g})"]
+        if self.driven:
+            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady state of the driving, "
+                   "Enskog theory)"]
+        else:
+            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (predicted by t = {self.t_end:.4g})"]
         if self.spread is not None:
             sp = self.spread
             out.append(f"validity     beta {sp['beta_min']:.3g}..{sp['beta_max']:.3g}, "
@@ -253,15 +258,49 @@ def table_range_error(gas: RunGas) -> str | None:
             "below 3)")
 
 
+def _check_driven(config, gas) -> RunValidity:
+    """Checks of a driven run: it heads for the steady temperature of the driving
+    (:mod:`granulargas.theory.driven`) instead of cooling."""
+    h = config.driving.heating_rate
+    if gas.model == "elastic":  # no steady state: T grows as T0 + H t
+        t_end = gas.temperature + h * (gas.end_time if gas.end_time is not None else 0.0)
+    elif gas.model == "constant":
+        t_end = float(theory.driven_temperature(h, gas.restitution, gas.density, gas.dimension, gas.sigma,
+                                                gas.mass))
+    else:
+        t_end = theory.viscoelastic_driven_state(h, gas.prefactor, gas.density, gas.dimension, gas.sigma,
+                                                 gas.mass, end=gas.end)[0]
+    spread = None
+    if gas.model == "viscoelastic" and gas.pair_constant > 0:
+        spread = restitution_spread(gas, max(gas.temperature, t_end), min(gas.temperature, t_end))
+    rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, float(t_end), spread,
+                     driven=True)
+    rv.tc_ratio = contact_time_ratio(gas, max(gas.temperature, t_end))
+    if rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN:
+        what = "tc_time" if gas.model == "constant" else "contact duration"
+        rv.warnings.append(
+            f"{gas.source}: {what} / mean free time = {rv.tc_ratio:.3g} > {TC_RATIO_WARN:g}: about "
+            f"{100 * (1 - math.exp(-2 * rv.tc_ratio)):.2g} % of collisions overlap a third contact, "
+            "so binary instantaneous collisions (event-driven dynamics) misstate the dissipation")
+    if spread is not None and spread["beta_max"] > BETA_VALID:
+        rv.warnings.append(
+            f"{gas.source}: beta of fast thermal impacts = {spread['beta_max']:.3g} > {BETA_VALID:g}: the "
+            "quasi-static viscoelastic force needs the dissipative time A well below the contact time")
+    return rv
+
+
 def check_run(config) -> RunValidity:
     """All run-level checks for a config (module doc); no simulation."""
     gas = config if isinstance(config, RunGas) else gas_from_config(config)
-    src = gas.source
     table = table_range_error(gas)
     if table:  # the predictions below would need the table beyond its range
         rv = RunValidity(gas, math.nan, gas.temperature, math.nan)
         rv.errors.append(table)
         return rv
+    driving = getattr(config, "driving", None)
+    if driving is not None and driving.heating_rate > 0.0:
+        return _check_driven(config, gas)
+    src = gas.source
     spread = curve = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = viscoelastic_cooling(gas)

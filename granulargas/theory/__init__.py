@@ -11,11 +11,14 @@ import theory; theory.haff_tau0(...)``):
   in the damping (``T ~ t^(-5/3)``), C1, C2;
 * :mod:`~granulargas.theory.gas` -- a homogeneous gas with the exact eps(beta):
   impact speeds, the spread of eps, the cooling curve, the instability length of
-  a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there).
+  a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there);
+* :mod:`~granulargas.theory.driven` -- the white-noise driven steady state
+  (temperature, a2, kick interval; viscoelastic: effective restitution).
 """
 
-from granulargas.theory import enskog, gas, viscoelastic  # noqa: F401
+from granulargas.theory import driven, enskog, gas, viscoelastic  # noqa: F401
+from granulargas.theory.driven import *  # noqa: F401,F403
 from granulargas.theory.enskog import *  # noqa: F401,F403
 from granulargas.theory.viscoelastic import *  # noqa: F401,F403
 
-__all__ = enskog.__all__ + viscoelastic.__all__
+__all__ = enskog.__all__ + viscoelastic.__all__ + driven.__all__

@@ -21,13 +21,15 @@ from granulargas.run.prepare import fresh_state, reduced_prefactor
 needs_lmp = pytest.mark.skipif(find_lmp() is None, reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
 
 
-def config_text(dimension=3, particles=120, end="force", extra=""):
+def config_text(dimension=3, particles=120, end="force", extra="", boundary=None):
+    walls = "" if boundary is None else "boundary = [" + ", ".join(f'"{b}"' for b in boundary) + "]"
     return f"""
 [system]
 dimension = {dimension}
 particles = {particles}
 packing_fraction = 0.1
 seed = 11
+{walls}
 
 [collision]
 model = "viscoelastic"
@@ -119,6 +121,41 @@ def test_export_matches_config(tmp_path, dimension):
     assert summary["young_modulus"] == pytest.approx(Y, rel=1e-15)
 
 
+@pytest.mark.parametrize("dimension, boundary", [(3, ("periodic", "periodic", "wall")),
+                                                 (2, ("wall", "wall"))])
+def test_walls_become_fixed_boundaries_with_a_wall_fix_of_the_same_contact(tmp_path, dimension, boundary):
+    config = parse_config(config_text(dimension, boundary=boundary))
+    ex = export_lammps(config, tmp_path)
+    cmds = read_input(ex.input_file)
+    want = ["f" if b == "wall" else "p" for b in boundary] + (["p"] if dimension == 2 else [])
+    assert cmds["boundary"] == [want]
+    state = fresh_state(config)
+    (pc,) = cmds["pair_coeff"]
+    walls = [f for f in cmds["fix"] if f[2] == "wall/gran"]
+    assert len(walls) == boundary.count("wall")
+    for f in walls:
+        axis = "xyz".index(f[-3][0])
+        assert f[1] == "type1" and f[3] == "granular" and f[-3] == f"{'xyz'[axis]}plane"
+        assert float(f[-2]) == 0.0 and float(f[-1]) == pytest.approx(state.box[axis], rel=1e-15)
+        # the pair's model with eta_n0 for m_eff = m (sphere-plane) instead of m/2
+        model = f[4:-3]
+        assert model[0] == "hertz/material" and model[4:] == pc[6:]
+        assert float(model[2]) == pytest.approx(0.5 * float(pc[4]), rel=1e-15)
+        assert model[1] == pc[3] and model[3] == pc[5]
+    data = read_data_file(ex.data_file)
+    for a, b in enumerate(boundary):
+        if b == "wall":  # every sphere within [R, L - R]
+            z = data["Atoms"][:, 4 + a]
+            r = data["Atoms"][:, 2] / 2
+            assert np.all(z >= r) and np.all(z <= state.box[a] - r)
+
+
+def test_driven_config_is_refused(tmp_path):
+    config = parse_config(config_text(extra="\n[driving]\nheating_rate = 0.1\n"))
+    with pytest.raises(UserError, match="driving"):
+        export_lammps(config, tmp_path)
+
+
 def test_overlap_end_has_no_limit_damping(tmp_path):
     ex = export_lammps(parse_config(config_text(end="overlap")), tmp_path)
     (pc,) = read_input(ex.input_file)["pair_coeff"]
@@ -179,8 +216,9 @@ def test_lammps_reads_export(tmp_path, dimension):
 
 
 @needs_lmp
-@pytest.mark.parametrize("dimension, end_time", [(3, 3.0), (2, 8.0)])
-def test_lammps_cools_like_granulargas(tmp_path, dimension, end_time):
+@pytest.mark.parametrize("dimension, end_time, boundary", [
+    (3, 3.0, None), (2, 8.0, None), (3, 3.0, ("periodic", "periodic", "wall"))])
+def test_lammps_cools_like_granulargas(tmp_path, dimension, end_time, boundary):
     """Same initial state, same contact law: T(t) of LAMMPS (t_c = 1 % of the mean free
     time) and of our event-driven run agree within the run-to-run fluctuation.
 
@@ -190,11 +228,12 @@ def test_lammps_cools_like_granulargas(tmp_path, dimension, end_time):
     |T_LAMMPS / T_ours - 1| is about 0.5-2 % (single runs; over 8 seeds at N = 2000
     in 3D the mean difference is +0.5 +- 0.4 %, scripts/compare_lammps.py --ensemble). A factor
     1.5 error in the damping mapping moves T(t_end) by 10-20 %; the tolerance is 4 %.
+    With walls on z (LAMMPS ``fix wall/gran``, the engine's sphere-plane contact) too.
     """
     from granulargas.io.h5md import read_observables
     from granulargas.run.runner import run_config
 
-    text = config_text(dimension, particles=1000).replace("damping = 0.2", "damping = 0.1")
+    text = config_text(dimension, particles=1000, boundary=boundary).replace("damping = 0.2", "damping = 0.1")
     text = text.replace("end_time = 0.5", f"end_time = {end_time}")
     text += f'\n[output]\nfile = "{tmp_path / "ed.h5"}"\nsnapshots = 2\nobservables_interval = 0.1\n'
     config = parse_config(text)

@@ -52,3 +52,15 @@ def hermite_table(func, beta_max=25.0, n=4000):
     from types import SimpleNamespace
 
     return SimpleNamespace(inv_h=1.0 / h, coeffs=np.ascontiguousarray(coeffs), beta_max=beta_max)
+
+
+def walled_state(n, packing, dimension, walls, seed=0, radii=0.5, temperature=1.0):
+    """A random state in a box with flat walls on the axes ``walls`` (no sphere overlapping one).
+
+    Returns (kwargs for Simulation without the boundary, boundary tuple).
+    """
+    boundary = tuple("wall" if a in walls else "periodic" for a in range(dimension))
+    st = random_state(n, packing, dimension, temperature=temperature, seed=seed, radii=radii,
+                      boundary=boundary)
+    return dict(positions=st.positions, velocities=st.velocities, radii=st.radii, masses=st.masses,
+                box=st.box), boundary

@@ -1,20 +1,27 @@
 """A naive O(N^2) event-driven reference (pure numpy; independent of the engine).
 
-All particles move together; the next collision is the minimum over all pairs
-and all 3^d periodic images of the textbook quadratic root. Used to check the
-engine's event sequence on small systems.
+All particles move together; the next event is the minimum over all pairs and
+all 3^d periodic images (periodic axes only) of the textbook quadratic root,
+and over every particle and every wall (flat walls at 0 and L on the axes
+listed in ``walls``) of the time to touch it. Used to check the engine's
+event sequence on small systems.
 """
 
 import itertools
 
 import numpy as np
 
+from granulargas.contact.lookup import table_lookup
 
-def next_collision(pos, vel, radii, box):
-    """(delay, i, j) of the next collision from the current state (inf, -1, -1 if none)."""
+
+def next_collision(pos, vel, radii, box, walls=()):
+    """(delay, i, j) of the next pair collision from the current state (inf, -1, -1 if none)."""
     n, d = pos.shape
     best = (np.inf, -1, -1)
+    periodic = np.array([a not in walls for a in range(d)], dtype=float)
     shifts = np.array(list(itertools.product((-1, 0, 1), repeat=d)), dtype=float) * box
+    if walls:  # no images across a wall
+        shifts = np.unique(shifts * periodic, axis=0)
     iu, ju = np.triu_indices(n, 1)
     dr0 = pos[iu] - pos[ju]
     dv = vel[iu] - vel[ju]
@@ -35,10 +42,46 @@ def next_collision(pos, vel, radii, box):
     return best
 
 
-def collide(pos, vel, radii, masses, box, i, j, eps):
+def next_wall_collision(pos, vel, radii, box, walls):
+    """(delay, i, axis, side) of the next sphere-wall contact (inf, -1, -1, -1 if none)."""
+    best = (np.inf, -1, -1, -1)
+    for a in walls:
+        x, v = pos[:, a], vel[:, a]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_low = np.where(v < 0, np.maximum(x - radii, 0.0) / -v, np.inf)
+            t_high = np.where(v > 0, np.maximum(box[a] - radii - x, 0.0) / v, np.inf)
+        for side, t in ((0, t_low), (1, t_high)):
+            k = int(np.argmin(t))
+            if t[k] < best[0]:
+                best = (float(t[k]), k, a, side)
+    return best
+
+
+def next_event(pos, vel, radii, box, walls=()):
+    """("pair", delay, i, j) or ("wall", delay, i, axis) of the next event."""
+    tp, i, j = next_collision(pos, vel, radii, box, walls)
+    tw, k, a, _ = next_wall_collision(pos, vel, radii, box, walls)
+    if tw < tp:
+        return "wall", tw, k, a
+    return "pair", tp, i, j
+
+
+def restitution(rule, gn, r_eff, m_eff):
+    """eps of a collision by ``rule`` (engine CollisionRule: kind, restitution, prefactor, table)."""
+    if rule.kind == "elastic":
+        return 1.0
+    if rule.kind == "constant":
+        return rule.restitution
+    beta = rule.prefactor * (r_eff * gn / m_eff**2) ** 0.2
+    return table_lookup(beta, rule.table.inv_h, rule.table.coeffs)
+
+
+def collide(pos, vel, radii, masses, box, i, j, eps, walls=()):
     """Smooth-sphere collision of i and j (nearest image) with restitution eps, in place."""
     dr = pos[i] - pos[j]
-    dr -= box * np.round(dr / box)
+    for a in range(len(box)):
+        if a not in walls:
+            dr[a] -= box[a] * np.round(dr[a] / box[a])
     nrm = dr / np.linalg.norm(dr)
     un = float(np.dot(vel[i] - vel[j], nrm))
     mi, mj = masses[i], masses[j]
@@ -47,17 +90,32 @@ def collide(pos, vel, radii, masses, box, i, j, eps):
     return un
 
 
-def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0):
-    """Event sequence [(time, i, j)] of the first ``ncoll`` collisions, global clock."""
+def bounce(vel, i, axis, eps):
+    """Sphere i hits a flat wall normal to ``axis``: v_n -> -eps v_n, in place; returns v_n."""
+    vn = float(vel[i, axis])
+    vel[i, axis] = -eps * vn
+    return vn
+
+
+def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None):
+    """Event sequence [(time, i, j)] of the first ``ncoll`` events, global clock; a wall
+    collision of particle i with a wall of axis a appears as (time, i, -1 - a)."""
     pos = pos.copy()
     vel = vel.copy()
+    wall_eps = eps if wall_eps is None else wall_eps
     t = 0.0
     out = []
     for _ in range(ncoll):
-        dt, i, j = next_collision(pos, vel, radii, box)
+        kind, dt, i, j = next_event(pos, vel, radii, box, walls)
         pos += vel * dt
-        pos %= box
+        for a in range(len(box)):
+            if a not in walls:
+                pos[:, a] %= box[a]
         t += dt
-        collide(pos, vel, radii, masses, box, i, j, eps)
-        out.append((t, min(i, j), max(i, j)))
+        if kind == "pair":
+            collide(pos, vel, radii, masses, box, i, j, eps, walls)
+            out.append((t, min(i, j), max(i, j)))
+        else:
+            bounce(vel, i, j, wall_eps)
+            out.append((t, i, -1 - j))
     return out, pos, vel

@@ -103,11 +103,11 @@ def test_neighbour_lists_grow_when_full():
     sim = make_sim(n=300, packing=0.45, seed=0, shell=1.0)
     sim._nb_width = 4  # overflow in the first build
     sim._build()
-    s = sim._s
-    w = int(s["nbn"].max())
-    s["nbl"] = np.ascontiguousarray(s["nbl"][:, :w])
+    lists = sim._engine.lists
+    w = int(lists.nbn.max())
     sim._nb_width = w
-    s["scratch"] = sim._new_scratch()
+    sim._engine = sim._engine._replace(lists=lists._replace(
+        nbl=np.ascontiguousarray(lists.nbl[:, :w]), scratch=sim._new_scratch()))
     sim.run(2.0)
     ref.run(2.0)
     assert sim._nb_width > w
@@ -151,10 +151,10 @@ def test_cells_grow_when_full():
     sim = make_sim(n=300, packing=0.05, seed=13)
     sim._cell_width = 1  # overflow in the first build
     sim._build()
-    s = sim._s
-    w = int(s["cell_n"].max())
+    cells = sim._engine.cells
+    w = int(cells.n.max())
     assert sim._cell_width > 1
-    s["cell_ids"] = np.ascontiguousarray(s["cell_ids"][:, :w])
+    sim._engine = sim._engine._replace(cells=cells._replace(ids=np.ascontiguousarray(cells.ids[:, :w])))
     sim._cell_width = w
     sim.run(20.0)
     ref.run(20.0)
@@ -194,15 +194,14 @@ def test_rebuild_tests_the_rounded_centre():
     sim = Simulation(pos, np.zeros((2, 3)), np.full(2, 0.5), np.ones(2), box,
                      CollisionRule.elastic(), shell=1.0)
     sim._build()
-    s = sim._s
-    assert sim.shell == 1.0 and s["nbn"].tolist() == [0, 0]
-    i = int(np.flatnonzero(s["rec"][:, 0] == 29980.0)[0])
+    e = sim._engine
+    rec = e.particles.rec
+    assert sim.shell == 1.0 and e.lists.nbn.tolist() == [0, 0]
+    i = int(np.flatnonzero(rec[:, 0] == 29980.0)[0])
     b = np.sqrt(4.0 - 1e-4 - 1.5**2)
-    s["rec"][i, :3] = [29991.5009, 3.0 + b, 3.0]
+    rec[i, :3] = [29991.5009, 3.0 + b, 3.0]
     assert np.float32(29991.5009) == np.float32(29991.5)
-    st = rebuild_list(i, s["rec"], s["centre"], 0.5, sim.shell, sim._box3, sim._ncell,
-                      s["cell_ids"], s["cell_n"], s["cell_of"], s["nbl"], s["nbn"],
-                      s["scratch"], s["stencil"])
+    st = rebuild_list(i, rec, e.lists, e.cells, sim._space, 0.5, sim.shell)
     assert st == 0
-    assert s["nbn"].tolist() == [1, 1]
+    assert e.lists.nbn.tolist() == [1, 1]
     assert check(sim) == []

@@ -1,0 +1,86 @@
+"""Cycle counters compiled into the event loop on request (numba leaf module).
+
+The loop takes an argument ``probe``: ``None`` in production, or an int64 array
+(:data:`PROBE_SIZE`) in the profiler (``scripts/profile_loop.py``). The
+functions here are numba overloads whose code depends on that argument's
+*type*: for ``None`` they compile to nothing, so the production build of the
+loop is the loop without counters; for an array they read the CPU cycle counter
+(``llvm.readcyclecounter``) and add the cycles since the previous probe to the
+part of the event that just ended. The same source thus gives two builds, and
+the profiler measures the loop without editing it.
+
+Parts of one event (indices into the probe array; ``probe[PARTS + k]`` counts
+the calls of part k):
+"""
+
+from llvmlite import ir
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic, overload
+
+POP, COLLIDE, REBUILD, WALL, STALE, PREDICT, UPDATE, PREFETCH, PEEK = range(9)
+PART_NAMES = ["pop + validate", "collide (+ partner)", "list rebuild", "wall", "stale",
+              "predict i", "update i", "prefetch", "peek next"]
+PARTS = len(PART_NAMES)
+#: probe[GUESSES]: events whose successor was guessed for the prefetch; probe[GUESSED]: right
+GUESSES = 2 * PARTS
+GUESSED = GUESSES + 1
+PROBE_SIZE = GUESSED + 1
+
+__doc__ += "".join(f"{k} {name}; " for k, name in enumerate(PART_NAMES)) + "\n"
+
+
+@intrinsic
+def _cycles(typingctx):
+    def codegen(context, builder, signature, args):
+        fn = cgutils.get_or_insert_function(builder.module, ir.FunctionType(ir.IntType(64), []),
+                                            "llvm.readcyclecounter")
+        return builder.call(fn, [])
+
+    return types.int64(), codegen
+
+
+def probe_start(probe):
+    """Cycle counter now (0 without a probe array)."""
+
+
+def probe(probe, part, clock):
+    """Add the cycles since ``clock`` to ``part``; returns the new clock (no-op without probe)."""
+
+
+def probe_guess(probe, right):
+    """Count one guess of the event after next, and whether it was ``right``."""
+
+
+@overload(probe_start)
+def _probe_start(probe):
+    if isinstance(probe, types.NoneType):
+        return lambda probe: 0
+    return lambda probe: _cycles()
+
+
+@overload(probe)
+def _probe(probe, part, clock):
+    if isinstance(probe, types.NoneType):
+        return lambda probe, part, clock: clock
+
+    def impl(probe, part, clock):
+        now = _cycles()
+        probe[part] += now - clock
+        probe[PARTS + part] += 1
+        return now
+
+    return impl
+
+
+@overload(probe_guess)
+def _probe_guess(probe, right):
+    if isinstance(probe, types.NoneType):
+        return lambda probe, right: None
+
+    def impl(probe, right):
+        probe[GUESSES] += 1
+        if right:
+            probe[GUESSED] += 1
+
+    return impl

@@ -1,0 +1,130 @@
+"""Named records of the compiled engine state (numba-compatible).
+
+The compiled kernels see the engine state as a few named tuples of arrays
+(structure of arrays, one row per particle slot in memory order) and two kinds
+of named scalars:
+
+* read-only parameters travel as named tuples of scalars (:class:`Params`,
+  :class:`RuleParams`, :class:`Space`), so that a kernel reads ``prm.shell``
+  instead of an index into a float vector;
+* mutable scalars (counters, the calendar's window) live in one-element numpy
+  *record* arrays (structured dtypes :data:`COUNTERS`, :data:`CALENDAR_STATE`);
+  a kernel takes ``c = counters[0]`` and reads and writes ``c.collisions``.
+
+Every field has one dtype, fixed here, so that the kernels compile once per
+signature and ``cache=True`` reuses them across processes (the named-tuple
+classes are module-level, hence importable by the cache).
+
+Record layout
+-------------
+``Engine`` (the whole mutable state):
+
+* ``particles`` :class:`Particles` -- ``rec`` (N, 8) f8, one 64-byte record per
+  particle: x, y, z at the particle's own clock, vx, vy, vz, clock t_i, radius;
+  ``img`` (N, 3) i4 periodic images; ``mass`` f8; ``count`` i4 (velocity
+  changes: a pair event is valid while its partner's count is unchanged);
+  ``lastcoll`` f8 (time of the last collision, TC model and collapse watch);
+  ``rapid`` i4 (collapse watch); ``ident`` i4 (particle id of the slot).
+* ``events`` :class:`Events` -- the one scheduled event per particle: ``partner``
+  i4 (>= 0: a pair collision with that slot; < 0: the event kind, see
+  :mod:`granulargas.engine._loop`) and ``tag`` i4 (the partner's ``count`` when
+  predicted; the wall index 2 a + side for a wall collision).
+* ``lists`` :class:`Lists` -- ``centre`` (N, 3) f4 list centres, ``nbl`` (N, M) i4
+  neighbour lists, ``nbn`` i4 lengths; work space ``scratch`` i4 and ``stencil`` i8.
+* ``cells`` :class:`Cells` -- ``ids`` (C, K) i4 slots of each cell, ``n`` i4 fill,
+  ``of`` (N,) i4 cell of each list centre.
+* ``calendar`` :class:`Calendar` -- see :mod:`granulargas.engine._calendar`.
+* ``counters`` (1,) :data:`COUNTERS` record.
+* ``walls`` :class:`Walls` -- ``impulse`` (3, 2) f8: normal momentum delivered to
+  the lower / upper wall of each axis since the last reset.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import namedtuple
+
+import numpy as np
+
+Particles = namedtuple("Particles", ["rec", "img", "mass", "count", "lastcoll", "rapid", "ident"])
+Events = namedtuple("Events", ["partner", "tag"])
+Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil"])
+Cells = namedtuple("Cells", ["ids", "n", "of"])
+Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
+Walls = namedtuple("Walls", ["impulse"])
+Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
+                               "walls"])
+
+# Read-only parameters.
+#: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
+#: ``eps``, ``tc_time`` (<= 0: TC model off), viscoelastic ``prefactor`` k and the
+#: restitution table (``inv_h``, ``coeffs``), and the sphere-wall ``wall_eps``
+#: (constant rule).
+RuleParams = namedtuple("RuleParams", ["kind", "eps", "tc_time", "prefactor", "inv_h", "coeffs",
+                                       "wall_eps"])
+#: Geometry: ``box`` (3,) side lengths (the cell grid spans [0, L)); ``period`` (3,)
+#: the period of each axis (L when periodic, inf on a wall axis, so that the
+#: minimum image and the wrap leave wall axes alone); ``ncell`` (3,) cells per
+#: axis; ``wall_axes`` (k,) the axes with flat walls at 0 and L; ``dims`` 2 or 3.
+Space = namedtuple("Space", ["box", "period", "ncell", "wall_axes", "dims"])
+#: Everything else the loop reads: ``shell`` (list shell width), ``half_shell``
+#: (how far a particle may move from its list centre, with a round-off margin),
+#: ``rmax`` (largest radius), ``collapse_dt`` and ``collapse_count`` (inelastic-
+#: collapse watch), and the white-noise driving: ``kick_interval`` (inf: none),
+#: ``kick_scale`` (velocity-kick standard deviation for unit mass), ``kick_seed``.
+Params = namedtuple("Params", ["rule", "space", "shell", "half_shell", "rmax", "collapse_dt",
+                               "collapse_count", "kick_interval", "kick_scale", "kick_seed"])
+
+#: Mutable scalars of a run. ``time`` of the last event; ``dissipated`` energy
+#: (cumulative); ``virial`` sum of r_ij . Delta p_ij and ``kin_int`` integral of
+#: sum m v^2 dt since the last pressure reset; ``sum_mv2`` = sum m v^2 now;
+#: ``injected`` energy put in by the driving (cumulative); event counts; ``kick_step``
+#: index k of the next driving step (at time (k + 1/2) kick_interval); ``err_i``, ``err_j``
+#: the slots involved in an error.
+COUNTERS = np.dtype([
+    ("time", "f8"), ("dissipated", "f8"), ("virial", "f8"), ("kin_int", "f8"),
+    ("sum_mv2", "f8"), ("injected", "f8"),
+    ("collisions", "i8"), ("events", "i8"), ("expiries", "i8"), ("stale", "i8"),
+    ("wall_collisions", "i8"), ("kicks", "i8"), ("kick_step", "i8"),
+    ("err_i", "i8"), ("err_j", "i8"),
+], align=True)
+
+#: The event calendar's scalars (:mod:`granulargas.engine._calendar`).
+CALENDAR_STATE = np.dtype([
+    ("size", "i8"), ("cur", "i8"), ("nb", "i8"), ("nring", "i8"), ("free", "i8"), ("look", "i8"),
+    ("width", "f8"), ("t0", "f8"), ("ovf_min", "f8"),
+], align=True)
+
+
+def rule_params(kind: int, eps: float = 1.0, tc_time: float = -1.0, prefactor: float = 0.0,
+                inv_h: float = 1.0, coeffs=None, wall_eps: float | None = None) -> RuleParams:
+    """A :class:`RuleParams` with the dtypes the kernels are compiled for."""
+    coeffs = np.zeros((1, 4)) if coeffs is None else np.ascontiguousarray(coeffs, dtype=np.float64)
+    return RuleParams(int(kind), float(eps), float(tc_time), float(prefactor), float(inv_h), coeffs,
+                      float(eps if wall_eps is None else wall_eps))
+
+
+def space(box3, period3, ncell, wall_axes, dims) -> Space:
+    """A :class:`Space` with the dtypes the kernels are compiled for."""
+    return Space(np.ascontiguousarray(box3, dtype=np.float64),
+                 np.ascontiguousarray(period3, dtype=np.float64),
+                 np.ascontiguousarray(ncell, dtype=np.int64),
+                 np.ascontiguousarray(wall_axes, dtype=np.int64), int(dims))
+
+
+def params(rule: RuleParams, spc: Space, shell: float, rmax: float, collapse_dt: float,
+           collapse_count: int, kick_interval: float = math.inf, kick_scale: float = 0.0,
+           kick_seed: int = 0) -> Params:
+    """A :class:`Params` with the dtypes the kernels are compiled for."""
+    return Params(rule, spc, float(shell), 0.5 * float(shell) * (1.0 - 1e-9), float(rmax),
+                  float(collapse_dt), int(collapse_count), float(kick_interval), float(kick_scale),
+                  np.uint64(kick_seed))
+
+
+def nbytes(engine: Engine) -> int:
+    """Bytes held by the arrays of an engine state."""
+    total = 0
+    for group in engine:
+        for a in (group if isinstance(group, tuple) else (group,)):
+            total += getattr(a, "nbytes", 0)
+    return total
