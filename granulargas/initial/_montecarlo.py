@@ -7,8 +7,7 @@ numpy Generator) and passed in, so the result is reproducible everywhere.
 """
 
 from granulargas._numba import jit
-from granulargas.engine._cells import (cell_coord, cell_index, cell_insert, cell_remove, stencil_cell,
-                                       stencil_size)
+from granulargas.engine._cells import _wrap, cell_coord, cell_index, cell_insert, cell_remove
 from granulargas.engine._geometry import min_image
 
 
@@ -26,17 +25,21 @@ def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
-    for k in range(stencil_size(ncell)):
-        j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
-        while j >= 0:
-            if j != i:
-                dx = min_image(x - r[j, 0], box[0])
-                dy = min_image(y - r[j, 1], box[1])
-                dz = min_image(z - r[j, 2], box[2])
-                s = radius[i] + radius[j]
-                if dx * dx + dy * dy + dz * dz < s * s:
-                    return True
-            j = cell_next[j]
+    for oz in range(-1 if ncell[2] >= 3 else 0, 2 if ncell[2] >= 3 else 1):
+        kz = _wrap(cz + oz, ncell[2])
+        for oy in range(-1, 2):
+            row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
+            for ox in range(-1, 2):
+                j = cell_head[_wrap(cx + ox, ncell[0]) + row]
+                while j >= 0:
+                    if j != i:
+                        dx = min_image(x - r[j, 0], box[0])
+                        dy = min_image(y - r[j, 1], box[1])
+                        dz = min_image(z - r[j, 2], box[2])
+                        s = radius[i] + radius[j]
+                        if dx * dx + dy * dy + dz * dz < s * s:
+                            return True
+                    j = cell_next[j]
     return False
 
 
@@ -73,18 +76,22 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
     total = 0.0
-    for k in range(stencil_size(ncell)):
-        j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
-        while j >= 0:
-            if j != i:
-                dx = min_image(x - r[j, 0], box[0])
-                dy = min_image(y - r[j, 1], box[1])
-                dz = min_image(z - r[j, 2], box[2])
-                s = radius[i] + radius[j]
-                d2 = dx * dx + dy * dy + dz * dz
-                if d2 < s * s:
-                    total += s - d2**0.5
-            j = cell_next[j]
+    for oz in range(-1 if ncell[2] >= 3 else 0, 2 if ncell[2] >= 3 else 1):
+        kz = _wrap(cz + oz, ncell[2])
+        for oy in range(-1, 2):
+            row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
+            for ox in range(-1, 2):
+                j = cell_head[_wrap(cx + ox, ncell[0]) + row]
+                while j >= 0:
+                    if j != i:
+                        dx = min_image(x - r[j, 0], box[0])
+                        dy = min_image(y - r[j, 1], box[1])
+                        dz = min_image(z - r[j, 2], box[2])
+                        s = radius[i] + radius[j]
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if d2 < s * s:
+                            total += s - d2**0.5
+                    j = cell_next[j]
     return total
 
 
@@ -133,18 +140,22 @@ def _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, o
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
-    for k in range(stencil_size(ncell)):
-        j = cell_head[stencil_cell(cx, cy, cz, k, ncell)]
-        while j >= 0:
-            if j != i:
-                dx = min_image(x - r[j, 0], box[0])
-                dy = min_image(y - r[j, 1], box[1])
-                dz = min_image(z - r[j, 2], box[2])
-                s = radius[i] + radius[j]
-                if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
-                    out[m] = j
-                    m += 1
-            j = cell_next[j]
+    for oz in range(-1 if ncell[2] >= 3 else 0, 2 if ncell[2] >= 3 else 1):
+        kz = _wrap(cz + oz, ncell[2])
+        for oy in range(-1, 2):
+            row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
+            for ox in range(-1, 2):
+                j = cell_head[_wrap(cx + ox, ncell[0]) + row]
+                while j >= 0:
+                    if j != i:
+                        dx = min_image(x - r[j, 0], box[0])
+                        dy = min_image(y - r[j, 1], box[1])
+                        dz = min_image(z - r[j, 2], box[2])
+                        s = radius[i] + radius[j]
+                        if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
+                            out[m] = j
+                            m += 1
+                    j = cell_next[j]
     return m
 
 
@@ -161,17 +172,25 @@ def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
 
 
 @jit
-def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, kick, out):
+def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, kick, margin, near,
+              out):
     """Push each particle of ``idx`` out of its overlaps (Gauss-Seidel descent).
 
-    Particle i moves by sum_j [(R_i + R_j - d_ij)/2 + 1e-3 (R_i + R_j)] n_ij,
+    Particle i moves by sum_j [(R_i + R_j - d_ij)/2 + margin (R_i + R_j)] n_ij,
     i.e. by a little more than its half of every overlap, so that overlaps
-    disappear in a finite number of passes; the push is scaled by ``kick[k]``
+    disappear in a finite number of passes (a larger margin opens the gaps a
+    growth step closed in fewer passes); the push is scaled by ``kick[k]``
     (random, around 1) to break the symmetric deadlocks of a particle squeezed
     between two others. Writes the particles still
     involved in overlaps (with repetitions) into ``out``; returns their number.
+
+    The scan of the 27 cells around i also keeps in ``near`` (int64 scratch) the
+    particles within R_i + R_j + reach of i, reach = R_i: when the push is shorter
+    than reach these are the only ones i can overlap at its new place (triangle
+    inequality), so the new overlaps are found without a second scan of the cells.
     """
     m = 0
+    cap = near.shape[0]
     for k in range(idx.shape[0]):
         i = idx[k]
         x = r[i, 0]
@@ -180,25 +199,35 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
         px = 0.0
         py = 0.0
         pz = 0.0
+        reach = radius[i]
+        nn = 0
         cx = cell_coord(x, box[0], ncell[0])
         cy = cell_coord(y, box[1], ncell[1])
         cz = cell_coord(z, box[2], ncell[2])
-        for q in range(stencil_size(ncell)):
-            j = cell_head[stencil_cell(cx, cy, cz, q, ncell)]
-            while j >= 0:
-                if j != i:
-                    dx = min_image(x - r[j, 0], box[0])
-                    dy = min_image(y - r[j, 1], box[1])
-                    dz = min_image(z - r[j, 2], box[2])
-                    s = radius[i] + radius[j]
-                    d2 = dx * dx + dy * dy + dz * dz
-                    if d2 < s * s and d2 > 0.0:
-                        dd = d2**0.5
-                        f = (0.5 * (s - dd) + 1e-3 * s) / dd
-                        px += f * dx
-                        py += f * dy
-                        pz += f * dz
-                j = cell_next[j]
+        for oz in range(-1 if ncell[2] >= 3 else 0, 2 if ncell[2] >= 3 else 1):
+            kz = _wrap(cz + oz, ncell[2])
+            for oy in range(-1, 2):
+                row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
+                for ox in range(-1, 2):
+                    j = cell_head[_wrap(cx + ox, ncell[0]) + row]
+                    while j >= 0:
+                        if j != i:
+                            dx = min_image(x - r[j, 0], box[0])
+                            dy = min_image(y - r[j, 1], box[1])
+                            dz = min_image(z - r[j, 2], box[2])
+                            s = radius[i] + radius[j]
+                            d2 = dx * dx + dy * dy + dz * dz
+                            if d2 < s * s and d2 > 0.0:
+                                dd = d2**0.5
+                                f = (0.5 * (s - dd) + margin * s) / dd
+                                px += f * dx
+                                py += f * dy
+                                pz += f * dz
+                            if d2 < (s + reach) * (s + reach):
+                                if nn < cap:
+                                    near[nn] = j
+                                nn += 1
+                        j = cell_next[j]
         if px == 0.0 and py == 0.0 and pz == 0.0:
             continue
         x += kick[k] * px
@@ -217,7 +246,19 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
         r[i, 1] = y
         r[i, 2] = z
         m0 = m
-        m = _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, out, m)
+        moved2 = kick[k] * kick[k] * (px * px + py * py + pz * pz)
+        if nn <= cap and moved2 < reach * reach:
+            for q in range(nn):
+                j = near[q]
+                dx = min_image(x - r[j, 0], box[0])
+                dy = min_image(y - r[j, 1], box[1])
+                dz = min_image(z - r[j, 2], box[2])
+                s = radius[i] + radius[j]
+                if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
+                    out[m] = j
+                    m += 1
+        else:
+            m = _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, out, m)
         if m > m0 and m < out.shape[0]:
             out[m] = i
             m += 1
