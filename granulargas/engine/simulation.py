@@ -43,13 +43,20 @@ BOUNDARIES = ("periodic", "wall")
 MIN_BOX_DIAMETERS = 3.15
 
 
-def default_shell(packing: float) -> float:
+def default_shell(packing: float, dimension: int = 3) -> float:
     """Neighbour-list shell width in units of the largest diameter.
 
     A thin shell means short lists but frequent expiries; the optimum drops
-    with density (tuned with ``scripts/bench_engine.py``).
+    with density (tuned with ``scripts/bench_engine.py`` and, for dilute
+    gases, ``scripts/bench_shell.py``). Below packing 0.15 in 3D the shell
+    keeps about 12 list centres within the cut-off 1 + shell of a particle
+    (number density 6 eta / pi): ``(1 + shell)^3 = 1.5 / eta``, at least 1.2.
+    A fixed shell would let the expiries per collision grow as the mean free
+    path, 1 / eta.
     """
     if packing < 0.15:
+        if dimension == 3 and packing > 0.0:
+            return max(1.2, (1.5 / packing) ** (1.0 / 3.0) - 1.0)
         return 1.2
     if packing < 0.4:
         return 0.7
@@ -250,7 +257,7 @@ class Simulation:
         unit = math.pi / 6.0 * 8.0 if d == 3 else math.pi
         self.packing_fraction = float(unit * np.sum(rad**d) / volume)
         dmax = 2.0 * float(rad.max())
-        want = default_shell(self.packing_fraction) if shell is None else float(shell)
+        want = default_shell(self.packing_fraction, d) if shell is None else float(shell)
         if want <= 0:
             raise ConfigError(f"shell = {want}: must be > 0")
         # at least 3 cells per side so that the 27 neighbour cells are distinct

@@ -116,7 +116,8 @@ def run_memory(n: int, dimension: int, packing: float, mean_volume_ratio: float 
     unit = math.pi / 6.0 if d == 3 else math.pi / 4.0  # volume of a diameter-1 particle
     with_overflow = n * unit * mean_volume_ratio / packing if packing > 0 else math.inf  # V / dmax^d
     edge = with_overflow ** (1.0 / d) if math.isfinite(with_overflow) else math.inf
-    shell = min(default_shell(packing), edge / 3.0 - 1.0) if math.isfinite(edge) else default_shell(packing)
+    shell = (min(default_shell(packing, d), edge / 3.0 - 1.0) if math.isfinite(edge)
+             else default_shell(packing, d))
     cut = 1.0 + max(shell, 0.05)
     engine_cells = _grid_cells(with_overflow, edge, d, cut)
     placement_cells = _grid_cells(with_overflow, edge, d, 1.0)
