@@ -61,6 +61,9 @@ def _header(info) -> list[str]:
         + (f" (restitution {info.restitution:g})" if info.restitution is not None and info.model == "constant" else "")
         + (f" (prefactor k = {info.prefactor:.4g})" if info.prefactor is not None and info.model == "viscoelastic" else ""),
     ]
+    if info.method == "dsmc":
+        lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; the pressure is not "
+                     "sampled)")
     if not info.monodisperse:
         lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
                      f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
@@ -263,6 +266,7 @@ def run(args) -> int:
         walls = wall_summary(a.info, t_from)
     if args.json:
         out = a.summary()
+        out["method"] = a.info.method
         if walls is not None:
             out["walls"] = walls
         print(json.dumps(out, indent=1, ensure_ascii=False, default=float))
