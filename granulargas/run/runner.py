@@ -86,11 +86,15 @@ class RunSummary:
     particles: int = 0
     warnings: tuple = field(default_factory=tuple)
     startup_time: float = 0.0
+    method: str = "edmd"
+    candidates: int | None = None  # DSMC: candidate pairs drawn (accepted or not)
 
     def lines(self) -> list[str]:
         per = 2.0 * self.collisions / self.particles if self.particles else float("nan")
+        counts = (f"{self.events} events" if self.candidates is None else
+                  f"DSMC, {self.candidates} candidate pairs drawn")
         return [
-            f"collisions   {self.collisions} ({per:.4g} per particle), {self.events} events",
+            f"collisions   {self.collisions} ({per:.4g} per particle), {counts}",
             f"time         {self.time:.6g} (stopped by {self.stop_reason})",
             f"wall time    {self.wall_time:.3g} s ({self.collisions_per_second:.4g} collisions/s)"
             f" + {self.startup_time:.3g} s start-up (JIT compile or cache load, queue build)",
@@ -518,6 +522,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         particles=len(st.radii),
         warnings=tuple(setup.warnings),
         startup_time=startup,
+        method=config.run.method,
+        candidates=int(sim.candidates) if dsmc else None,
     )
     writer.set_parameters({"summary": {
         "stop_reason": stop_reason, "time": summary.time, "collisions": summary.collisions,
