@@ -490,7 +490,7 @@ SCHEMA: tuple[Key, ...] = (
         '`"edmd"`: event-driven molecular dynamics (positions, walls, structure); `"dsmc"`: Direct '
         "Simulation Monte Carlo of the homogeneous Enskog–Boltzmann equation with the same collision rule "
         "(no positions: `particles` is the sample size, `packing_fraction` sets n and χ; no walls, "
-        "no TC model, no driving).",
+        "no TC model).",
         default="edmd", choices=METHODS),
     # [output]
     Key("output", "file", "string", "The H5MD output file, relative to the working directory.",
@@ -794,9 +794,6 @@ def _check_dsmc_supported(v: Values):
     if v.has("collision.tc_time"):
         v.fail("collision.tc_time", 'the TC model needs pair histories of a spatial gas: not available with '
                                     'method = "dsmc" (a homogeneous DSMC gas shows no inelastic collapse)')
-    if v.section_given("driving"):
-        v.fail("driving.heating_rate", 'white-noise driving is not available with method = "dsmc" '
-                                       '(use method = "edmd")', v.raw.get("driving.heating_rate", ...))
 
 
 RULES: tuple[Rule, ...] = (
@@ -824,7 +821,7 @@ RULES: tuple[Rule, ...] = (
     Rule('`wall_restitution` is used only with walls (a `"wall"` entry in `boundary`).',
          _check_wall_restitution_needs_walls),
     Rule("`[driving]` needs `heating_rate`.", _check_driving_needs_heating_rate),
-    Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls, no `tc_time` and no `[driving]`.',
+    Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls and no `tc_time`.',
          _check_dsmc_supported),
 )
 

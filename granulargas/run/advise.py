@@ -23,7 +23,7 @@ advice predicts, with kinetic theory and no simulation
 
 6. the model of the scene (:func:`choose_method`): DSMC (``run.method = "dsmc"``) for a
    homogeneous dilute gas, where it solves the same Enskog-Boltzmann equation much
-   faster: no walls, TC model or driving, a box below the instability length and a
+   faster: no walls or TC model, a box below the instability length and a
    packing fraction up to :data:`DSMC_MAX_PACKING`; EDMD otherwise. The predicted
    speed-up is the ratio of collision rates measured by ``scripts/bench_dsmc.py``
    (docs/performance.md, DSMC section), interpolated in the packing fraction.
@@ -91,8 +91,6 @@ def choose_method(config, instability_length: float = math.inf) -> tuple[str, st
         return "edmd", "walls need positions (DSMC simulates a homogeneous gas)"
     if c.tc_time is not None:
         return "edmd", "the TC model needs pair histories of a spatial gas"
-    if config.driving is not None and config.driving.heating_rate > 0.0:
-        return "edmd", "white-noise driving is not available in DSMC"
     box = _box(config)
     if box > instability_length:
         return "edmd", (f"the box {box:.4g} exceeds the instability length {instability_length:.4g}: "

@@ -4,13 +4,14 @@
 (:mod:`granulargas.run.runner`) uses on an engine ``Simulation``: ``events`` (the
 frames' step: pair collisions), ``synchronise()`` (nothing to do: the DSMC state is
 always synchronised), ``positions``/``images`` (None: a homogeneous gas has none),
-``boundary``, ``driving``. :func:`make_dsmc` builds it from a
+``boundary``. :func:`make_dsmc` builds it from a
 :class:`granulargas.run.prepare.Setup`: the density is that of the config's box
 (the volume of ``system.packing_fraction``), chi the Enskog value
 :func:`granulargas.theory.contact_value` of that packing fraction (the one the
 theory module uses), the collision rule the engine's (same restitution table and
 pair prefactor), and the random streams seeded with ``system.seed``, or continued
-from the restart file's stored DSMC state.
+from the restart file's stored DSMC state; ``[driving]`` gives the engine's white-noise
+kicks (:class:`granulargas.engine.WhiteNoise`, the same kick law and random stream).
 """
 
 from __future__ import annotations
@@ -26,7 +27,6 @@ class DSMCRun(DSMC):
 
     positions = None
     images = None
-    driving = None
     last_collision = None
 
     @property
@@ -45,7 +45,9 @@ class DSMCRun(DSMC):
         """One observables sample (:mod:`granulargas.io.h5md`): no pressure; ``events`` is the
         count of candidate pairs drawn."""
         t, a2, a3 = self._moments()
-        return {
+        driven = {} if self.driving is None else {"injected_energy": float(self.injected_energy),
+                                                   "kick_step": int(self.kick_step)}
+        return {**driven,
             "temperature": float(t),
             "kinetic_energy": float(self.kinetic_energy),
             "collisions": int(self.collisions),
@@ -62,4 +64,5 @@ def make_dsmc(config, setup) -> DSMCRun:
     st = setup.state
     return DSMCRun(st.velocities, st.radii, st.masses, setup.rule, volume=float(np.prod(st.box)),
                    chi=setup.parameters["dsmc"]["chi"], seed=config.system.seed, time=st.time,
-                   collisions=st.collisions, dissipated_energy=st.dissipated_energy, state=setup.dsmc_state)
+                   collisions=st.collisions, dissipated_energy=st.dissipated_energy, state=setup.dsmc_state,
+                   driving=setup.driving, kick_step=st.kick_step, injected_energy=st.injected_energy)

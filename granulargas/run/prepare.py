@@ -205,7 +205,8 @@ def restart_state(config: RunConfig) -> InitialState:
             masses=np.ascontiguousarray(snap.masses, dtype=np.float64),
             box=np.ascontiguousarray(snap.box, dtype=np.float64), species=np.asarray(snap.species, dtype=np.int32),
             time=snap.time, collisions=collisions, events=snap.step, dissipated_energy=dissipated,
-            boundary=boundary, source=str(path))
+            boundary=boundary, injected_energy=float(counters.get("injected_energy", 0.0)),
+            kick_step=int(counters["kick_step"]) if "kick_step" in counters else None, source=str(path))
     return InitialState(
         positions=np.ascontiguousarray(snap.positions, dtype=np.float64),
         velocities=np.ascontiguousarray(snap.velocities, dtype=np.float64),

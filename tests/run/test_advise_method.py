@@ -57,7 +57,6 @@ def test_speedup_interpolates_the_measured_ratios():
 @pytest.mark.parametrize("kwargs, why", [
     ({"extra_system": 'boundary = ["wall", "periodic", "periodic"]'}, "walls"),
     ({"extra_collision": "tc_time = 0.001"}, "TC model"),
-    ({"driving": "[driving]\nheating_rate = 0.1\n"}, "driving"),
     ({"eta": 0.2, "n": 50}, "packing fraction 0.2"),
     ({"n": 200000}, "instability length"),
 ])

@@ -187,7 +187,6 @@ def test_2d_constant_and_mixtures_run(dsmc_config):
 @pytest.mark.parametrize("extra, key", [
     ('[system]\nboundary = ["wall", "periodic", "periodic"]', "system.boundary"),
     ('[collision]\nmodel = "constant"\nrestitution = 0.9\ntc_time = 0.001', "collision.tc_time"),
-    ("[driving]\nheating_rate = 0.1", "driving.heating_rate"),
 ])
 def test_keys_dsmc_cannot_honour_are_refused(extra, key):
     base = {"system": "dimension = 3\nparticles = 100\npacking_fraction = 0.05",
@@ -242,3 +241,21 @@ def test_engine_runs_write_sonine_coefficients(small_3d, write_config):
     assert obs["sonine_a2"][2][k] == pytest.approx(a2, rel=1e-12, abs=1e-15)
     assert obs["sonine_a3"][2][k] == pytest.approx(a3, rel=1e-12, abs=1e-15)
     assert has_positions(s.output) and "pressure" in obs
+
+
+def test_driven_dsmc_config_restarts_exactly(dsmc_config, tmp_path):
+    """[driving] with method = "dsmc": the engine's kicks; the file carries injected_energy and
+    kick_step, and --append continues bit for bit."""
+    text = DSMC_3D.replace('model = "viscoelastic"\ndamping = 0.1', 'model = "constant"\nrestitution = 0.8').replace(
+        "[run]", "[driving]\nheating_rate = 0.05\n\n[run]")
+    path = dsmc_config(text)
+    full = run_config(load_config(path, {"output.file": str(tmp_path / "full.h5")}))
+    part = tmp_path / "part.h5"
+    run_config(load_config(path, {"run.end_time": 10.0, "output.file": str(part)}))
+    run_config(load_config(path, {"initial.from": str(part), "output.file": str(part)}), append=True)
+    _assert_same_datasets(full.output, part)
+    obs = read_observables(full.output)
+    assert obs["kick_step"][2][-1] > 0 and obs["injected_energy"][2][-1] > 0
+    ke, diss, inj = obs["kinetic_energy"][2], obs["dissipated_energy"][2], obs["injected_energy"][2]
+    assert np.allclose(ke + diss - inj, ke[0], rtol=1e-9)
+    assert read_parameters(full.output)["driving"]["heating_rate"] == 0.05
