@@ -47,6 +47,11 @@ def test_analyze_reads_a_dsmc_file(tmp_path, capsys):
     assert main(["analyze", str(out), "--plot", str(png)]) == 0
     text = capsys.readouterr().out
     assert "method = dsmc" in text and png.stat().st_size > 0
+    # the velocity distribution of the later snapshots: a2 against the first-Sonine HCS value
+    vel = tmp_path / "v.png"
+    assert main(["analyze", str(out), "--velocity", str(vel)]) == 0
+    text = capsys.readouterr().out
+    assert "velocity distribution: 6 snapshots" in text and "high-energy tail" in text and vel.stat().st_size > 0
     assert main(["analyze", str(out), "--json"]) == 0
     js = json.loads(capsys.readouterr().out)
     assert js["method"] == "dsmc" and js["kind"] == "cooling"
@@ -88,3 +93,20 @@ def test_a_sweep_runs_dsmc_configs(tmp_path):
     assert not any(has_positions(f) for f in files)
     t_final = [read_observables(f)["temperature"][2][-1] for f in files]
     assert t_final[1] < t_final[0] < 1.0  # the more inelastic gas cools faster
+
+
+def test_velocity_distribution_of_an_engine_file(tmp_path, capsys):
+    """--velocity reads velocities only, so it works for either method; an elastic gas is
+    Maxwellian (a2 = 0 within its sampling error, ~ sqrt(8 / (d (d + 2) N)) per snapshot)."""
+    text = CONFIG.replace('method = "dsmc"\n', "").replace('model = "constant"\nrestitution = 0.8',
+                                                           'model = "elastic"').replace(
+        "particles = 2000", "particles = 500").replace("end_time = 60.0", "end_time = 20.0")
+    _, out = _run(tmp_path, capsys, text)
+    assert has_positions(out)
+    assert main(["analyze", str(out), "--velocity", str(tmp_path / "v.png")]) == 0
+    line = [x for x in capsys.readouterr().out.splitlines() if "velocity distribution" in x][0]
+    a2 = float(line.split("a2 = ")[1].split()[0])
+    assert abs(a2) < 4 * (8.0 / (15 * 500 * 6)) ** 0.5 and "theory a2 = 0.0000" in line
+    assert main(["analyze", str(out), "--velocity", str(tmp_path / "missing" / "v.png")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--velocity" in err
