@@ -15,7 +15,7 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.dsmc import _loop
-from granulargas.dsmc._majorant import build_histogram, class_edge, new_histogram, top_classes
+from granulargas.dsmc._majorant import build_histogram, class_edge, largest_component, new_histogram, top_classes
 from granulargas.dsmc._random import STATE_WORDS, seed_state
 from granulargas.engine._drive import kick_scale, kick_velocities
 from granulargas.engine.driving import WhiteNoise
@@ -313,7 +313,7 @@ class DSMC:
     def _advance(self, until, target, progress):
         """The compiled loop in chunks up to ``until`` or the collision count ``target``."""
         d = self.dimension
-        vmax = float(np.max(np.abs(self._rec[:, :d])))
+        vmax = float(largest_component(self._rec, d))
         if not (vmax < 1e150) or (0.0 < vmax < 1e-150):
             raise SimulationError(f"velocities out of range at t = {self.time:.12g} (max |v_a| = "
                                   f"{vmax:.3g}): squared speeds must stay within float64; rescale the units")

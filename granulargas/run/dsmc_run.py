@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from granulargas.dsmc import DSMC
-from granulargas.observables import energy_moments
+from granulargas.observables import kinetic_energy_momentum
 
 
 class DSMCRun(DSMC):
@@ -45,15 +45,16 @@ class DSMCRun(DSMC):
         """One observables sample (:mod:`granulargas.io.h5md`): no pressure; ``events`` is the
         count of candidate pairs drawn."""
         t, a2, a3 = self._moments()
+        ke, *p = kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)
         driven = {} if self.driving is None else {"injected_energy": float(self.injected_energy),
                                                    "kick_step": int(self.kick_step)}
         return {**driven,
             "temperature": float(t),
-            "kinetic_energy": float(self.kinetic_energy),
+            "kinetic_energy": float(ke),
             "collisions": int(self.collisions),
             "events": int(self.candidates),
             "dissipated_energy": float(self.dissipated_energy),
-            "momentum": np.asarray(self.momentum, dtype=np.float64),
+            "momentum": np.array(p[:self.dimension], dtype=np.float64),
             "sonine_a2": float(a2),
             "sonine_a3": float(a3),
         }
