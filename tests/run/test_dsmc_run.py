@@ -259,3 +259,15 @@ def test_driven_dsmc_config_restarts_exactly(dsmc_config, tmp_path):
     ke, diss, inj = obs["kinetic_energy"][2], obs["dissipated_energy"][2], obs["injected_energy"][2]
     assert np.allclose(ke + diss - inj, ke[0], rtol=1e-9)
     assert read_parameters(full.output)["driving"]["heating_rate"] == 0.05
+
+
+def test_a_damaged_dsmc_file_is_refused_with_one_line(dsmc_config, tmp_path, capsys):
+    path = dsmc_config()
+    d = run_config(load_config(path, {"run.end_time": 5.0, "output.file": str(tmp_path / "d.h5")}))
+    with h5py.File(d.output, "r+") as f:
+        del f["particles/all/dsmc/rng"]
+    with pytest.raises(Exception, match="particles/all/dsmc/rng/value is missing"):
+        load_snapshot(d.output)
+    assert main(["run", str(path), "--restart", str(d.output), "--output", str(tmp_path / "x.h5")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "dsmc/rng" in err and not (tmp_path / "x.h5").exists()
