@@ -57,7 +57,7 @@ from granulargas.run.prepare import mean_particle
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
-           "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING"]
+           "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line"]
 
 #: default tolerance on the relative error of T(t)
 DEFAULT_TOLERANCE = 0.02
@@ -300,6 +300,19 @@ def _set_method(adv: Advice, config):
     adv.method, adv.method_reason = choose_method(config, length)
     adv.speedup = dsmc_speedup(config.system.packing_fraction)
     adv.configured_method = config.run.method
+
+
+def method_line(config) -> str | None:
+    """One line for the run summary of a DSMC config whose scene needs positions (box above
+    the instability length, dense gas): the DSMC answer is that of a homogeneous Enskog gas.
+    None otherwise (walls and the TC model are refused by the config rules)."""
+    if config.run.method != "dsmc":
+        return None
+    method, reason = choose_method(config, V.gas_from_config(config).instability_length())
+    if method == "dsmc":
+        return None
+    return (f"warning      run.method = \"dsmc\": {reason}; this run shows the homogeneous Enskog-Boltzmann gas "
+            "(method = \"edmd\" for the real one)")
 
 
 def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:

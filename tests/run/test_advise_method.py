@@ -81,3 +81,17 @@ def test_cli_advise_prints_the_method(tmp_path, capsys):
     assert "method       DSMC" in out
     assert main(["advise", str(p), "--set", "system.packing_fraction=0.3"]) == 0
     assert "method       EDMD" in capsys.readouterr().out
+
+
+def test_a_dsmc_run_of_a_scene_that_needs_positions_says_so(tmp_path, capsys):
+    p = tmp_path / "c.toml"
+    text = BASE.format(n=200, eta=0.3, extra_system="", extra_collision="").replace(
+        "[run]", '[run]\nmethod = "dsmc"').replace("end_time = 10.0", "end_time = 1.0") + \
+        f'[output]\nfile = "{tmp_path / "c.h5"}"\n'
+    p.write_text(text)
+    assert main(["run", str(p), "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert 'warning      run.method = "dsmc": packing fraction 0.3 > 0.1' in out
+    p.write_text(text.replace("packing_fraction = 0.3", "packing_fraction = 0.02"))
+    assert main(["run", str(p), "--quiet", "--overwrite"]) == 0
+    assert "warning" not in capsys.readouterr().out
