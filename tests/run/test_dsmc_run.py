@@ -271,3 +271,57 @@ def test_a_damaged_dsmc_file_is_refused_with_one_line(dsmc_config, tmp_path, cap
     assert main(["run", str(path), "--restart", str(d.output), "--output", str(tmp_path / "x.h5")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "dsmc/rng" in err and not (tmp_path / "x.h5").exists()
+
+
+def test_append_to_a_file_without_sonine_observables(small_3d, write_config, tmp_path):
+    """Files written before sonine_a2/a3 were sampled continue with --append (without them)."""
+    path = write_config(small_3d)
+    part = tmp_path / "part.h5"
+    run_config(load_config(path, {"run.end_time": 1.0, "output.file": str(part)}))
+    with h5py.File(part, "r+") as f:
+        del f["observables/sonine_a2"], f["observables/sonine_a3"]
+    s = run_config(load_config(path, {"run.end_time": 2.0, "initial.from": str(part), "output.file": str(part)}),
+                   append=True)
+    obs = read_observables(part)
+    assert s.time == 2.0 and "sonine_a2" not in obs and obs["temperature"][1][-1] == 2.0
+
+
+def test_sigint_in_a_real_dsmc_process(write_config, tmp_path):
+    """A real SIGINT during a long DSMC run: exit 130, one line, the file keeps the state reached
+    as its last frame (with the DSMC state), and --append continues it."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    text = DSMC_3D.replace("particles = 400", "particles = 200000").replace("end_time = 20.0", "end_time = 1e6")
+    path = write_config(text.replace("snapshot_interval = 5.0\nobservables_interval = 1.0\n", ""))
+    out = tmp_path / "runs" / "out.h5"
+    proc = subprocess.Popen([sys.executable, "-m", "granulargas", "run", str(path), "--quiet"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        end = time.time() + 240.0
+        while time.time() < end:
+            time.sleep(0.3)
+            if out.exists():
+                try:
+                    with h5py.File(out, "r", locking=False) as f:
+                        if f["particles/all/velocity/time"].shape[0] >= 2:
+                            break
+                except (OSError, KeyError):
+                    pass
+            assert proc.poll() is None, proc.stderr.read()
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    assert len(err.strip().splitlines()) == 1 and err.startswith("interrupted: SIGINT at t = ")
+    frames = list(iter_snapshots(out))
+    assert interrupted_frames(out) == [len(frames) - 1] and frames[-1].time > frames[-2].time
+    t_s = frames[-1].time
+    assert read_dsmc_state(out)["candidates"] > 0
+    assert main(["run", str(path), "--restart", str(out), "--append", "--quiet",
+                 "--set", f"run.end_time={t_s + 1.0!r}"]) == 0
+    assert [s.time for s in iter_snapshots(out)][-1] == t_s + 1.0
