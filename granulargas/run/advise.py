@@ -64,8 +64,9 @@ DEFAULT_TOLERANCE = 0.02
 
 #: largest packing fraction for which advise recommends DSMC. Enskog's equation neglects the
 #: velocity correlations of a dense gas; at packing 0.02 the engine's T(t) and a2(t) agree
-#: with DSMC within 0.33 % and 0.005 (scripts/dsmc_vs_engine.py, docs/dsmc.md). 0.1 is a
-#: conservative bound, not a measured crossover.
+#: with DSMC within 0.33 % and 0.005 (scripts/dsmc_vs_engine.py), and the engine's energy
+#: loss per collision falls below DSMC's by about 1 % at packing 0.1 and 5 % at 0.4 for
+#: eps = 0.8 (scripts/dsmc_packing_gap.py; docs/dsmc.md, "denser packings").
 DSMC_MAX_PACKING = 0.1
 
 #: (packing fraction, DSMC / engine collision rate): CPU-time medians at N = 10^5, 3D,
