@@ -57,6 +57,8 @@ from granulargas.errors import ConfigError, InputFileError, SimulationError, Use
 from granulargas.io.config import RunConfig, parse_config
 from granulargas.io.h5md import H5MDWriter, read_parameters
 from granulargas.io.paths import existing_directory, output_file
+from granulargas.observables import sonine_coefficients
+from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
@@ -84,11 +86,15 @@ class RunSummary:
     particles: int = 0
     warnings: tuple = field(default_factory=tuple)
     startup_time: float = 0.0
+    method: str = "edmd"
+    candidates: int | None = None  # DSMC: candidate pairs drawn (accepted or not)
 
     def lines(self) -> list[str]:
         per = 2.0 * self.collisions / self.particles if self.particles else float("nan")
+        counts = (f"{self.events} events" if self.candidates is None else
+                  f"DSMC, {self.candidates} candidate pairs drawn")
         return [
-            f"collisions   {self.collisions} ({per:.4g} per particle), {self.events} events",
+            f"collisions   {self.collisions} ({per:.4g} per particle), {counts}",
             f"time         {self.time:.6g} (stopped by {self.stop_reason})",
             f"wall time    {self.wall_time:.3g} s ({self.collisions_per_second:.4g} collisions/s)"
             f" + {self.startup_time:.3g} s start-up (JIT compile or cache load, queue build)",
@@ -288,6 +294,9 @@ def _plain(v):
 
 
 def _observables(sim, pressure: bool) -> dict:
+    if hasattr(sim, "observables"):  # a DSMC run (run.dsmc_run.DSMCRun)
+        return sim.observables()
+    a2, a3 = sonine_coefficients(sim.velocities, sim.masses)
     out = {
         "temperature": float(sim.temperature),
         "kinetic_energy": float(sim.kinetic_energy),
@@ -296,6 +305,8 @@ def _observables(sim, pressure: bool) -> dict:
         "dissipated_energy": float(sim.dissipated_energy),
         "momentum": np.asarray(sim.momentum, dtype=np.float64),
         "pressure": float(sim.pressure_window()) if pressure else math.nan,
+        "sonine_a2": float(a2),
+        "sonine_a3": float(a3),
     }
     if "wall" in sim.boundary:
         out["wall_collisions"] = int(sim.wall_collisions)
@@ -360,13 +371,17 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         raise ConfigError(f"{config.source}: run.collisions_per_particle = {run.collisions_per_particle:g}: the "
                           f"restart file {st.source} already has {st.collisions} collisions; nothing to run")
 
-    sim = Simulation(
-        st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
-        time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
-        events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
-        wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
-        injected_energy=st.injected_energy,
-    )
+    dsmc = config.run.method == "dsmc"
+    if dsmc:
+        sim = make_dsmc(config, setup)
+    else:
+        sim = Simulation(
+            st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
+            time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
+            events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
+            wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
+            injected_energy=st.injected_energy,
+        )
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
     # event loop; both paths of a restart do it, so restart equality is unaffected
@@ -389,7 +404,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     else:
         writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
                             last_collision=tc, overwrite=overwrite, boundary=sim.boundary,
-                            driven=sim.driving is not None)
+                            driven=sim.driving is not None, positions=not dsmc)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached
@@ -421,7 +436,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     def snapshot():
         sim.synchronise()
         lc = np.asarray(sim.last_collision) if tc else None
-        writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc)
+        writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc,
+                              dsmc_state=sim.state if dsmc else None)
         frame[0] = (sim.events, sim.time)
 
     wall0 = _time.perf_counter()
@@ -506,6 +522,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         particles=len(st.radii),
         warnings=tuple(setup.warnings),
         startup_time=startup,
+        method=config.run.method,
+        candidates=int(sim.candidates) if dsmc else None,
     )
     writer.set_parameters({"summary": {
         "stop_reason": stop_reason, "time": summary.time, "collisions": summary.collisions,

@@ -276,6 +276,13 @@ def _check_driven(config, gas) -> RunValidity:
     rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, float(t_end), spread,
                      driven=True)
     rv.tc_ratio = contact_time_ratio(gas, max(gas.temperature, t_end))
+    _warn_contact(rv, gas, spread)
+    return rv
+
+
+def _warn_contact(rv: RunValidity, gas: RunGas, spread) -> None:
+    """Warnings of contacts the event-driven model misstates: contact durations that are not
+    short against the mean free time, and damping beyond the quasi-static force's range."""
     if rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN:
         what = "tc_time" if gas.model == "constant" else "contact duration"
         rv.warnings.append(
@@ -286,7 +293,6 @@ def _check_driven(config, gas) -> RunValidity:
         rv.warnings.append(
             f"{gas.source}: beta of fast thermal impacts = {spread['beta_max']:.3g} > {BETA_VALID:g}: the "
             "quasi-static viscoelastic force needs the dissipative time A well below the contact time")
-    return rv
 
 
 def check_run(config) -> RunValidity:
@@ -310,16 +316,7 @@ def check_run(config) -> RunValidity:
         spread = restitution_spread(gas, gas.temperature, max(T_end, 1e-300))
     rv = RunValidity(gas, float(t_end), gas.temperature, float(T_end), spread)
     rv.tc_ratio = contact_time_ratio(gas)
-    if rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN:
-        what = "tc_time" if gas.model == "constant" else "contact duration"
-        rv.warnings.append(
-            f"{src}: {what} / mean free time = {rv.tc_ratio:.3g} > {TC_RATIO_WARN:g}: about "
-            f"{100 * (1 - math.exp(-2 * rv.tc_ratio)):.2g} % of collisions overlap a third contact, "
-            "so binary instantaneous collisions (event-driven dynamics) misstate the dissipation")
-    if spread is not None and spread["beta_max"] > BETA_VALID:
-        rv.warnings.append(
-            f"{src}: beta of fast thermal impacts = {spread['beta_max']:.3g} > {BETA_VALID:g}: the quasi-static "
-            "viscoelastic force needs the dissipative time A well below the contact time")
+    _warn_contact(rv, gas, spread)
     if ln_T_end - math.log(gas.temperature) < math.log(DRIFT_T_RATIO) and not (
             ln_T_end - math.log(gas.mass) < math.log(UNDERFLOW_T)):
         rv.warnings.append(

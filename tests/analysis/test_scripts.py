@@ -53,3 +53,16 @@ def test_kinetic_theory_check_script(capsys):
     assert mod.main(["--quick"]) == 0
     out = capsys.readouterr().out
     assert "engine/theory-1" in out and "a2 theory" in out
+
+
+def test_models_speed_accuracy_script(tmp_path, capsys):
+    mod = _load("models_speed_accuracy")
+    assert mod.main(["--quick", "--prefix", str(tmp_path / "m")]) == 0
+    for name in ("m_speed_accuracy.png", "m_where_dsmc_fails.png"):
+        assert (tmp_path / name).stat().st_size > 5000
+    out = capsys.readouterr().out
+    # every sample size of both methods reports a finite error; the clustered gas is warmer than DSMC's
+    rows = [l for l in out.splitlines() if "rms(T/T_ref - 1)" in l]
+    assert len(rows) == 4 and all("nan" not in r for r in rows)
+    last = [l for l in out.splitlines() if "T_engine/T_DSMC =" in l][-1]
+    assert float(last.split("=")[-1]) > 1.05

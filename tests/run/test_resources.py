@@ -63,7 +63,7 @@ def test_memory_estimate_bounds_the_measured_peak(n, d, eta):
 def test_cell_count_is_the_engines():
     st = random_state(2000, 0.01, 3, seed=1)
     sim = Simulation(st.positions, st.velocities, st.radii, st.masses, st.box, CollisionRule.elastic())
-    assert resources.run_memory(2000, 3, 0.01)["engine_cells"] == float(np.prod(sim._ncell))
+    assert resources.run_memory(2000, 3, 0.01)["engine_cells"] == float(np.prod(sim._space.ncell))
 
 
 def test_memory_refusal_names_estimate_and_available():

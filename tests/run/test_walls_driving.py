@@ -62,7 +62,7 @@ observables_interval = 2.0
     (WALLS, {"system.boundary": "wall"}, "a list of 3 strings"),
     (WALLS, {"system.particles": 30, "system.packing_fraction": 0.3}, "wall axis z is .* too short for the"),
     (WALLS, {"system.boundary": ["periodic"] * 3}, "wall_restitution .* only used with walls"),
-    (DRIVEN, {"driving.heating_rate": -0.1}, r"driving.heating_rate = -0.1: must be a number >= 0"),
+    (DRIVEN, {"driving.heating_rate": -0.1}, r"driving.heating_rate = -0.1: must be a number in \[0, "),
     (DRIVEN, {"driving.model": "shaker"}, "driving.model"),
     (DRIVEN, {"driving.interval": 0.0}, "driving.interval"),
 ], ids=["boundary-length", "boundary-value", "boundary-type", "wall-axis-short", "wall-eps-no-walls",
