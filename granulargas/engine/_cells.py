@@ -302,29 +302,14 @@ def _shift(c, n, length):
     return 0.0
 
 
-@kernel(inline="always")
-def _contains(a, row, n, v):
-    for k in range(n):
-        if a[row, k] == v:
-            return True
-    return False
-
-
-@kernel(inline="always")
-def _in(a, n, v):
-    for k in range(n):
-        if a[k] == v:
-            return True
-    return False
-
-
 @kernel
 def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     """New list centre c_i = r_i and a new neighbour list for particle i.
 
     Only the differences to the old list touch other particles' lists: i is
     removed from the lists of old neighbours that are not new ones, and added
-    to those of new ones that were not old ones. Nothing is modified when a
+    to those of new ones that were not old ones (old and new told apart by the
+    per-particle byte ``lists.mark``, linear in the list lengths). Nothing is modified when a
     list or a cell would overflow (returns OVERFLOW or CELL_OVERFLOW); the
     caller enlarges ``nbl`` or ``cell_ids`` and calls again. Returns 0 on success.
     """
@@ -332,6 +317,7 @@ def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     nbl = lists.nbl
     nbn = lists.nbn
     scratch = lists.scratch
+    mark = lists.mark
     cell_ids = cells.ids
     cell_n = cells.n
     cell_of = cells.of
@@ -352,14 +338,25 @@ def rebuild_list(i, rec, lists, cells, space, rmax, shell):
         prefetch(nbn, scratch[k])
     for k in range(nold):
         prefetch(nbl, nbl[i, k])
+    # mark[j]: 1 = old neighbour only, 2 = old and new; all zero again on return
+    for k in range(nold):
+        mark[nbl[i, k]] = 1
+    full = False
     for k in range(count):
         j = scratch[k]
-        if nbn[j] >= m and not _contains(nbl, i, nold, j):
-            return OVERFLOW
+        if mark[j] != 0:
+            mark[j] = 2
+        elif nbn[j] >= m:
+            full = True
+    if full:
+        for k in range(nold):
+            mark[nbl[i, k]] = 0
+        return OVERFLOW
     # old neighbours that are not new ones lose i (swap with their last entry)
     for k in range(nold):
         j = nbl[i, k]
-        if not _in(scratch, count, j):
+        if mark[j] == 1:
+            mark[j] = 0
             last = nbn[j] - 1
             for q in range(last + 1):
                 if nbl[j, q] == i:
@@ -369,7 +366,9 @@ def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     # new neighbours that were not old ones gain i
     for k in range(count):
         j = scratch[k]
-        if not _contains(nbl, i, nold, j):
+        if mark[j] == 2:
+            mark[j] = 0
+        else:
             nbl[j, nbn[j]] = i
             nbn[j] += 1
     for k in range(count):

@@ -30,7 +30,8 @@ Record layout
   :mod:`granulargas.engine._loop`) and ``tag`` i4 (the partner's ``count`` when
   predicted; the wall index 2 a + side for a wall collision).
 * ``lists`` :class:`Lists` -- ``centre`` (N, 3) f4 list centres, ``nbl`` (N, M) i4
-  neighbour lists, ``nbn`` i4 lengths; work space ``scratch`` i4 and ``stencil`` i8.
+  neighbour lists, ``nbn`` i4 lengths; work space ``scratch`` i4, ``stencil`` i8 and
+  ``mark`` (N,) u1 (all zero between list rebuilds).
 * ``cells`` :class:`Cells` -- ``ids`` (C, K) i4 slots of each cell, ``n`` i4 fill,
   ``of`` (N,) i4 cell of each list centre.
 * ``calendar`` :class:`Calendar` -- see :mod:`granulargas.engine._calendar`.
@@ -48,7 +49,7 @@ import numpy as np
 
 Particles = namedtuple("Particles", ["rec", "img", "mass", "count", "lastcoll", "rapid", "ident"])
 Events = namedtuple("Events", ["partner", "tag"])
-Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil"])
+Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil", "mark"])
 Cells = namedtuple("Cells", ["ids", "n", "of"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])

@@ -320,7 +320,7 @@ class Simulation:
         while True:
             lists = _state.Lists(centre=centre, nbl=np.empty((n, self._nb_width), dtype=np.int32),
                                  nbn=np.zeros(n, dtype=np.int32), scratch=np.empty(1, np.int32),
-                                 stencil=stencil)
+                                 stencil=stencil, mark=np.zeros(n, dtype=np.uint8))
             cells = _state.Cells(ids=_aligned_int_rows(ncells, self._cell_width),
                                  n=np.zeros(ncells, dtype=np.int32),
                                  of=np.empty(n, dtype=np.int32))
