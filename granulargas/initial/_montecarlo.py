@@ -164,8 +164,7 @@ def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
     """Indices of all particles overlapping some other one, into out; returns the count."""
     m = 0
     for i in range(r.shape[0]):
-        if overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
-                         cell_next) > 0.0:
+        if overlaps(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head, cell_next):
             out[m] = i
             m += 1
     return m
