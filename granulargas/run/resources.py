@@ -179,7 +179,8 @@ def check_memory(config: RunConfig, *, n: int | None = None, packing: float | No
     src = config.source
     if available is None:
         available = available_memory()
-    grid = est["engine_cells"] * ENGINE_BYTES_PER_CELL
+    # the engine's and the placement's cell grids: both grow with the box, not with N
+    grid = est["engine_cells"] * ENGINE_BYTES_PER_CELL + est["placement_cells"] * PLACEMENT_BYTES_PER_CELL
     dilute = cells > 64.0 * n  # the grid, not the particles, is what is too large
     if cells > MAX_CELLS and dilute:
         raise ConfigError(
@@ -191,7 +192,7 @@ def check_memory(config: RunConfig, *, n: int | None = None, packing: float | No
             "system.particles", str(n))
         raise ConfigError(
             f"{src}: {key} = {value}: the run needs about {format_bytes(est['total'])} of memory "
-            f"({format_bytes(est['total'] / n)} per particle, of which the cell grid {format_bytes(grid)}), "
+            f"({format_bytes(est['total'] / n)} per particle, of which the cell grids {format_bytes(grid)}), "
             f"{format_bytes(available)} are available")
     if cells > MAX_CELLS:
         raise ConfigError(
