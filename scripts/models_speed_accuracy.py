@@ -44,7 +44,7 @@ from granulargas.contact import prefactor_from_damping, restitution_table
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
-from granulargas.observables import energy_moments
+from granulargas.observables import energy_moments, sample_history
 from granulargas.run.prepare import beta_bound
 
 
@@ -53,15 +53,6 @@ def moments(v):
     t, a2, _ = energy_moments(np.ascontiguousarray(v), v.shape[1], np.ones(1))
     return t, a2
 
-
-def history(sim, times):
-    """(T, a2, pair collisions) at the given times."""
-    out = np.empty((len(times), 3))
-    for k, t in enumerate(times):
-        sim.run(t)
-        out[k, :2] = moments(sim.velocities)
-        out[k, 2] = sim.collisions
-    return out
 
 
 def maxwellian(n, d, seed):
@@ -88,14 +79,14 @@ def engine_run(n, eta, d, rule, seed, times, relax=0.0):
         v = warm.velocities - warm.velocities.mean(axis=0)
         kw.update(positions=warm.positions, velocities=v / math.sqrt(moments(v)[0]))
     sim = Simulation(**kw, rule=rule)
-    h = history(sim, times)
+    h = sample_history(sim, times)
     return h, time.process_time() - c0
 
 
 def dsmc_run(n, eta, d, rule, seed, times, chi):
     c0 = time.process_time()
     sim = DSMC(maxwellian(n, d, seed), 0.5, 1.0, rule, packing_fraction=eta, chi=chi, seed=seed)
-    h = history(sim, times)
+    h = sample_history(sim, times)
     return h, time.process_time() - c0
 
 
@@ -185,8 +176,8 @@ def clustering(args):
     end = (100.0 if args.quick else 400.0) / omega0
     times = np.geomspace(1.0 / omega0, end, 16)
     st = random_state(n, eta, d, seed=1)
-    eng = history(Simulation(**st.as_kwargs(), rule=rule_engine), times)
-    ref = history(DSMC(maxwellian(100000, d, 3), 0.5, 1.0, rule_dsmc, packing_fraction=eta, chi=chi, seed=3), times)
+    eng = sample_history(Simulation(**st.as_kwargs(), rule=rule_engine), times)
+    ref = sample_history(DSMC(maxwellian(100000, d, 3), 0.5, 1.0, rule_dsmc, packing_fraction=eta, chi=chi, seed=3), times)
     print(f"3. clustering: 2D, constant eps = {eps}, packing {eta}, N = {n}, L = {box:.4g} = {box / lc:.1f} L_c",
           flush=True)
     for q in range(0, len(times), 3):
