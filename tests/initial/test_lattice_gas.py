@@ -135,3 +135,18 @@ def test_dilute_placement(d, eta):
     st = random_state(500, eta, d, seed=1)  # lattice of 8 N sites (capped)
     assert _min_ratio(st.positions, st.radii, st.box) >= 1.0
     assert np.all(st.positions >= 0) and np.all(st.positions < st.box)
+
+
+def _central_q6(st, m=400):
+    """Q6 of the ~m particles in a cube at the box centre (no periodic images)."""
+    side = st.box[0] * (m / len(st.positions)) ** (1 / 3)
+    inside = np.all(np.abs(st.positions - st.box / 2) < side / 2, axis=1)
+    return global_q6(st.positions[inside], np.full(3, 1e9))
+
+
+def test_large_states_are_melted_too():
+    """The default sweeps melt the lattice of a large dense state (a local Q6 at the fluid's level);
+    the control with too few sweeps keeps the lattice's order, so the check can fail."""
+    melted = random_state(20000, 0.5, 3, seed=3)
+    assert _central_q6(melted) < 0.07
+    assert _central_q6(random_state(20000, 0.5, 3, seed=3, sweeps=6)) > 0.1
