@@ -14,6 +14,10 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         velocity/  step, time (links), value (F, N, d)
         image/     step, time (links), value (F, N, d) int64 periodic image counts (0 on wall axes)
         last_collision/        (TC model only) value (F, N): time of each particle's last collision
+        contact_until/         (collisions that take time only) value (F, N) float64: when each
+                               particle's contact under way ends (-inf: none)
+        contact_partner/       (collisions that take time only) value (F, N) int64: particle id of
+                               that contact's partner (-1: none)
         mass       (N,) float64         time-independent
         radius     (N,) float64         time-independent, non-standard element
         species    (N,) int32           time-independent
@@ -22,6 +26,8 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         momentum (d,), pressure:        step (S,), time (S,) shared, value (S, ...)
         wall_collisions, wall_pressure  (runs with walls)
         injected_energy, kick_step      (driven runs: energy put in, index of the next kick)
+        three_body_contacts             (collisions that take time: collisions of a particle still
+                                        in contact with another one, cumulative)
     parameters/
         config (resolved TOML text), config_source (file text), attrs
         version, seed, model, units, prefactor, ...; restitution_table/ (the
@@ -60,6 +66,7 @@ what is missing or unreadable.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import re
 import time as _time
@@ -80,7 +87,10 @@ SCALAR_OBSERVABLES = ("temperature", "kinetic_energy", "collisions", "events", "
 #: observables of runs with walls / with driving (written only by such runs)
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
-_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step")
+RESOLVED_OBSERVABLES = ("three_body_contacts",)
+_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts")
+#: per-particle restart state of collisions that take time: (name, dtype)
+CONTACT_ELEMENTS = (("contact_until", np.float64), ("contact_partner", np.int64))
 #: H5MD box boundary of each axis kind
 _H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
 
@@ -108,10 +118,15 @@ class H5MDWriter:
     last_collision : bool
         Also store each particle's last collision time per snapshot (TC model restart).
     overwrite : bool
+    contacts : bool
+        Collisions that take time: also store each particle's contact under way per
+        snapshot (``contact_until``, ``contact_partner``; restart) and the
+        ``three_body_contacts`` observable.
     """
 
     def __init__(self, path, box, radii, masses, species=None, *, parameters=None,
-                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False):
+                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False,
+                 contacts=False):
         self.path = Path(path)
         box = np.ascontiguousarray(box, dtype=np.float64)
         self.d = int(box.shape[0])
@@ -124,9 +139,10 @@ class H5MDWriter:
             raise InputFileError(f"{self.path}: cannot create output file ({_short(exc)})") from None
         self.file = f
         self.boundary = ("periodic",) * self.d if boundary is None else tuple(boundary)
-        extra = (WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
+        extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
+                 + (RESOLVED_OBSERVABLES if contacts else ()))
         try:
-            self._create(box, radii, masses, species, parameters or {}, last_collision, author, extra)
+            self._create(box, radii, masses, species, parameters or {}, last_collision, author, extra, contacts)
         except BaseException:
             self.file.close()
             self.path.unlink(missing_ok=True)
@@ -139,7 +155,8 @@ class H5MDWriter:
     flush_seconds = 2.0
 
     @classmethod
-    def append(cls, path, *, particles: int, dimension: int, last_collision: bool, step: int, time: float):
+    def append(cls, path, *, particles: int, dimension: int, last_collision: bool, step: int, time: float,
+               contacts: bool = False):
         """Open one of our files to continue its run in it (module docstring).
 
         The file must hold ``particles`` particles in ``dimension`` dimensions and end
@@ -151,7 +168,8 @@ class H5MDWriter:
         """
         path = Path(path)
         with open_run(path) as f, _damaged(path, "the run to continue"):
-            frames, samples = _continuation_point(f, path, particles, dimension, last_collision, step, time)
+            frames, samples = _continuation_point(f, path, particles, dimension, last_collision, step, time,
+                                                  contacts)
         f = open_run(path, "r+")
         try:
             with _damaged(path, "the run to continue"):
@@ -161,6 +179,7 @@ class H5MDWriter:
                 self.box = np.ascontiguousarray(part["box/edges/value"][frames - 1], dtype=np.float64)
                 self.boundary = read_boundary(f)
                 names = ["position", "velocity", "image", "box/edges"] + (["last_collision"] if last_collision else [])
+                names += [name for name, _ in CONTACT_ELEMENTS] if contacts else []
                 self._frame_groups = [part[name] for name in names]
                 for g in self._frame_groups:
                     g["value"].resize(frames, axis=0)
@@ -195,7 +214,7 @@ class H5MDWriter:
         self.file.flush()
 
     # ----------------------------------------------------------------- layout
-    def _create(self, box, radii, masses, species, parameters, last_collision, author, extra):
+    def _create(self, box, radii, masses, species, parameters, last_collision, author, extra, contacts=False):
         f, n, d = self.file, self.n, self.d
         h = f.create_group("h5md")
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
@@ -230,6 +249,11 @@ class H5MDWriter:
             g = part.create_group("last_collision")
             g["step"], g["time"] = step, time
             g.create_dataset("value", shape=(0, n), maxshape=(None, n), dtype=np.float64, chunks=_frame_chunks(n, 0))
+            groups.append(g)
+        for name, dtype in CONTACT_ELEMENTS if contacts else ():
+            g = part.create_group(name)
+            g["step"], g["time"] = step, time
+            g.create_dataset("value", shape=(0, n), maxshape=(None, n), dtype=dtype, chunks=_frame_chunks(n, 0))
             groups.append(g)
         self._frame_groups = groups
         part.create_dataset("mass", data=np.asarray(masses, dtype=np.float64))
@@ -269,8 +293,9 @@ class H5MDWriter:
     def frames(self) -> int:
         return int(self.file["particles/all/position/step"].shape[0])
 
-    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None):
-        """Append one frame (synchronised state) and flush.
+    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None, contacts=None):
+        """Append one frame (synchronised state) and flush (``contacts``: the arrays
+        (contact_until, contact_partner) of collisions that take time).
 
         The frame's values are written before its step/time, so a reader of a
         killed run never sees a time without data."""
@@ -279,6 +304,8 @@ class H5MDWriter:
         data = {"position": positions, "velocity": velocities, "image": images, "edges": self.box}
         if last_collision is not None:
             data["last_collision"] = last_collision
+        if contacts is not None:
+            data["contact_until"], data["contact_partner"] = contacts
         for g in self._frame_groups:
             name = g.name.rsplit("/", 1)[-1]
             v = g["value"]
@@ -343,7 +370,8 @@ class H5MDWriter:
         self.close()
 
 
-def _continuation_point(f, path, particles, dimension, last_collision, step, time) -> tuple[int, int]:
+def _continuation_point(f, path, particles, dimension, last_collision, step, time,
+                        contacts=False) -> tuple[int, int]:
     """(frames, samples) to keep of a file a run continues in (:meth:`H5MDWriter.append`)."""
     part = f["particles/all"]
     n, d = (int(x) for x in part["position/value"].shape[1:])
@@ -352,6 +380,9 @@ def _continuation_point(f, path, particles, dimension, last_collision, step, tim
     if ("last_collision" in part) != bool(last_collision):
         raise InputFileError(f"{path}: {'has' if 'last_collision' in part else 'lacks'} the TC model's "
                              "last-collision times; continue it with the same collision model")
+    if ("contact_until" in part) != bool(contacts):
+        raise InputFileError(f"{path}: {'has' if 'contact_until' in part else 'lacks'} the contacts under way of "
+                             "collisions that take time; continue it with the same collision duration")
     frames = _frame_count(f)
     if frames == 0 or int(part["position/step"][frames - 1]) != step or float(
             part["position/time"][frames - 1]) != time:
@@ -422,6 +453,8 @@ class Snapshot:
     species: np.ndarray  # (N,)
     last_collision: np.ndarray | None = None  # (N,) TC model only
     boundary: tuple = ()  # "periodic" or "wall" per axis
+    contact_until: np.ndarray | None = None  # (N,) collisions that take time only
+    contact_partner: np.ndarray | None = None  # (N,) int64, collisions that take time only
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
@@ -506,11 +539,12 @@ def _check_layout(f, path):
         if part[name].dtype.kind not in "fiu":
             raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} holds {part[name].dtype} "
                                  "values, not numbers")
-    if "last_collision" in part:
-        lc = part.get("last_collision/value")
-        if not isinstance(lc, h5py.Dataset) or lc.shape[1:] != (n,):
-            raise InputFileError(f"{path}: damaged H5MD file: particles/all/last_collision/value is missing "
-                                 f"or not (frames, {n})")
+    for name in ("last_collision",) + tuple(name for name, _ in CONTACT_ELEMENTS):
+        if name in part:
+            lc = part.get(f"{name}/value")
+            if not isinstance(lc, h5py.Dataset) or lc.shape[1:] != (n,):
+                raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name}/value is missing "
+                                     f"or not (frames, {n})")
     if not isinstance(f.get("observables"), h5py.Group):
         raise InputFileError(f"{path}: damaged H5MD file: observables/ is missing")
     if not isinstance(f.get("parameters"), h5py.Group):
@@ -533,8 +567,9 @@ def _frame_count(f) -> int:
     part = f["particles/all"]
     lengths = [pos["step"].shape[0], pos["time"].shape[0], pos["value"].shape[0]]
     lengths += [part[name].shape[0] for name in ("velocity/value", "image/value", "box/edges/value")]
-    if "last_collision" in part:
-        lengths.append(part["last_collision/value"].shape[0])
+    for name in ("last_collision",) + tuple(name for name, _ in CONTACT_ELEMENTS):
+        if name in part:
+            lengths.append(part[f"{name}/value"].shape[0])
     return int(min(lengths))
 
 
@@ -543,6 +578,9 @@ def _snapshot(f, k, static) -> Snapshot:
     radii, masses, species, boundary = static
     lc = part["last_collision/value"][k] if "last_collision" in part else None
     snap = _read_snapshot(part, k, radii, masses, species, lc, boundary)
+    if "contact_until" in part and "contact_partner" in part:
+        snap = dataclasses.replace(snap, contact_until=part["contact_until/value"][k],
+                                   contact_partner=part["contact_partner/value"][k])
     for name in ("positions", "velocities", "box"):
         if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")
