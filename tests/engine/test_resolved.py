@@ -168,3 +168,17 @@ def test_resolved_rule_needs_stiffness_and_table(tables):
     with pytest.raises(ConfigError, match="walls"):
         st = random_state(20, 0.1, 3, seed=1, boundary=("periodic", "periodic", "wall"))
         Simulation(**st.as_kwargs(), rule=resolved(tables, 0.02))
+
+
+def test_impact_beyond_the_table_extends_it(tables):
+    """An impact with delta beyond the table: the run extends the table and goes on."""
+    q, g = 0.05, 6.0
+    rule = resolved(tables, q)
+    delta = q * g**0.8
+    assert delta > rule.oblique.delta_limit
+    sim = two_spheres([1.0, 1.0, 1.0], [2.5, 1.0, 1.0], [g, 0, 0], [0, 0, 0], rule=rule)
+    sim.run(0.3)
+    assert sim.collisions == 1 and sim.rule.oblique.delta_limit > delta
+    eps = float(restitution(K * g**0.2, "ode"))
+    v = sim.velocities
+    assert (v[0, 0] - v[1, 0]) == pytest.approx(-eps * g, abs=1e-8)
