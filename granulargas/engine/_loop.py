@@ -67,6 +67,8 @@ simultaneous events than the event calendar's window holds.
 import math
 
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from granulargas._numba import kernel
 from granulargas.engine._calendar import (
@@ -216,6 +218,43 @@ def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts):
     return best, p
 
 
+def in_contact(contacts, i, t):
+    """Whether particle i's contact is under way at t (always False without contacts:
+    ``contacts`` is None for the instantaneous rules, so that their loop compiles
+    without any of the resolved rule's code)."""
+
+
+def predict_pair_contact(i, t, before, rec, nbl, nbn, period, contacts):
+    """:func:`predict_pair_except` (``contacts`` None: never called, returns (before, -1))."""
+
+
+def collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
+    """:func:`granulargas.engine._resolved.resolved_pair` (``contacts`` None: never called)."""
+
+
+@overload(in_contact)
+def _in_contact(contacts, i, t):
+    if isinstance(contacts, types.NoneType):
+        return lambda contacts, i, t: False
+    return lambda contacts, i, t: contacts.until[i] > t
+
+
+@overload(predict_pair_contact)
+def _predict_pair_contact(i, t, before, rec, nbl, nbn, period, contacts):
+    if isinstance(contacts, types.NoneType):
+        return lambda i, t, before, rec, nbl, nbn, period, contacts: (before, np.int64(-1))
+    return lambda i, t, before, rec, nbl, nbn, period, contacts: predict_pair_except(
+        i, t, before, rec, nbl, nbn, period, contacts)
+
+
+@overload(collide_resolved)
+def _collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
+    if isinstance(contacts, types.NoneType):
+        return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: 0
+    return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: resolved_pair(
+        i, j, te, dx, dy, dz, p, contacts, c, rule, period)
+
+
 @kernel(inline="always")
 def predict_wall(i, t, rec, space):
     """Earliest wall collision of particle i (streamed to t): (time, wall index 2 a + side).
@@ -241,15 +280,15 @@ def predict_kick(c, prm):
 
 
 @kernel
-def predict(i, t, rec, count, events, lists, space, half_shell, contacts, resolved):
+def predict(i, t, rec, count, events, lists, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
 
-    ``resolved`` (collisions that take time): while i's contact is under way
+    ``contacts`` (resolved rule; None otherwise): while i's contact is under way
     (t < ``contacts.until[i]``; the end of a contact of i with j is never before j's)
     its contact partners are left out (:func:`predict_pair_except`)."""
     best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
-    if resolved and contacts.until[i] > t:
-        best, p = predict_pair_except(i, t, best, rec, lists.nbl, lists.nbn, space.period, contacts)
+    if in_contact(contacts, i, t):
+        best, p = predict_pair_contact(i, t, best, rec, lists.nbl, lists.nbn, space.period, contacts)
     else:
         best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
     tag = count[p] if p >= 0 else 0
@@ -264,10 +303,10 @@ def predict(i, t, rec, count, events, lists, space, half_shell, contacts, resolv
 
 
 @kernel
-def predict_all(t, rec, count, events, lists, space, half_shell, contacts, resolved, times):
+def predict_all(t, rec, count, events, lists, space, half_shell, contacts, times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
     for i in range(rec.shape[0]):
-        times[i] = predict(i, t, rec, count, events, lists, space, half_shell, contacts, resolved)
+        times[i] = predict(i, t, rec, count, events, lists, space, half_shell, contacts)
 
 
 # --------------------------------------------------------------------- execute
@@ -286,7 +325,8 @@ def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
     Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
-    ``c.err_j`` set). A resolved rule collides by :func:`granulargas.engine._resolved.resolved_pair`.
+    ``c.err_j`` set). With ``contacts`` (the resolved rule; None otherwise) the pair collides by
+    :func:`granulargas.engine._resolved.resolved_pair`.
     """
     rec = p.rec
     period = prm.space.period
@@ -305,8 +345,8 @@ def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
     b = dx * ux + dy * uy + dz * uz
     if b >= 0.0:  # receding (round-off): nothing happens
         return DONE
-    if rule.resolved:
-        status = resolved_pair(i, j, te, dx, dy, dz, p, contacts, c, rule, period)
+    if contacts is not None:
+        status = collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period)
         if status != DONE:
             return status
     else:
@@ -344,13 +384,11 @@ def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
     c.collisions += 1
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
-    tj = predict(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts,
-                 rule.resolved)
+    tj = predict(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
     if not cal_update(j, tj, cal):
         return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
-        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts,
-                     prm.rule.resolved)
+        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
         c.events += 1
         c.err_i = i
@@ -425,8 +463,7 @@ def execute_kick(t, p, ev, lists, cal, c, prm, contacts):
     c.sum_mv2 = s
     c.kick_step += 1
     c.kicks += 1
-    predict_all(t, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, prm.rule.resolved,
-                cal.qt)
+    predict_all(t, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, cal.qt)
     return DONE if cal_build(t, cal) else CALENDAR
 
 
@@ -586,8 +623,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:
-                    ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts,
-                     prm.rule.resolved)
+                    ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
                     if not cal_update(i, ti, cal):
                         status = CALENDAR
                     c.events += 1
@@ -598,8 +634,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             c.stale += 1
             clock = tick(probe, P_STALE, clock)
         # ---- re-predict the particle of the event
-        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts,
-                     prm.rule.resolved)
+        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
         clock = tick(probe, PREDICT, clock)
         if not cal_update(i, ti, cal):
             status = CALENDAR

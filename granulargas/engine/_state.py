@@ -41,7 +41,8 @@ Record layout
   (:mod:`granulargas.engine._resolved`): ``until`` f8, the time at which the
   particle's last contact ends (-inf: none), ``partner`` i4 the slot of that
   contact's partner (-1: none); work space ``work`` (3,) and ``out`` (5,) f8 of
-  the table lookup. Read and written only by runs with a resolved rule.
+  the table lookup. None for the other rules, whose loop then compiles without
+  any of this (:func:`granulargas.engine._loop.in_contact`).
 """
 
 from __future__ import annotations

@@ -55,8 +55,11 @@ def check(sim, overlap_tol: float = 1e-9) -> list[str]:
         dr = np.linalg.norm(_min_image(r[i] - r, period), axis=1)
         dr[i] = np.inf
         bad = np.flatnonzero(dr < (rad[i] + rad) * (1 - overlap_tol))
-        cu, cp = e.contacts.until, e.contacts.partner
-        bad = [int(j) for j in bad if not ((cp[i] == j and cu[i] > t) or (cp[j] == i and cu[j] > t))]
+        if e.contacts is not None:
+            cu, cp = e.contacts.until, e.contacts.partner
+            bad = [int(j) for j in bad if not ((cp[i] == j and cu[i] > t) or (cp[j] == i and cu[j] > t))]
+        else:
+            bad = bad.tolist()
         if len(bad):
             problems.append(f"overlap of {i} with {bad[:5]}")
     for a in sim._space.wall_axes:

@@ -357,11 +357,12 @@ class Simulation:
         slot = np.empty(n, dtype=np.int64)
         slot[order] = np.arange(n)
         cp = self._contact_partner[order]
+        # the instantaneous rules' loop is compiled without the contacts (None)
         contacts = _state.contacts(n, self._contact_until[order],
-                                   np.where(cp >= 0, slot[np.maximum(cp, 0)], -1).astype(np.int32))
+                                   np.where(cp >= 0, slot[np.maximum(cp, 0)], -1).astype(np.int32)
+                                   ) if self.rule.resolved else None
         _loop.predict_all(self._time, rec, particles.count, events, lists, spc,
-                          0.5 * self.shell * (1.0 - 1e-9), contacts, int(self.rule.resolved),
-                          calendar.qt)
+                          0.5 * self.shell * (1.0 - 1e-9), contacts, calendar.qt)
         counters = np.zeros(1, dtype=_state.COUNTERS)
         c = counters[0]
         with np.errstate(over="ignore", under="ignore"):
@@ -618,11 +619,12 @@ class Simulation:
             self._kick_step = int(c["kick_step"])
             self._three_body = int(c["three_body"])
             self._wall_impulse = e.walls.impulse.copy()
-            self._contact_until = np.empty(n)
-            self._contact_until[inv] = e.contacts.until
-            cp = e.contacts.partner.astype(np.int64)
-            self._contact_partner = np.empty(n, dtype=np.int64)
-            self._contact_partner[inv] = np.where(cp >= 0, inv[np.maximum(cp, 0)], -1)
+            if e.contacts is not None:
+                self._contact_until = np.empty(n)
+                self._contact_until[inv] = e.contacts.until
+                cp = e.contacts.partner.astype(np.int64)
+                self._contact_partner = np.empty(n, dtype=np.int64)
+                self._contact_partner[inv] = np.where(cp >= 0, inv[np.maximum(cp, 0)], -1)
             self._built = False
             self._engine = None
         return self
@@ -672,7 +674,7 @@ class Simulation:
     @property
     def contact_until(self) -> np.ndarray:
         """Resolved rule: when each particle's contact under way ends (-inf: none), (N,)."""
-        if not self._built:
+        if not self._built or self._engine.contacts is None:
             return self._contact_until.copy()
         out = np.empty(self.n)
         out[self._order] = self._engine.contacts.until
@@ -681,7 +683,7 @@ class Simulation:
     @property
     def contact_partner(self) -> np.ndarray:
         """Resolved rule: the particle id of each particle's last contact partner (-1: none), (N,)."""
-        if not self._built:
+        if not self._built or self._engine.contacts is None:
             return self._contact_partner.copy()
         cp = self._engine.contacts.partner.astype(np.int64)
         out = np.empty(self.n, dtype=np.int64)
