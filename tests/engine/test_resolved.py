@@ -62,9 +62,13 @@ def test_head_on_gives_the_restitution_and_duration_of_the_contact(tables):
     np.testing.assert_array_equal(sim.contact_partner, [1, 0])
 
 
-@pytest.mark.parametrize("offset", [0.3, 0.7, 0.95])
-def test_oblique_trajectory_after_contact_matches_direct_integration(tables, offset):
+@pytest.mark.parametrize("offset, end", [(0.3, "overlap"), (0.7, "overlap"), (0.95, "overlap"),
+                                         (0.7, "force")])
+def test_oblique_trajectory_after_contact_matches_direct_integration(tables, offset, end):
     """Post-contact relative position and velocity against the Cartesian DOP853 integration."""
+    if end == "force":
+        tab, ob = restitution_table(1.0, end="force"), oblique_table(0.39, 0.125, end="force")
+        tables = (tab, ob)
     q = 0.05
     p1, p2 = np.array([1.0, 1.0, 1.0]), np.array([2.6, 1.0 + offset, 1.2])
     v1, v2 = np.array([1.2, 0.1, 0.0]), np.array([-0.3, 0.0, 0.2])
@@ -80,7 +84,7 @@ def test_oblique_trajectory_after_contact_matches_direct_integration(tables, off
     beta = K * g_n**0.2
     delta = q * g_n**0.8 / 1.0
     c = delta * (g_t / g_n) ** 2
-    ref = solve_oblique_cartesian(beta, c, delta)
+    ref = solve_oblique_cartesian(beta, c, delta, end=end)
     tc = ref["duration"] * q * g_n**0.8 / g_n
     t_end = t0 + tc + 0.5
     sim.run(t_end)
@@ -182,3 +186,16 @@ def test_impact_beyond_the_table_extends_it(tables):
     eps = float(restitution(K * g**0.2, "ode"))
     v = sim.velocities
     assert (v[0, 0] - v[1, 0]) == pytest.approx(-eps * g, abs=1e-8)
+
+
+def test_driven_gas_balances_energy(tables):
+    """White-noise kicks with contacts under way: KE + dissipated - injected stays E0."""
+    from granulargas.engine import WhiteNoise
+
+    st = random_state(40, 0.2, 3, seed=4)
+    sim = Simulation(**st.as_kwargs(), rule=resolved(tables, 0.02), driving=WhiteNoise(0.5, 0.05, seed=2),
+                     remove_drift=False)
+    e0 = sim.kinetic_energy
+    sim.run(2.0)
+    assert sim.injected_energy > 0 and sim.dissipated_energy > 0
+    assert sim.kinetic_energy + sim.dissipated_energy - sim.injected_energy == pytest.approx(e0, rel=1e-11)
