@@ -139,3 +139,18 @@ def finite_sample_sonine(n: int, dim: int) -> tuple[float, float]:
     """
     big_d = dim * (n - 1)
     return -2.0 / (big_d + 2.0), -16.0 / ((big_d + 2.0) * (big_d + 4.0))
+
+
+def sample_history(sim, times) -> np.ndarray:
+    """Run a simulation through ``times`` and sample it at each: rows (T, a2, pair collisions).
+
+    ``sim`` is anything with ``run(until)``, ``velocities``, ``masses`` and ``collisions``:
+    the engine's :class:`~granulargas.engine.Simulation` or a :class:`~granulargas.dsmc.DSMC`.
+    """
+    out = np.empty((len(times), 3))
+    for k, t in enumerate(times):
+        sim.run(t)
+        v, m = _arrays(sim.velocities, sim.masses)
+        temperature, a2, _ = energy_moments(v, v.shape[1], m)
+        out[k] = temperature, a2, sim.collisions
+    return out

@@ -31,7 +31,7 @@ from granulargas.contact import prefactor_from_damping, restitution_table
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
-from granulargas.observables import energy_moments
+from granulargas.observables import energy_moments, sample_history
 from granulargas.run.prepare import beta_bound
 from granulargas.theory.gas import Gas, viscoelastic_cooling
 
@@ -40,15 +40,6 @@ def observe(v):
     t, a2, a3 = energy_moments(np.ascontiguousarray(v), v.shape[1], np.ones(1))
     return t, a2
 
-
-def history(sim, times):
-    """(T, a2, collisions) of a simulation (engine or DSMC) at the given times."""
-    out = np.empty((len(times), 3))
-    for k, t in enumerate(times):
-        sim.run(t)
-        temp, a2 = observe(sim.velocities)
-        out[k] = temp, a2, sim.collisions
-    return out
 
 
 def main(argv=None):
@@ -86,11 +77,11 @@ def main(argv=None):
         rule = CollisionRule.viscoelastic(k, table)
         sim = Simulation(**state.as_kwargs(), rule=rule)
         t0 = time.perf_counter()
-        engine.append(history(sim, times))
+        engine.append(sample_history(sim, times))
         wall["engine"] += time.perf_counter() - t0
         small = DSMC(state.velocities, state.radii, state.masses, rule, volume=float(np.prod(state.box)),
                      seed=100 + seed)
-        dsmc_small.append(history(small, times))
+        dsmc_small.append(sample_history(small, times))
         print(f"  seed {seed}: engine {int(engine[-1][-1, 2])} collisions, DSMC {int(dsmc_small[-1][-1, 2])}",
               flush=True)
     rng = np.random.default_rng(7)
@@ -99,7 +90,7 @@ def main(argv=None):
     v *= 1.0 / math.sqrt(observe(v - v.mean(axis=0))[0])
     ref = DSMC(v, 0.5, 1.0, CollisionRule.viscoelastic(k, big_table), packing_fraction=eta, seed=3)
     t0 = time.perf_counter()
-    reference = history(ref, times)
+    reference = sample_history(ref, times)
     wall["dsmc"] = time.perf_counter() - t0
     engine, dsmc_small = np.array(engine), np.array(dsmc_small)
     # kinetic theory with the exact eps(g_n) and a Maxwellian distribution (a2 = 0)

@@ -102,3 +102,22 @@ def test_kinetic_energy_and_momentum(dim):
     assert np.allclose(p[:dim], (m[:, None] * v).sum(axis=0), rtol=1e-12, atol=1e-12)
     e1 = kinetic_energy_momentum(v, dim, np.array([2.0]))[0]
     assert e1 == pytest.approx(np.sum(v * v), rel=1e-12)
+
+
+def test_sample_history_runs_and_samples_either_method():
+    from granulargas.dsmc import DSMC
+    from granulargas.engine import CollisionRule, Simulation
+    from granulargas.initial import random_state
+    from granulargas.observables import sample_history
+
+    st = random_state(200, 0.1, 3, seed=4)
+    rule = CollisionRule.constant(0.8)
+    times = np.array([0.5, 1.0, 2.0])
+    for sim in (Simulation(**st.as_kwargs(), rule=rule),
+                DSMC(st.velocities, st.radii, st.masses, rule, volume=float(np.prod(st.box)), seed=1)):
+        h = sample_history(sim, times)
+        assert sim.time == 2.0 and h[-1, 2] == sim.collisions
+        c = sim.velocities - sim.velocities.mean(axis=0)
+        assert h[-1, 0] == pytest.approx(np.mean(np.sum(c * c, axis=1)) / 3, rel=1e-12)
+        assert h[-1, 1] == pytest.approx(sonine_coefficients(sim.velocities)[0], rel=1e-12)
+        assert np.all(np.diff(h[:, 0]) < 0) and np.all(np.diff(h[:, 2]) > 0)  # a cooling gas

@@ -41,7 +41,8 @@ def _title(info, what):
     elif info.model == "viscoelastic" and info.prefactor is not None:
         extra = f", k = {info.prefactor:.3g}"
     eta = info.solid_fraction if math.isfinite(info.solid_fraction) else info.packing_fraction
-    return (f"{what}\n{name}: {info.model}{extra}, {info.dimension}D, N = {info.particles}, $\\eta$ = {eta:.3g}"
+    method = "DSMC, " if getattr(info, "method", "edmd") == "dsmc" else ""
+    return (f"{what}\n{name}: {method}{info.model}{extra}, {info.dimension}D, N = {info.particles}, $\\eta$ = {eta:.3g}"
             + ("" if info.monodisperse else "; polydisperse, theory for particles of the mean diameter"))
 
 

@@ -115,6 +115,7 @@ class RunInfo:
     parameters: dict = field(repr=False, default_factory=dict)
     solid_fraction: float = math.nan  # sum of the particle volumes over the box volume
     boundary: tuple = ()  # "periodic" or "wall" per axis
+    method: str = "edmd"  # "dsmc": a homogeneous gas without positions (velocities only)
 
     @classmethod
     def from_file(cls, path) -> "RunInfo":
@@ -139,6 +140,7 @@ class RunInfo:
             solid_fraction=float(np.sum(theory.particle_volume(2.0 * radii, int(snap.box.shape[0])))
                                  / float(np.prod(snap.box))),
             boundary=tuple(snap.boundary) or ("periodic",) * int(snap.box.shape[0]),
+            method=str(params.get("method", "edmd")),
         )
 
     @property

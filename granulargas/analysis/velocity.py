@@ -38,7 +38,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, special
 
+from granulargas import theory
 from granulargas.analysis.cooling import peculiar_velocities, sonine_coefficients, sonine_polynomial
+from granulargas.io.h5md import iter_snapshots, load_snapshot, snapshot_count
 
 __all__ = [
     "scaled_velocities",
@@ -347,3 +349,76 @@ def plot_velocity_distribution(panels, path, title=None):
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+# ------------------------------------------------------------------ a run's file
+
+
+@dataclass
+class FileDistribution:
+    """The scaled speed distribution of a run's snapshots (:func:`file_distribution`)."""
+
+    hist: SpeedHistogram
+    t_from: float
+    a2_theory: float | None  # steady first-Sonine a2 of the run's kind (None: no steady value)
+    a_theory: float | None  # tail constant 2 B_d / zeta* of the HCS (constant eps only)
+    fit: TailFit | None
+
+    def lines(self) -> list[str]:
+        a2, a2e, a3, a3e = self.hist.sonine()
+        out = [f"  velocity distribution: {self.hist.snapshots} snapshots from t = {self.t_from:.4g}, "
+               f"{self.hist.samples} speeds; a2 = {a2:.4f} +- {a2e:.2g}, a3 = {a3:.4f} +- {a3e:.2g}"
+               + ("" if self.a2_theory is None else f" (first-Sonine theory a2 = {self.a2_theory:.4f})")]
+        if self.a_theory is not None:
+            fit = (f"fit exp(-A c) for c >= {self.fit.c_min:.2f}: A = {self.fit.A:.3f} +- {self.fit.A_err:.2g} "
+                   f"({self.fit.counts} speeds)" if self.fit is not None else f"fewer than 10 speeds beyond c = {self.a_theory:.2f} to fit")
+            out.append(f"  high-energy tail: {fit}; HCS theory A = 2 B_d / zeta* = {self.a_theory:.3f} "
+                       "(van Noije & Ernst 1998)")
+        return out
+
+
+def file_distribution(info, kind: str, c_max: float = 8.0) -> FileDistribution:
+    """Pool the scaled speeds of the later half of a run's snapshots (never the initial one)
+    for either method (a DSMC file has velocities only; that is all this needs).
+
+    ``info``: :class:`granulargas.analysis.run.RunInfo`; ``kind``: ``"cooling"``,
+    ``"elastic"`` or ``"driven"`` (:func:`granulargas.analysis.run.run_kind`). The theory:
+    a2 = 0 (elastic), van Noije & Ernst's HCS a2 (constant eps) or the driven a2
+    (white noise), none for the viscoelastic HCS (its a2 changes with T); the tail constant
+    for the HCS of constant eps, fitted from c = A on (the exponential overtakes the
+    Gaussian there).
+    """
+    d = info.dimension
+    count = snapshot_count(info.path)
+    if count < 2:
+        raise ValueError(f"{info.path}: no snapshot after the initial one")
+    t_from = load_snapshot(info.path, max(1, count // 2)).time
+    hist = SpeedHistogram(d, c_max=c_max, bins=int(round(c_max / 0.05)))
+    for snap in iter_snapshots(info.path):
+        if snap.time >= t_from and snap.index > 0:
+            hist.add(snap.velocities, snap.masses)
+    eps = info.restitution if info.model == "constant" else (1.0 if info.model == "elastic" else None)
+    a2_theory = a_theory = fit = None
+    if kind == "elastic":
+        a2_theory = 0.0
+    elif kind == "driven" and eps is not None:
+        a2_theory = float(theory.driven_sonine_a2(eps, d))
+    elif kind == "cooling" and eps is not None and eps < 1.0:
+        a2_theory = float(theory.sonine_a2(eps, d))
+        a_theory = tail_constant(sonine_cooling_rate(eps, d, a2_theory), d)
+        try:
+            fit = fit_exponential_tail(hist, round(a_theory / 0.05) * 0.05)
+        except ValueError:
+            fit = None
+    return FileDistribution(hist, t_from, a2_theory, a_theory, fit)
+
+
+def plot_file_distribution(dist: FileDistribution, info, path):
+    """:func:`plot_velocity_distribution` of a :class:`FileDistribution`."""
+    method = "DSMC" if getattr(info, "method", "edmd") == "dsmc" else "EDMD"
+    panel = {"hist": dist.hist, "fit": dist.fit, "a2_theory": dist.a2_theory,
+             "label": f"{info.path.rsplit('/', 1)[-1]}: {method}, {info.model}, {info.dimension}D, "
+                      f"N = {info.particles},\n{dist.hist.snapshots} snapshots from t = {dist.t_from:.4g}"}
+    if dist.a_theory is not None:
+        panel["A_theory"] = {"HCS theory (first Sonine)": dist.a_theory}
+    return plot_velocity_distribution([panel], path)

@@ -34,6 +34,9 @@ def configure_parser(parser):
     parser.add_argument("--fit-range", nargs=2, type=float, metavar=("TMIN", "TMAX"),
                         help="fit window in time since the first sample (default: all samples)")
     parser.add_argument("--no-snapshots", action="store_true", help="skip a2/a3 (do not read the snapshots)")
+    parser.add_argument("--velocity", metavar="PNG",
+                        help="velocity distribution f(c) of the later snapshots (log scale, Maxwellian, first-Sonine "
+                             "form, high-energy tail against theory) to this figure")
     parser.add_argument("--rows", type=int, default=10, help="rows of the T(t) table (default 10)")
 
 
@@ -61,6 +64,9 @@ def _header(info) -> list[str]:
         + (f" (restitution {info.restitution:g})" if info.restitution is not None and info.model == "constant" else "")
         + (f" (prefactor k = {info.prefactor:.4g})" if info.prefactor is not None and info.model == "viscoelastic" else ""),
     ]
+    if info.method == "dsmc":
+        lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; the pressure is not "
+                     "sampled)")
     if not info.monodisperse:
         lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
                      f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
@@ -243,6 +249,8 @@ def run(args) -> int:
     path = Path(args.file)
     if args.plot:  # before any work: a typo in the directory is refused, never created
         existing_directory(args.plot, f"--plot {args.plot}")
+    if args.velocity:
+        existing_directory(args.velocity, f"--velocity {args.velocity}")
     if path.is_dir():
         if not _is_sweep(path):
             raise InputFileError(f"{path}: is a directory without {INDEX_NAME} (give a run's .h5 file or a "
@@ -263,6 +271,7 @@ def run(args) -> int:
         walls = wall_summary(a.info, t_from)
     if args.json:
         out = a.summary()
+        out["method"] = a.info.method
         if walls is not None:
             out["walls"] = walls
         print(json.dumps(out, indent=1, ensure_ascii=False, default=float))
@@ -278,4 +287,15 @@ def run(args) -> int:
             extra.append(plot_density_profiles(a.info, walls, p.with_name(p.stem + "_profile" + p.suffix)))
         if not args.json:
             print("  wrote " + ", ".join(str(x) for x in [args.plot] + extra))
+    if args.velocity:
+        from granulargas.analysis.run import run_kind
+        from granulargas.analysis.velocity import file_distribution, plot_file_distribution  # matplotlib when drawn
+
+        try:
+            dist = file_distribution(a.info, run_kind(a.info))
+        except ValueError as exc:
+            raise InputFileError(f"{args.file}: --velocity: {exc}") from None
+        plot_file_distribution(dist, a.info, args.velocity)
+        if not args.json:
+            print("\n".join(dist.lines() + [f"  wrote {args.velocity}"]))
     return 0

@@ -14,7 +14,7 @@ import shlex
 
 from granulargas.cli._args import add_override_argument, overrides_from
 from granulargas.io.config import load_config
-from granulargas.run.advise import summary_line
+from granulargas.run.advise import method_line, summary_line
 from granulargas.run.runner import RunInterrupted, run_config, stop_on_signals
 from granulargas.run.validity import raise_if_invalid
 
@@ -59,6 +59,6 @@ def run(args) -> int:
         except RunInterrupted as exc:
             raise RunInterrupted(f"{exc}; continue with: {continue_command(args, exc.output)}", signum=exc.signum,
                                  time=exc.time, collisions=exc.collisions, output=exc.output) from None
-    advice = summary_line(config)
-    print("\n".join(summary.lines() + validity.lines() + ([advice] if advice else [])))
+    advice = [line for line in (summary_line(config), method_line(config)) if line]
+    print("\n".join(summary.lines() + validity.lines() + advice))
     return 0

@@ -43,6 +43,9 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
     granulargas.dem.lammps.LammpsExport
     """
     c = config.collision
+    if config.run.method == "dsmc":
+        raise ConfigError(f'{config.source}: run.method = "dsmc": a DSMC run has no positions; LAMMPS export '
+                          'writes a spatial run (export the config with run.method = "edmd")')
     if c.model == "constant":
         raise ConfigError(
             f"{config.source}: collision.model = \"constant\": LAMMPS export needs the viscoelastic "

@@ -109,3 +109,15 @@ def new_histogram() -> np.ndarray:
     """Zeroed class counts (int64, one per class)."""
     return np.zeros(N_CLASSES, dtype=np.int64)
 
+
+
+@jit
+def largest_component(rec, dim):
+    """max |rec[i, a]| over the particles and the first ``dim`` columns (no temporaries)."""
+    out = 0.0
+    for i in range(rec.shape[0]):
+        for a in range(dim):
+            x = abs(rec[i, a])
+            if x > out:
+                out = x
+    return out

@@ -15,8 +15,10 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.dsmc import _loop
-from granulargas.dsmc._majorant import build_histogram, class_edge, new_histogram, top_classes
+from granulargas.dsmc._majorant import build_histogram, class_edge, largest_component, new_histogram, top_classes
 from granulargas.dsmc._random import STATE_WORDS, seed_state
+from granulargas.engine._drive import kick_scale, kick_velocities
+from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
 from granulargas.observables import energy_moments, kinetic_energy_momentum
@@ -67,7 +69,19 @@ class DSMC:
     state : dict, optional
         :attr:`state` of an earlier DSMC to continue bit for bit (random words,
         candidate count, pending collision, frame velocity), together with its
-        :attr:`velocities`, ``time``, ``collisions`` and ``dissipated_energy``.
+        :attr:`velocities`, ``time``, ``collisions`` and ``dissipated_energy``
+        (and, when driven, ``kick_step`` and ``injected_energy``).
+    driving : WhiteNoise, optional
+        The engine's white-noise driving (:mod:`granulargas.engine._drive`, eq. (1)):
+        at the times (k + 1/2) dt_k every velocity gets the same momentum-free
+        Gaussian kick as in the engine (the same compiled kick and random stream, by
+        particle id). After a kick the pending collision, accepted against the old
+        velocities, is dropped and the majorant restarts from the kick time (the
+        majorant process is memoryless, so this is exact).
+    kick_step : int, optional
+        Index k of the next kick (default: the first after ``time``).
+    injected_energy : float
+        Energy put in by the kicks so far (carried over).
 
     Notes
     -----
@@ -85,7 +99,8 @@ class DSMC:
                  number_density: float | None = None, packing_fraction: float | None = None,
                  volume: float | None = None, chi: float | None = None, seed: int = 0,
                  time: float = 0.0, collisions: int = 0, dissipated_energy: float = 0.0,
-                 state: dict | None = None):
+                 state: dict | None = None, driving: WhiteNoise | None = None, kick_step: int | None = None,
+                 injected_energy: float = 0.0):
         vel = np.asarray(velocities, dtype=np.float64)
         if vel.ndim != 2 or vel.shape[1] not in (2, 3):
             raise ConfigError(f"velocities: shape {vel.shape}, expected (N, 2) or (N, 3)")
@@ -211,6 +226,26 @@ class DSMC:
         self._scal, self._iscal = scal, iscal
         self._rate_last = float("nan")
         self._acceptance_last = float("nan")
+        self.driving = driving
+        self._injected = float(injected_energy)
+        self._kick_step = 0
+        if driving is not None:
+            if not isinstance(driving, WhiteNoise):
+                raise TypeError("driving must be a granulargas.engine.WhiteNoise")
+            dt = driving.interval
+            if kick_step is None:  # the first kick after time (as the engine)
+                k0 = max(0, int(math.floor(float(time) / dt - 0.5)))
+                while (k0 + 0.5) * dt <= float(time):
+                    k0 += 1
+                self._kick_step = k0
+            else:
+                self._kick_step = int(kick_step)
+                if not (self._kick_step + 0.5) * dt > float(time):
+                    raise ConfigError(f"kick_step = {kick_step}: the next driving step k must come after the "
+                                      f"time {time} ((k + 1/2) interval > time)")
+            self._kick_mass = np.ascontiguousarray(np.broadcast_to(mas, (n,)), dtype=np.float64)
+            self._kick_ident = np.arange(n, dtype=np.int32)
+            self._kick_scale = kick_scale(driving.heating_rate, dt, n)
 
     # ------------------------------------------------------------------ helpers
     def _rate(self):
@@ -241,15 +276,49 @@ class DSMC:
             raise ValueError(f"run(until={until}): the simulation is already at time {self.time}")
         if math.isinf(until) and max_collisions is None:
             raise ValueError("run(until=inf) needs max_collisions")
+        start_time, start_coll, start_cand = self.time, self.collisions, self.candidates
+        target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
+        if self.driving is not None:
+            dt = self.driving.interval
+            while (self._kick_step + 0.5) * dt <= until:
+                t_kick = (self._kick_step + 0.5) * dt
+                if t_kick > self.time:
+                    self._advance(t_kick, target, progress)
+                if self.collisions >= target:
+                    break
+                self._kick()
+        if self.collisions < target:
+            self._advance(until, target, progress)
+        dt = self.time - start_time
+        dc = self.collisions - start_coll
+        self._rate_last = 2.0 * dc / (self.n * dt) if dt > 0 else float("nan")
+        cand = self.candidates - start_cand
+        self._acceptance_last = dc / cand if cand > 0 else float("nan")
+        if progress is not None:
+            progress(self)
+        return self
+
+    def _kick(self):
+        """One driving step at its time (class docstring): kick, rebuild the speed classes,
+        drop the pending collision."""
         d = self.dimension
-        vmax = float(np.max(np.abs(self._rec[:, :d])))
+        self._scal[_loop.S_TIME] = (self._kick_step + 0.5) * self.driving.interval
+        self._injected += kick_velocities(self._rec, 0, self._kick_mass, self._kick_ident, d,
+                                          np.uint64(self.driving.seed), self._kick_step, self._kick_scale)
+        self._kick_step += 1
+        self._iscal[_loop.I_TOP] = build_histogram(self._rec, d, self._hist)
+        self._iscal[_loop.I_PENDING_I] = self._iscal[_loop.I_PENDING_J] = -1
+        self._scal[_loop.S_NEXT] = math.nan
+
+    def _advance(self, until, target, progress):
+        """The compiled loop in chunks up to ``until`` or the collision count ``target``."""
+        d = self.dimension
+        vmax = float(largest_component(self._rec, d))
         if not (vmax < 1e150) or (0.0 < vmax < 1e-150):
             raise SimulationError(f"velocities out of range at t = {self.time:.12g} (max |v_a| = "
                                   f"{vmax:.3g}): squared speeds must stay within float64; rescale the units")
         if vmax == 0.0:
             raise SimulationError(f"all velocities are zero at t = {self.time:.12g}: nothing collides")
-        start_time, start_coll, start_cand = self.time, self.collisions, self.candidates
-        target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
         chunk = max(1 << 21, 4 * self.n)
         s = self._scal
         while True:
@@ -263,14 +332,6 @@ class DSMC:
             if status in (_loop.DONE, _loop.MAX_COLLISIONS):
                 break
             self._raise(status)
-        dt = self.time - start_time
-        dc = self.collisions - start_coll
-        self._rate_last = 2.0 * dc / (self.n * dt) if dt > 0 else float("nan")
-        cand = self.candidates - start_cand
-        self._acceptance_last = dc / cand if cand > 0 else float("nan")
-        if progress is not None:
-            progress(self)
-        return self
 
     def _raise(self, status):
         i, j = int(self._iscal[_loop.I_ERR_I]), int(self._iscal[_loop.I_ERR_J])
@@ -356,6 +417,16 @@ class DSMC:
     def sonine_a3(self) -> float:
         """Third Sonine coefficient of the peculiar velocities (:mod:`granulargas.observables`)."""
         return float(self._moments()[2])
+
+    @property
+    def injected_energy(self) -> float:
+        """Kinetic energy put in by the driving's kicks (cumulative)."""
+        return self._injected
+
+    @property
+    def kick_step(self) -> int:
+        """Index k of the next driving step (at (k + 1/2) interval)."""
+        return self._kick_step
 
     @property
     def dissipated_energy(self) -> float:

@@ -68,6 +68,8 @@ CONTACT_ENDS = ("overlap", "force")
 DURATIONS = ("instantaneous", "resolved")
 BOUNDARIES = ("periodic", "wall")
 DRIVING_MODELS = ("white_noise",)
+#: ``run.method``: event-driven molecular dynamics, or DSMC of the homogeneous Enskog-Boltzmann equation
+METHODS = ("edmd", "dsmc")
 DEFAULT_SNAPSHOTS = 20
 
 #: largest particle count: the engine indexes particles (neighbour lists, cells) with int32
@@ -193,6 +195,7 @@ class RunSection:
 
     end_time: float | None = None
     collisions_per_particle: float | None = None
+    method: str = "edmd"
 
 
 @dataclass(frozen=True)
@@ -495,6 +498,12 @@ SCHEMA: tuple[Key, ...] = (
         low=0.0, low_open=True, high=float(MAX_COLLISIONS),
         reason="C = s N / 2 pair collisions must stay <= 2^53 (exact in float64; room in the int64 "
                "event counter)"),
+    Key("run", "method", "string",
+        '`"edmd"`: event-driven molecular dynamics (positions, walls, structure); `"dsmc"`: Direct '
+        "Simulation Monte Carlo of the homogeneous Enskog–Boltzmann equation with the same collision rule "
+        "(no positions: `particles` is the sample size, `packing_fraction` sets n and χ; no walls, "
+        "no TC model).",
+        default="edmd", choices=METHODS),
     # [output]
     Key("output", "file", "string", "The H5MD output file, relative to the working directory.",
         default_text="runs/<config name>.h5",
@@ -738,6 +747,9 @@ def _check_resolved_needs_material(v: Values):
     if boundary is not None and "wall" in boundary:
         v.fail("collision.duration", '"resolved" is available with periodic boundaries only '
                                      "(system.boundary has a wall)")
+    if v.get("run.method") == "dsmc":
+        v.fail("collision.duration", '"resolved" needs positions: it is for run.method = "edmd" (DSMC has '
+                                     "instantaneous collisions only)")
 
 
 def _check_run_has_an_end(v: Values):
@@ -803,6 +815,18 @@ def _check_driving_needs_heating_rate(v: Values):
         v.fail("driving.heating_rate", "missing; [driving] needs heating_rate >= 0 (dT/dt of the driving alone)")
 
 
+def _check_dsmc_supported(v: Values):
+    if v.get("run.method") != "dsmc":
+        return
+    boundary = v.get("system.boundary")
+    if boundary is not None and "wall" in boundary:
+        v.fail("system.boundary", 'walls need positions: method = "dsmc" simulates a homogeneous gas '
+                                  '(use method = "edmd" or an all-"periodic" boundary)')
+    if v.has("collision.tc_time"):
+        v.fail("collision.tc_time", 'the TC model needs pair histories of a spatial gas: not available with '
+                                    'method = "dsmc" (a homogeneous DSMC gas shows no inelastic collapse)')
+
+
 RULES: tuple[Rule, ...] = (
     Rule('`model = "constant"` needs `restitution`.', _check_constant_needs_restitution),
     _only_with("collision.restitution", ("constant",)),
@@ -811,8 +835,8 @@ RULES: tuple[Rule, ...] = (
     _only_with("collision.material", ("viscoelastic",)),
     Rule('`model = "viscoelastic"` needs `damping` or `[collision.material]`.', _check_viscoelastic_needs_contact),
     _exclusive("collision.damping", "collision.material"),
-    Rule('`duration = "resolved"` needs `model = "viscoelastic"` with `[collision.material]` and periodic '
-         "boundaries.", _check_resolved_needs_material),
+    Rule('`duration = "resolved"` needs `model = "viscoelastic"` with `[collision.material]`, periodic '
+         'boundaries and `method = "edmd"`.', _check_resolved_needs_material),
     Rule("`diameter = { min, max }` needs both keys and min <= max (min = max is monodisperse).",
          _check_diameter_range),
     _exclusive("particles.mass", "particles.density"),
@@ -830,6 +854,8 @@ RULES: tuple[Rule, ...] = (
     Rule('`wall_restitution` is used only with walls (a `"wall"` entry in `boundary`).',
          _check_wall_restitution_needs_walls),
     Rule("`[driving]` needs `heating_rate`.", _check_driving_needs_heating_rate),
+    Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls and no `tc_time`.',
+         _check_dsmc_supported),
 )
 
 

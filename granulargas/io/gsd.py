@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from granulargas.errors import InputFileError, UserError
-from granulargas.io.h5md import iter_snapshots, snapshot_count
+from granulargas.io.h5md import has_positions, iter_snapshots, snapshot_count
 from granulargas.io.paths import output_file
 
 #: Time of each frame in the GSD file (OVITO shows log/ entries as global attributes).
@@ -67,6 +67,9 @@ def export_gsd(h5_path, gsd_path=None, *, overwrite: bool = False) -> tuple[Path
     output_file(gsd_path, str(gsd_path), overwrite=overwrite)
     if snapshot_count(h5_path) == 0:
         raise InputFileError(f"{h5_path}: holds no snapshot")
+    if not has_positions(h5_path):
+        raise InputFileError(f"{h5_path}: DSMC file has no positions: nothing to export to GSD "
+                             "(granulargas analyze reads its velocities)")
     tmp = gsd_path.with_name(gsd_path.name + ".part")
     frames = 0
     try:

@@ -18,6 +18,9 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
                                particle's contact under way ends (-inf: none)
         contact_partner/       (collisions that take time only) value (F, N) int64: particle id of
                                that contact's partner (-1: none)
+        dsmc/                  (DSMC runs only) the random state that continues the run bit for
+                               bit: rng (F, 5) uint64, candidates (F,), pending_pair (F, 2),
+                               pending_time (F,), frame_velocity (F, d); step, time linked
         mass       (N,) float64         time-independent
         radius     (N,) float64         time-independent, non-standard element
         species    (N,) int32           time-independent
@@ -32,6 +35,13 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         config (resolved TOML text), config_source (file text), attrs
         version, seed, model, units, prefactor, ...; restitution_table/ (the
         exact table the engine used: inv_h, coeffs, duration_coeffs, beta_max, end)
+
+A DSMC run (``parameters/`` attribute ``method = "dsmc"``) simulates a homogeneous
+gas without positions: it has no ``position`` and ``image`` elements (``velocity``
+then owns the frames' ``step`` and ``time``; the velocities are peculiar velocities),
+no ``pressure`` observable, and the ``dsmc/`` elements above; ``step`` counts pair
+collisions, ``events`` the candidate pairs drawn. The readers return snapshots with
+``positions = images = None`` (:func:`has_positions`).
 
 All elements with an explicit ``step`` and ``time``. ``pressure`` is the mean
 over the sampling interval that ends at ``time`` (kinetic plus collisional
@@ -83,14 +93,20 @@ from granulargas.errors import InputFileError
 
 CREATOR = "granulargas"
 _wall = _time.monotonic
-SCALAR_OBSERVABLES = ("temperature", "kinetic_energy", "collisions", "events", "dissipated_energy", "pressure")
+SCALAR_OBSERVABLES = ("temperature", "kinetic_energy", "collisions", "events", "dissipated_energy", "pressure",
+                      "sonine_a2", "sonine_a3")
+#: observables a file may lack: Sonine coefficients (files written before they were sampled), pressure (DSMC)
+OPTIONAL_OBSERVABLES = ("sonine_a2", "sonine_a3", "pressure")
+#: the DSMC random state stored with every frame of a DSMC run: name -> (trailing shape, dtype)
+DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_pair": ((2,), np.int64),
+              "pending_time": ((), np.float64), "frame_velocity": (("d",), np.float64)}
 #: observables of runs with walls / with driving (written only by such runs)
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
 RESOLVED_OBSERVABLES = ("three_body_contacts",)
-_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts")
 #: per-particle restart state of collisions that take time: (name, dtype)
 CONTACT_ELEMENTS = (("contact_until", np.float64), ("contact_partner", np.int64))
+_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts")
 #: H5MD box boundary of each axis kind
 _H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
 
@@ -117,20 +133,24 @@ class H5MDWriter:
         numpy arrays become datasets.
     last_collision : bool
         Also store each particle's last collision time per snapshot (TC model restart).
-    overwrite : bool
     contacts : bool
         Collisions that take time: also store each particle's contact under way per
         snapshot (``contact_until``, ``contact_partner``; restart) and the
         ``three_body_contacts`` observable.
+    overwrite : bool
+    positions : bool
+        False for a DSMC run: no positions and images; each frame stores the DSMC random
+        state instead (``dsmc_state`` of :meth:`write_snapshot`).
     """
 
     def __init__(self, path, box, radii, masses, species=None, *, parameters=None,
-                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False,
-                 contacts=False):
+                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False, contacts=False,
+                 positions=True):
         self.path = Path(path)
         box = np.ascontiguousarray(box, dtype=np.float64)
         self.d = int(box.shape[0])
         self.n = int(np.asarray(radii).shape[0])
+        self.positions = bool(positions)
         if self.path.exists() and not overwrite:
             raise InputFileError(f"{self.path}: output file exists (use --overwrite to replace it)")
         try:
@@ -141,8 +161,11 @@ class H5MDWriter:
         self.boundary = ("periodic",) * self.d if boundary is None else tuple(boundary)
         extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
                  + (RESOLVED_OBSERVABLES if contacts else ()))
+        names = SCALAR_OBSERVABLES + ("momentum",) + extra
+        if not self.positions:  # DSMC: no pair virial, no pressure
+            names = tuple(x for x in names if x != "pressure")
         try:
-            self._create(box, radii, masses, species, parameters or {}, last_collision, author, extra, contacts)
+            self._create(box, radii, masses, species, parameters or {}, last_collision, author, names, contacts)
         except BaseException:
             self.file.close()
             self.path.unlink(missing_ok=True)
@@ -176,15 +199,18 @@ class H5MDWriter:
                 self = cls.__new__(cls)
                 self.path, self.file, self.n, self.d = path, f, particles, dimension
                 part = f["particles/all"]
+                self.positions = has_positions(f)
                 self.box = np.ascontiguousarray(part["box/edges/value"][frames - 1], dtype=np.float64)
                 self.boundary = read_boundary(f)
-                names = ["position", "velocity", "image", "box/edges"] + (["last_collision"] if last_collision else [])
+                names = (["position", "velocity", "image"] if self.positions else
+                         ["velocity"] + [f"dsmc/{k}" for k in DSMC_STATE])
+                names += ["box/edges"] + (["last_collision"] if last_collision else [])
                 names += [name for name, _ in CONTACT_ELEMENTS] if contacts else []
                 self._frame_groups = [part[name] for name in names]
                 for g in self._frame_groups:
                     g["value"].resize(frames, axis=0)
                 for key in ("step", "time"):
-                    part["position"][key].resize(frames, axis=0)
+                    part[_clock_name(f)][key].resize(frames, axis=0)
                 self._obs = {name: g for name, g in f["observables"].items()}
                 self._obs_clock = (f["observables/temperature/step"], f["observables/temperature/time"])
                 for g in self._obs.values():
@@ -214,7 +240,7 @@ class H5MDWriter:
         self.file.flush()
 
     # ----------------------------------------------------------------- layout
-    def _create(self, box, radii, masses, species, parameters, last_collision, author, extra, contacts=False):
+    def _create(self, box, radii, masses, species, parameters, last_collision, author, names, contacts=False):
         f, n, d = self.file, self.n, self.d
         h = f.create_group("h5md")
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
@@ -230,17 +256,33 @@ class H5MDWriter:
                                        dtype=h5py.string_dtype("ascii", 8))
         self.box = box
 
-        pos = part.create_group("position")
-        step = pos.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(256,))
-        time = pos.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(256,))
         chunks = _frame_chunks(n, d)
-        pos.create_dataset("value", shape=(0, n, d), maxshape=(None, n, d), dtype=np.float64, chunks=chunks)
-        groups = [pos]
-        for name, dtype in (("velocity", np.float64), ("image", np.int64)):
+        elements = (("position", np.float64), ("velocity", np.float64), ("image", np.int64)) if self.positions else (
+            ("velocity", np.float64),)
+        groups = []
+        step = time = None
+        for name, dtype in elements:
             g = part.create_group(name)
-            g["step"], g["time"] = step, time  # hard links: one clock for all frames
+            if step is None:  # the first element owns the frames' clock
+                step = g.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(256,))
+                time = g.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(256,))
+            else:
+                g["step"], g["time"] = step, time  # hard links: one clock for all frames
             g.create_dataset("value", shape=(0, n, d), maxshape=(None, n, d), dtype=dtype, chunks=chunks)
             groups.append(g)
+        if not self.positions:
+            part["velocity"].attrs["description"] = (
+                "peculiar velocities of a DSMC run (homogeneous gas, no positions)")
+            dg = part.create_group("dsmc")
+            dg.attrs["description"] = ("DSMC random state at each frame (granulargas.dsmc.DSMC.state): "
+                                       "continues the run bit for bit")
+            for name, (tail, dtype) in DSMC_STATE.items():
+                tail = tuple(d if x == "d" else x for x in tail)
+                g = dg.create_group(name)
+                g["step"], g["time"] = step, time
+                g.create_dataset("value", shape=(0,) + tail, maxshape=(None,) + tail, dtype=dtype,
+                                 chunks=(256,) + tail)
+                groups.append(g)
         e = b.create_group("edges")
         e["step"], e["time"] = step, time
         e.create_dataset("value", shape=(0, d), maxshape=(None, d), dtype=np.float64, chunks=(256, d))
@@ -264,7 +306,7 @@ class H5MDWriter:
         obs = f.create_group("observables")
         self._obs = {}
         step = time = None
-        for name in SCALAR_OBSERVABLES + ("momentum",) + tuple(extra):
+        for name in names:
             shape = (d,) if name == "momentum" else ()
             dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
             g = obs.create_group(name)
@@ -277,10 +319,16 @@ class H5MDWriter:
                              chunks=(1024,) + shape)
             self._obs[name] = g
         self._obs_clock = (step, time)
-        obs["pressure"].attrs["description"] = (
-            "mean pressure (kinetic + collisional virial) over the sampling interval ending at time; "
-            "NaN at the first sample of a run"
-        )
+        if "pressure" in obs:
+            obs["pressure"].attrs["description"] = (
+                "mean pressure (kinetic + collisional virial) over the sampling interval ending at time; "
+                "NaN at the first sample of a run"
+            )
+        obs["sonine_a2"].attrs["description"] = (
+            "second Sonine coefficient d/(d+2) <c^4>/<c^2>^2 - 1 of the peculiar velocities "
+            "(mass-weighted; granulargas.observables)")
+        obs["sonine_a3"].attrs["description"] = (
+            "third Sonine coefficient of the peculiar velocities (granulargas.observables)")
         if "wall_pressure" in obs:
             obs["wall_pressure"].attrs["description"] = (
                 "normal momentum delivered to the walls per unit wall area per unit time over the sampling "
@@ -291,14 +339,18 @@ class H5MDWriter:
     # ----------------------------------------------------------------- frames
     @property
     def frames(self) -> int:
-        return int(self.file["particles/all/position/step"].shape[0])
+        return int(self.file[f"particles/all/{_clock_name(self.file)}/step"].shape[0])
 
-    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None, contacts=None):
+    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None, dsmc_state=None,
+                       contacts=None):
         """Append one frame (synchronised state) and flush (``contacts``: the arrays
         (contact_until, contact_partner) of collisions that take time).
 
         The frame's values are written before its step/time, so a reader of a
-        killed run never sees a time without data."""
+        killed run never sees a time without data. A DSMC file (``positions=False``)
+        takes ``positions = images = None`` and ``dsmc_state`` (:attr:`granulargas.dsmc.DSMC.state`)."""
+        if self.positions != (positions is not None) or (not self.positions and dsmc_state is None):
+            raise ValueError("write_snapshot: positions and images for an EDMD file, dsmc_state for a DSMC file")
         self.flush_observables()
         k = self.frames
         data = {"position": positions, "velocity": velocities, "image": images, "edges": self.box}
@@ -306,13 +358,15 @@ class H5MDWriter:
             data["last_collision"] = last_collision
         if contacts is not None:
             data["contact_until"], data["contact_partner"] = contacts
+        if dsmc_state is not None:
+            data.update({name: np.asarray(dsmc_state[name]) for name in DSMC_STATE})
         for g in self._frame_groups:
             name = g.name.rsplit("/", 1)[-1]
             v = g["value"]
             v.resize(k + 1, axis=0)
             if name in data:
                 v[k] = data[name]
-        pos = self.file["particles/all/position"]
+        pos = self.file[f"particles/all/{_clock_name(self.file)}"]
         for key, val in (("step", step), ("time", time)):
             pos[key].resize(k + 1, axis=0)
             pos[key][k] = val
@@ -326,6 +380,7 @@ class H5MDWriter:
         per call dominates small writes) when ``flush`` is true, before each
         snapshot, at :meth:`close`, and at least every ``flush_seconds`` of
         wall time."""
+        values = {k: v for k, v in values.items() if k in self._obs or k not in OPTIONAL_OBSERVABLES}
         unknown = set(values) - set(self._obs)
         if unknown:
             raise KeyError(f"unknown observables {sorted(unknown)}")
@@ -374,7 +429,7 @@ def _continuation_point(f, path, particles, dimension, last_collision, step, tim
                         contacts=False) -> tuple[int, int]:
     """(frames, samples) to keep of a file a run continues in (:meth:`H5MDWriter.append`)."""
     part = f["particles/all"]
-    n, d = (int(x) for x in part["position/value"].shape[1:])
+    n, d = (int(x) for x in part[f"{_clock_name(f)}/value"].shape[1:])
     if (n, d) != (particles, dimension):
         raise InputFileError(f"{path}: holds {n} particles in {d}D, the continuation {particles} in {dimension}D")
     if ("last_collision" in part) != bool(last_collision):
@@ -384,11 +439,12 @@ def _continuation_point(f, path, particles, dimension, last_collision, step, tim
         raise InputFileError(f"{path}: {'has' if 'contact_until' in part else 'lacks'} the contacts under way of "
                              "collisions that take time; continue it with the same collision duration")
     frames = _frame_count(f)
-    if frames == 0 or int(part["position/step"][frames - 1]) != step or float(
-            part["position/time"][frames - 1]) != time:
+    clock = _clock_name(f)
+    if frames == 0 or int(part[f"{clock}/step"][frames - 1]) != step or float(
+            part[f"{clock}/time"][frames - 1]) != time:
         raise InputFileError(f"{path}: its last frame is not the state the continuation starts from")
     names = list(f["observables"])
-    for name in SCALAR_OBSERVABLES + ("momentum",):  # the writer appends to every one of them
+    for name in tuple(x for x in SCALAR_OBSERVABLES if x not in OPTIONAL_OBSERVABLES) + ("momentum",):
         g = f["observables"].get(name)
         if not isinstance(g, h5py.Group) or any(not isinstance(g.get(p), h5py.Dataset) for p in ("step", "time", "value")):
             raise InputFileError(f"{path}: damaged H5MD file: observables/{name} is missing or incomplete")
@@ -444,20 +500,22 @@ class Snapshot:
     index: int
     time: float
     step: int
-    positions: np.ndarray  # (N, d) in [0, box)
+    positions: np.ndarray | None  # (N, d) in [0, box); None in a DSMC file
     velocities: np.ndarray  # (N, d)
-    images: np.ndarray  # (N, d) int64
+    images: np.ndarray | None  # (N, d) int64; None in a DSMC file
     box: np.ndarray  # (d,)
     radii: np.ndarray  # (N,)
     masses: np.ndarray  # (N,)
     species: np.ndarray  # (N,)
     last_collision: np.ndarray | None = None  # (N,) TC model only
-    boundary: tuple = ()  # "periodic" or "wall" per axis
     contact_until: np.ndarray | None = None  # (N,) collisions that take time only
     contact_partner: np.ndarray | None = None  # (N,) int64, collisions that take time only
+    boundary: tuple = ()  # "periodic" or "wall" per axis
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
+        if self.positions is None:
+            raise InputFileError("DSMC file has no positions (a homogeneous gas: velocities only)")
         return self.positions + self.images * self.box
 
 
@@ -511,6 +569,22 @@ def open_run(path, mode="r") -> h5py.File:
 #: datasets every reader needs, relative to particles/all
 _REQUIRED = ("position/step", "position/time", "position/value", "velocity/value", "image/value",
              "box/edges/value", "radius", "mass", "species")
+#: ... in a DSMC file (no positions; ``velocity`` owns the frames' clock)
+_REQUIRED_DSMC = ("velocity/step", "velocity/time", "velocity/value", "box/edges/value", "radius", "mass",
+                  "species") + tuple(f"dsmc/{k}/value" for k in DSMC_STATE)
+
+
+def has_positions(f) -> bool:
+    """False for a DSMC run's file (open file or path): no positions, only velocities."""
+    if not isinstance(f, h5py.File):
+        with open_run(f) as g:
+            return has_positions(g)
+    return "position" in f["particles/all"] or "dsmc" not in f["particles/all"]
+
+
+def _clock_name(f) -> str:
+    """The particles/all element that owns the frames' step and time."""
+    return "position" if has_positions(f) else "velocity"
 
 
 def _check_layout(f, path):
@@ -518,16 +592,23 @@ def _check_layout(f, path):
     part = f.get("particles/all")
     if not isinstance(part, h5py.Group):
         raise InputFileError(f"{path}: damaged H5MD file: particles/all is missing")
-    for name in _REQUIRED:
+    positions = has_positions(f)
+    clock = "position" if positions else "velocity"
+    for name in _REQUIRED if positions else _REQUIRED_DSMC:
         if not isinstance(part.get(name), h5py.Dataset):
             raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} is missing")
-    pos = part["position/value"].shape
+    pos = part[f"{clock}/value"].shape
     if len(pos) != 3 or pos[2] not in (2, 3):
-        raise InputFileError(f"{path}: damaged H5MD file: particles/all/position/value has shape {pos}, "
+        raise InputFileError(f"{path}: damaged H5MD file: particles/all/{clock}/value has shape {pos}, "
                              "expected (frames, particles, 2 or 3)")
     n, d = pos[1], pos[2]
-    expect = {"velocity/value": (n, d), "image/value": (n, d), "box/edges/value": (d,), "radius": None,
-              "mass": None, "species": None, "position/step": (), "position/time": ()}
+    expect = {"velocity/value": (n, d), "box/edges/value": (d,), "radius": None,
+              "mass": None, "species": None, f"{clock}/step": (), f"{clock}/time": ()}
+    if positions:
+        expect["image/value"] = (n, d)
+    else:
+        expect.update({f"dsmc/{k}/value": tuple(d if x == "d" else x for x in tail)
+                       for k, (tail, _) in DSMC_STATE.items()})
     for name, tail in expect.items():
         shape = part[name].shape
         ok = shape == (n,) if tail is None else (len(shape) == len(tail) + 1 and shape[1:] == tail)
@@ -535,7 +616,7 @@ def _check_layout(f, path):
             want = "(particles,)" if tail is None else "(frames" + "".join(f", {x}" for x in tail) + ")"
             raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} has shape {shape}, "
                                  f"expected {want} with {n} particles in {d}D")
-    for name in _REQUIRED:
+    for name in _REQUIRED if positions else _REQUIRED_DSMC:
         if part[name].dtype.kind not in "fiu":
             raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} holds {part[name].dtype} "
                                  "values, not numbers")
@@ -563,10 +644,11 @@ def _damaged(path, what: str):
 
 
 def _frame_count(f) -> int:
-    pos = f["particles/all/position"]
     part = f["particles/all"]
+    pos = part[_clock_name(f)]
     lengths = [pos["step"].shape[0], pos["time"].shape[0], pos["value"].shape[0]]
-    lengths += [part[name].shape[0] for name in ("velocity/value", "image/value", "box/edges/value")]
+    others = ("velocity/value", "image/value") if has_positions(f) else tuple(f"dsmc/{k}/value" for k in DSMC_STATE)
+    lengths += [part[name].shape[0] for name in others + ("box/edges/value",)]
     for name in ("last_collision",) + tuple(name for name, _ in CONTACT_ELEMENTS):
         if name in part:
             lengths.append(part[f"{name}/value"].shape[0])
@@ -581,7 +663,7 @@ def _snapshot(f, k, static) -> Snapshot:
     if "contact_until" in part and "contact_partner" in part:
         snap = dataclasses.replace(snap, contact_until=part["contact_until/value"][k],
                                    contact_partner=part["contact_partner/value"][k])
-    for name in ("positions", "velocities", "box"):
+    for name in ("positions", "velocities", "box") if snap.positions is not None else ("velocities", "box"):
         if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")
     if not np.isfinite(snap.time):
@@ -590,13 +672,15 @@ def _snapshot(f, k, static) -> Snapshot:
 
 
 def _read_snapshot(part, k, radii, masses, species, lc, boundary) -> Snapshot:
+    positions = "position" in part
+    clock = part["position" if positions else "velocity"]
     return Snapshot(
         index=k,
-        time=float(part["position/time"][k]),
-        step=int(part["position/step"][k]),
-        positions=part["position/value"][k],
+        time=float(clock["time"][k]),
+        step=int(clock["step"][k]),
+        positions=part["position/value"][k] if positions else None,
         velocities=part["velocity/value"][k],
-        images=part["image/value"][k],
+        images=part["image/value"][k] if positions else None,
         box=part["box/edges/value"][k],
         radii=radii,
         masses=masses,
@@ -619,7 +703,7 @@ def _static(f):
 def read_boundary(f) -> tuple:
     """The boundary of each axis ("periodic" or "wall") from an open file's box attributes."""
     box = f["particles/all/box"]
-    d = int(box.attrs.get("dimension", f["particles/all/position/value"].shape[-1]))
+    d = int(box.attrs.get("dimension", f["particles/all/velocity/value"].shape[-1]))
     raw = box.attrs.get("boundary", None)
     if raw is None:
         return ("periodic",) * d
@@ -656,6 +740,24 @@ def load_snapshot(path, index: int = -1) -> Snapshot:
             raise InputFileError(f"{path}: snapshot index {index} out of range ({n} snapshots)")
         with _damaged(path, f"frame {k}"):
             return _snapshot(f, k, _static(f))
+
+
+def read_dsmc_state(path, index: int = -1) -> dict:
+    """The DSMC random state stored with one frame of a DSMC file (:attr:`granulargas.dsmc.DSMC.state`)."""
+    with open_run(path) as f:
+        if has_positions(f):
+            raise InputFileError(f"{path}: not a DSMC file (it has positions and no DSMC state)")
+        n = _frame_count(f)
+        k = index + n if index < 0 else index
+        if not 0 <= k < n:
+            raise InputFileError(f"{path}: snapshot index {index} out of range ({n} snapshots)")
+        with _damaged(path, f"particles/all/dsmc at frame {k}"):
+            g = f["particles/all/dsmc"]
+            out = {name: g[name]["value"][k] for name in DSMC_STATE}
+        out["candidates"] = int(out["candidates"])
+        out["pending_time"] = float(out["pending_time"])
+        out["pending_pair"] = tuple(int(x) for x in out["pending_pair"])
+        return out
 
 
 def interrupted_frames(path) -> list[int]:

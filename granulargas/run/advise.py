@@ -21,6 +21,13 @@ advice predicts, with kinetic theory and no simulation
    gas's grows as it cools, so clusters seeded early dissolve later; the
    homogeneous prediction then fails for both rules).
 
+6. the model of the scene (:func:`choose_method`): DSMC (``run.method = "dsmc"``) for a
+   homogeneous dilute gas, where it solves the same Enskog-Boltzmann equation much
+   faster: no walls or TC model, a box below the instability length and a
+   packing fraction up to :data:`DSMC_MAX_PACKING`; EDMD otherwise. The predicted
+   speed-up is the ratio of collision rates measured by ``scripts/bench_dsmc.py``
+   (docs/performance.md, DSMC section), interpolated in the packing fraction.
+
 For a constant-eps config the advice reports the config ``damping`` (beta at
 g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
@@ -49,10 +56,52 @@ from granulargas.run import validity as V
 from granulargas.run.prepare import mean_particle
 from granulargas.theory.gas import cooling_curve
 
-__all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant"]
+__all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
+           "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line"]
 
 #: default tolerance on the relative error of T(t)
 DEFAULT_TOLERANCE = 0.02
+
+#: largest packing fraction for which advise recommends DSMC. Enskog's equation neglects the
+#: velocity correlations of a dense gas; at packing 0.02 the engine's T(t) and a2(t) agree
+#: with DSMC within 0.33 % and 0.005 (scripts/dsmc_vs_engine.py), and the engine's energy
+#: loss per collision falls below DSMC's by about 1 % at packing 0.1 and 5 % at 0.4 for
+#: eps = 0.8 (scripts/dsmc_packing_gap.py; docs/dsmc.md, "denser packings").
+DSMC_MAX_PACKING = 0.1
+
+#: (packing fraction, DSMC / engine collision rate): CPU-time medians at N = 10^5, 3D,
+#: constant eps = 0.9 (``scripts/bench_dsmc.py``; docs/performance.md, DSMC section)
+DSMC_SPEEDUP_MEASURED = ((0.02, 252.0), (0.3, 26.0))
+
+
+def dsmc_speedup(packing: float) -> float:
+    """Predicted DSMC / EDMD collision rate at ``packing``: the measured ratios
+    (:data:`DSMC_SPEEDUP_MEASURED`) interpolated as a power law in the packing fraction
+    (the engine's cost per collision grows as the gas gets more dilute), held constant
+    outside the measured range."""
+    (p0, r0), (p1, r1) = DSMC_SPEEDUP_MEASURED
+    p = min(max(packing, p0), p1)
+    return float(r0 * math.exp(math.log(r1 / r0) * math.log(p / p0) / math.log(p1 / p0)))
+
+
+def choose_method(config, instability_length: float = math.inf) -> tuple[str, str]:
+    """("dsmc" or "edmd", the reason in words) for a config's scene (module docstring, 6.)."""
+    s, c = config.system, config.collision
+    eta = s.packing_fraction
+    if "wall" in s.boundary:
+        return "edmd", "walls need positions (DSMC simulates a homogeneous gas)"
+    if c.tc_time is not None:
+        return "edmd", "the TC model needs pair histories of a spatial gas"
+    box = _box(config)
+    if box > instability_length:
+        return "edmd", (f"the box {box:.4g} exceeds the instability length {instability_length:.4g}: "
+                        "clusters and shear modes grow, which DSMC (no space) cannot show")
+    if eta > DSMC_MAX_PACKING:
+        return "edmd", (f"packing fraction {eta:g} > {DSMC_MAX_PACKING:g}: velocity correlations of a dense gas, "
+                        "which the Enskog-Boltzmann equation of DSMC neglects, matter")
+    return "dsmc", (f"homogeneous and dilute (packing {eta:g} <= {DSMC_MAX_PACKING:g}, box below the "
+                    "instability length): DSMC solves the same Enskog-Boltzmann equation with the same "
+                    "collision rule")
 
 
 @dataclass
@@ -78,6 +127,12 @@ class Advice:
     constant_ok : bool or None
     box, instability_length : float
         Box edge and the shear-instability length at T0.
+    method, method_reason : str
+        The model the scene needs (:func:`choose_method`) and why.
+    speedup : float
+        Predicted DSMC / EDMD collision rate at the config's packing (:func:`dsmc_speedup`).
+    configured_method : str
+        The config's ``run.method``.
     notes : list of str
     """
 
@@ -92,6 +147,10 @@ class Advice:
     constant_ok: bool | None = None
     box: float = math.nan
     instability_length: float = math.nan
+    method: str = "edmd"
+    method_reason: str = ""
+    speedup: float = math.nan
+    configured_method: str = "edmd"
     notes: tuple = ()
 
     def lines(self) -> list[str]:
@@ -113,6 +172,13 @@ class Advice:
             rel = "above" if self.box > self.instability_length else "below"
             out.append(f"clustering   box {self.box:.4g} is {rel} the shear-instability length "
                        f"{self.instability_length:.4g} (homogeneous cooling {'un' if rel == 'above' else ''}stable)")
+        if self.method_reason:
+            name = {"dsmc": "DSMC", "edmd": "EDMD"}[self.method]
+            speed = (f"; about x{self.speedup:.3g} the collisions per CPU second of EDMD (scripts/bench_dsmc.py, "
+                     "interpolated in the packing fraction)" if self.method == "dsmc" else "")
+            out.append(f"method       {name} (run.method = \"{self.method}\"): {self.method_reason}{speed}")
+            if self.configured_method != self.method:
+                out.append(f"             the config has run.method = \"{self.configured_method}\"")
         out += [f"note         {n}" for n in self.notes]
         return out
 
@@ -211,6 +277,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         if k is None:
             adv.notes = (f"eps = {eps:g}: no viscoelastic damping within the restitution table's range cools "
                          "at this rate",)
+            _set_method(adv, config)
             return adv
         ve = replace(gas, model="viscoelastic", prefactor=k)
         curve = V.viscoelastic_cooling(ve)
@@ -225,7 +292,28 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
                          "(InelasticCollapseError); set [collision] tc_time (TC model) or use the viscoelastic "
                          "rule (scripts/collapse_demo.py)")
     adv.notes = tuple(notes)
+    _set_method(adv, config)
     return adv
+
+
+def _set_method(adv: Advice, config):
+    length = adv.instability_length if math.isfinite(adv.instability_length) else math.inf
+    adv.method, adv.method_reason = choose_method(config, length)
+    adv.speedup = dsmc_speedup(config.system.packing_fraction)
+    adv.configured_method = config.run.method
+
+
+def method_line(config) -> str | None:
+    """One line for the run summary of a DSMC config whose scene needs positions (box above
+    the instability length, dense gas): the DSMC answer is that of a homogeneous Enskog gas.
+    None otherwise (walls and the TC model are refused by the config rules)."""
+    if config.run.method != "dsmc":
+        return None
+    method, reason = choose_method(config, V.gas_from_config(config).instability_length())
+    if method == "dsmc":
+        return None
+    return (f"warning      run.method = \"dsmc\": {reason}; this run shows the homogeneous Enskog-Boltzmann gas "
+            "(method = \"edmd\" for the real one)")
 
 
 def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:

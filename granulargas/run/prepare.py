@@ -46,10 +46,11 @@ from granulargas.engine import CollisionRule, WhiteNoise
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
 from granulargas.initial import InitialState, box_for_packing, random_state
-from granulargas.initial.lattice_gas import MIN_WALL_AXIS_DIAMETERS, RANDOM_PLACEMENT_MAX
+from granulargas.initial.lattice_gas import MIN_WALL_AXIS_DIAMETERS, RANDOM_PLACEMENT_MAX, maxwell_velocities
 from granulargas.io.config import TABLE_BETA_MAX, RunConfig
-from granulargas.io.h5md import load_snapshot, open_run, read_boundary, read_observables, snapshot_count
-from granulargas.run.resources import check_memory
+from granulargas.io.h5md import (has_positions, load_snapshot, open_run, read_boundary, read_dsmc_state,
+                                 read_observables, snapshot_count)
+from granulargas.run.resources import check_dsmc_memory, check_memory
 from granulargas.theory import particle_volume
 
 #: observables samples of a run without [output] observables_interval (run.schedule uses it)
@@ -68,6 +69,8 @@ class Setup:
     parameters: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     driving: object = None
+    #: ``run.method = "dsmc"``: the DSMC random state to continue from (None: a fresh start)
+    dsmc_state: dict | None = None
 
 
 # ------------------------------------------------------------------- particles
@@ -130,6 +133,21 @@ def fresh_state(config: RunConfig) -> InitialState:
                           f"placement works up to about {limit:g} in {s.dimension}D") from None
 
 
+def fresh_velocities(config: RunConfig) -> InitialState:
+    """A fresh state without positions (``run.method = "dsmc"``): radii and masses as
+    :func:`fresh_state` draws them, the box of the packing fraction (its volume sets the
+    density), Maxwell-Boltzmann velocities with zero total momentum and temperature exactly
+    ``initial.temperature``, all from ``numpy.random.default_rng(system.seed)``; no
+    hard-sphere placement (the costly part of a large engine state)."""
+    s = config.system
+    check_dsmc_memory(config)
+    rng = np.random.default_rng(s.seed)
+    radii, masses = make_particles(config, rng)
+    box = box_for_packing(radii, s.packing_fraction, s.dimension)
+    velocities = maxwell_velocities(masses, s.dimension, config.initial.temperature, rng=rng)
+    return InitialState(None, np.ascontiguousarray(velocities), radii, masses, box, boundary=tuple(s.boundary))
+
+
 def restart_state(config: RunConfig) -> InitialState:
     """The last snapshot of one of our files, with its time and counters."""
     path = Path(config.initial.from_file)
@@ -145,6 +163,7 @@ def restart_state(config: RunConfig) -> InitialState:
         obs = read_observables(path)
         with open_run(path) as f:
             boundary = read_boundary(f)
+            file_method = "edmd" if has_positions(f) else "dsmc"
     except InputFileError as exc:
         raise InputFileError(f"{where}: {str(exc).split(': ', 1)[-1]}") from None
     for name in ("collisions", "dissipated_energy"):
@@ -163,25 +182,42 @@ def restart_state(config: RunConfig) -> InitialState:
             counters[name] = obs[name][2][k]
     collisions = int(obs["collisions"][2][k])
     dissipated = float(obs["dissipated_energy"][2][k])
-    n, dim = snap.positions.shape
+    if file_method != config.run.method:
+        raise ConfigError(f'{config.source}: run.method = "{config.run.method}": restart file {path} is a '
+                          f'{"DSMC run (no positions)" if file_method == "dsmc" else "EDMD run"}; continue it '
+                          f'with method = "{file_method}"')
+    n, dim = snap.velocities.shape
     if dim != config.system.dimension:
         raise ConfigError(f"{config.source}: system.dimension = {config.system.dimension}: restart file {path} is {dim}D")
     if n != config.system.particles:
         raise ConfigError(
             f"{config.source}: system.particles = {config.system.particles}: restart file {path} has {n} particles"
         )
-    bad = [name for name in ("positions", "velocities", "radii", "masses", "box")
-           if not np.all(np.isfinite(np.asarray(getattr(snap, name), dtype=np.float64)))]
+    arrays = ("positions", "velocities", "radii", "masses", "box") if file_method == "edmd" else (
+        "velocities", "radii", "masses", "box")
+    bad = [name for name in arrays if not np.all(np.isfinite(np.asarray(getattr(snap, name), dtype=np.float64)))]
     if bad or not (np.all(snap.radii > 0) and np.all(snap.masses > 0) and np.all(snap.box > 0)):
         raise InputFileError(f"{where}: damaged H5MD file: the last snapshot holds non-finite or non-positive "
                              f"{', '.join(bad) or 'radii, masses or box'}")
     packing = float(particle_volume(2.0 * snap.radii, dim).sum() / np.prod(snap.box))
-    check_memory(config, n=n, packing=packing, fresh=False)
+    if file_method == "dsmc":
+        check_dsmc_memory(config, n=n)
+    else:
+        check_memory(config, n=n, packing=packing, fresh=False)
     if boundary != tuple(config.system.boundary):
         raise ConfigError(
             f"{config.source}: system.boundary = [{', '.join(repr(b) for b in config.system.boundary)}]: "
             f"restart file {path} has [{', '.join(repr(b) for b in boundary)}]"
         )
+    if file_method == "dsmc":
+        return InitialState(
+            positions=None, velocities=np.ascontiguousarray(snap.velocities, dtype=np.float64),
+            radii=np.ascontiguousarray(snap.radii, dtype=np.float64),
+            masses=np.ascontiguousarray(snap.masses, dtype=np.float64),
+            box=np.ascontiguousarray(snap.box, dtype=np.float64), species=np.asarray(snap.species, dtype=np.int32),
+            time=snap.time, collisions=collisions, events=snap.step, dissipated_energy=dissipated,
+            boundary=boundary, injected_energy=float(counters.get("injected_energy", 0.0)),
+            kick_step=int(counters["kick_step"]) if "kick_step" in counters else None, source=str(path))
     return InitialState(
         positions=np.ascontiguousarray(snap.positions, dtype=np.float64),
         velocities=np.ascontiguousarray(snap.velocities, dtype=np.float64),
@@ -405,7 +441,9 @@ def make_driving(config: RunConfig, prefactor: float | None, state: InitialState
 def initial_state(config: RunConfig) -> InitialState:
     """The state a run of ``config`` starts from: the restart file's last snapshot
     (``initial.from``) or a fresh random state."""
-    return restart_state(config) if config.initial.from_file else fresh_state(config)
+    if config.initial.from_file:
+        return restart_state(config)
+    return fresh_velocities(config) if config.run.method == "dsmc" else fresh_state(config)
 
 
 def prepare(config: RunConfig) -> Setup:
@@ -429,9 +467,17 @@ def prepare(config: RunConfig) -> Setup:
                  "time: diameter * sqrt(mass / T0)",
         "collision": rule_params,
         "boundary": " ".join(s.boundary),
+        "method": config.run.method,
     }
     if driving_params is not None:
         parameters["driving"] = driving_params
+    if config.run.method == "dsmc":
+        parameters["dsmc"] = {
+            "chi": float(theory.contact_value(parameters["packing_fraction"], s.dimension)),
+            "number_density": float(len(state.radii) / np.prod(state.box)),
+            "description": "DSMC of the homogeneous Enskog-Boltzmann equation (granulargas.dsmc): no positions; "
+                           "chi = theory.contact_value(packing_fraction)",
+        }
     if config.collision.material is not None:
         m = config.collision.material
         parameters["units_si"] = {"length_m": m.diameter, "mass_kg": reference_mass_si(m),
@@ -439,4 +485,11 @@ def prepare(config: RunConfig) -> Setup:
     if state.source:
         parameters["restart"] = {"file": state.source, "time": state.time, "step": state.events,
                                  "collisions": state.collisions}
-    return Setup(rule, name, state, k, table, parameters, warns, driving)
+    dsmc_state = None
+    if config.run.method == "dsmc" and state.source:
+        try:
+            dsmc_state = read_dsmc_state(state.source, -1)
+        except InputFileError as exc:
+            raise InputFileError(f'{config.source}: initial.from = "{state.source}": '
+                                 f'{str(exc).split(": ", 1)[-1]}') from None
+    return Setup(rule, name, state, k, table, parameters, warns, driving, dsmc_state)

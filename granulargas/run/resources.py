@@ -24,6 +24,11 @@ The peak is the larger of the placement (with the state it returns) and the
 engine with the state. The engine stores cell ids as int32, so the grid may not
 exceed 2^31 - 1 cells: this, and the memory, bound dilute packings from below.
 
+A DSMC run (``run.method = "dsmc"``, :func:`check_dsmc_memory`) has no placement and no
+grid: its estimate is counted from the arrays it holds, 48 B per particle for the DSMC
+(32 B of velocity rows, 16 B of radii and masses of unlike particles) plus
+8 (4 d + 2) B for the initial state, one snapshot's copy and the Maxwell-Boltzmann draw.
+
 The output's share (the schedule in memory, the file on its disk) is checked by
 :func:`granulargas.run.schedule.check_output_size`.
 """
@@ -129,6 +134,24 @@ def run_memory(n: int, dimension: int, packing: float, mean_volume_ratio: float 
     return {"engine": engine, "engine_cells": engine_cells, "placement": placement,
             "placement_cells": placement_cells if fresh else 0.0, "state": state,
             "total": max(placement, engine) + state}
+
+
+def dsmc_memory(n: int, dimension: int) -> float:
+    """Estimated peak memory (bytes) of a DSMC run of ``n`` particles (module docstring)."""
+    return (48.0 + 8.0 * (4 * dimension + 2)) * float(n)
+
+
+def check_dsmc_memory(config: RunConfig, *, n: int | None = None, available: float | None = None) -> float:
+    """Refuse a DSMC run whose estimated memory exceeds what is available (one line naming
+    ``system.particles``). Returns the estimate."""
+    n = config.system.particles if n is None else int(n)
+    need = dsmc_memory(n, config.system.dimension)
+    if available is None:
+        available = available_memory()
+    if available is not None and need > available:
+        raise ConfigError(f"{config.source}: system.particles = {n}: the DSMC run needs about "
+                          f"{format_bytes(need)} of memory, {format_bytes(available)} are available")
+    return need
 
 
 def _volume_ratio(config: RunConfig) -> float:

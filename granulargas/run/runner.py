@@ -57,6 +57,8 @@ from granulargas.errors import ConfigError, InputFileError, SimulationError, Use
 from granulargas.io.config import RunConfig, parse_config
 from granulargas.io.h5md import H5MDWriter, read_parameters
 from granulargas.io.paths import existing_directory, output_file
+from granulargas.observables import sonine_coefficients
+from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
@@ -85,9 +87,13 @@ class RunSummary:
     warnings: tuple = field(default_factory=tuple)
     startup_time: float = 0.0
     three_body_contacts: int | None = None  # collisions that take time only
+    method: str = "edmd"
+    candidates: int | None = None  # DSMC: candidate pairs drawn (accepted or not)
 
     def lines(self) -> list[str]:
         per = 2.0 * self.collisions / self.particles if self.particles else float("nan")
+        counts = (f"{self.events} events" if self.candidates is None else
+                  f"DSMC, {self.candidates} candidate pairs drawn")
         extra = []
         if self.three_body_contacts is not None:
             share = self.three_body_contacts / self.collisions if self.collisions else 0.0
@@ -96,7 +102,7 @@ class RunSummary:
             extra.append(f"three-body   {self.three_body_contacts} collisions with a pair still in contact "
                          f"({100.0 * share:.3g} % of the collisions{note})")
         return [
-            f"collisions   {self.collisions} ({per:.4g} per particle), {self.events} events", *extra,
+            f"collisions   {self.collisions} ({per:.4g} per particle), {counts}", *extra,
             f"time         {self.time:.6g} (stopped by {self.stop_reason})",
             f"wall time    {self.wall_time:.3g} s ({self.collisions_per_second:.4g} collisions/s)"
             f" + {self.startup_time:.3g} s start-up (JIT compile or cache load, queue build)",
@@ -296,6 +302,9 @@ def _plain(v):
 
 
 def _observables(sim, pressure: bool) -> dict:
+    if hasattr(sim, "observables"):  # a DSMC run (run.dsmc_run.DSMCRun)
+        return sim.observables()
+    a2, a3 = sonine_coefficients(sim.velocities, sim.masses)
     out = {
         "temperature": float(sim.temperature),
         "kinetic_energy": float(sim.kinetic_energy),
@@ -304,6 +313,8 @@ def _observables(sim, pressure: bool) -> dict:
         "dissipated_energy": float(sim.dissipated_energy),
         "momentum": np.asarray(sim.momentum, dtype=np.float64),
         "pressure": float(sim.pressure_window()) if pressure else math.nan,
+        "sonine_a2": float(a2),
+        "sonine_a3": float(a3),
     }
     if "wall" in sim.boundary:
         out["wall_collisions"] = int(sim.wall_collisions)
@@ -370,14 +381,18 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         raise ConfigError(f"{config.source}: run.collisions_per_particle = {run.collisions_per_particle:g}: the "
                           f"restart file {st.source} already has {st.collisions} collisions; nothing to run")
 
-    sim = Simulation(
-        st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
-        time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
-        events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
-        wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
-        injected_energy=st.injected_energy, contact_until=st.contact_until,
-        contact_partner=st.contact_partner, three_body_contacts=st.three_body_contacts,
-    )
+    dsmc = config.run.method == "dsmc"
+    if dsmc:
+        sim = make_dsmc(config, setup)
+    else:
+        sim = Simulation(
+            st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
+            time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
+            events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
+            wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
+            injected_energy=st.injected_energy, contact_until=st.contact_until,
+            contact_partner=st.contact_partner, three_body_contacts=st.three_body_contacts,
+        )
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
     # event loop; both paths of a restart do it, so restart equality is unaffected
@@ -393,7 +408,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         budget = collision_budget(config)
 
     tc = setup.rule_name == "constant" and config.collision.tc_time is not None
-    resolved = sim.rule.resolved
+    resolved = not dsmc and sim.rule.resolved
     if append:
         writer = H5MDWriter.append(path, particles=len(st.radii), dimension=st.box.shape[0], last_collision=tc,
                                    step=st.events, time=st.time, contacts=resolved)
@@ -401,7 +416,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     else:
         writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
                             last_collision=tc, overwrite=overwrite, boundary=sim.boundary,
-                            driven=sim.driving is not None, contacts=resolved)
+                            driven=sim.driving is not None, positions=not dsmc, contacts=resolved)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached
@@ -434,7 +449,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         sim.synchronise()
         lc = np.asarray(sim.last_collision) if tc else None
         contacts = (sim.contact_until, sim.contact_partner) if resolved else None
-        writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc, contacts)
+        writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc,
+                              dsmc_state=sim.state if dsmc else None, contacts=contacts)
         frame[0] = (sim.events, sim.time)
 
     wall0 = _time.perf_counter()
@@ -519,13 +535,15 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         particles=len(st.radii),
         warnings=tuple(setup.warnings),
         startup_time=startup,
-        three_body_contacts=int(sim.three_body_contacts) if sim.rule.resolved else None,
+        three_body_contacts=int(sim.three_body_contacts) if resolved else None,
+        method=config.run.method,
+        candidates=int(sim.candidates) if dsmc else None,
     )
     writer.set_parameters({"summary": {
         "stop_reason": stop_reason, "time": summary.time, "collisions": summary.collisions,
         "events": summary.events, "wall_time": wall, "collisions_per_second": summary.collisions_per_second,
         "startup_time": startup,
-        **({"three_body_contacts": summary.three_body_contacts} if sim.rule.resolved else {}),
+        **({"three_body_contacts": summary.three_body_contacts} if resolved else {}),
     }})
     writer.close()
     if bar is not None:

@@ -67,3 +67,24 @@ def test_mdanalysis_reads_3d_run(run_files):
         assert np.allclose(ts.positions, s.positions, rtol=1e-6, atol=1e-5)  # MDAnalysis keeps float32
         assert np.allclose(ts.velocities, s.velocities, rtol=1e-6, atol=1e-6)
         assert np.allclose(ts.dimensions, list(s.box) + [90, 90, 90])
+
+
+def test_pyh5md_reads_a_dsmc_file(tmp_path):
+    """A DSMC file (no positions): velocity is a time element of its own, observables as usual."""
+    pyh5md = pytest.importorskip("pyh5md")
+    cfg = tmp_path / "d.toml"
+    cfg.write_text('[system]\nparticles = 300\npacking_fraction = 0.02\n[collision]\nmodel = "constant"\n'
+                   f'restitution = 0.9\n[run]\nmethod = "dsmc"\nend_time = 5.0\n[output]\nfile = "{tmp_path / "d.h5"}"\n'
+                   "snapshot_interval = 1.0\n")
+    out = run_config(load_config(cfg)).output
+    ours = list(iter_snapshots(out))
+    with pyh5md.File(str(out), "r") as f:
+        part = f.particles_group("all")
+        assert "position" not in part
+        vel = pyh5md.element(part, "velocity")
+        assert vel.element_type == "TimeElement"
+        assert list(vel.time[()]) == [s.time for s in ours] == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+        for k, s in enumerate(ours):
+            assert np.array_equal(vel.value[k], s.velocities)
+        temp = pyh5md.element(f["observables"], "temperature")
+        assert np.array_equal(temp.value[()], read_observables(out)["temperature"][2])
