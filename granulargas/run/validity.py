@@ -286,8 +286,8 @@ def _warn_contact(rv: RunValidity, gas: RunGas, spread) -> None:
     short against the mean free time, and damping beyond the quasi-static force's range."""
     if rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN and gas.duration == "resolved":
         rv.warnings.append(
-            f"{gas.source}: contact duration / mean free time = {rv.tc_ratio:.3g} > {TC_RATIO_WARN:g}: about "
-            f"{100 * (1 - math.exp(-2 * rv.tc_ratio)):.2g} % of collisions may meet a pair still in contact, "
+            f"{gas.source}: contact duration / mean free time = {rv.tc_ratio:.3g} > {TC_RATIO_WARN:g}: of the order "
+            f"of {100 * (1 - math.exp(-2 * rv.tc_ratio)):.2g} % of collisions may meet a pair still in contact, "
             "which the resolved two-body contacts do not describe (counted as three_body_contacts)")
     elif rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN:
         what = "tc_time" if gas.model == "constant" else "contact duration"

@@ -96,3 +96,12 @@ def test_resolved_with_walls_is_refused(write_config, capsys):
     assert main(["run", str(write_config(text))]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "periodic boundaries only" in err[0]
+
+
+def test_advise_keeps_a_resolved_config_on_edmd(write_config):
+    from granulargas.run.advise import advise
+
+    adv = advise(load_config(write_config(RESOLVED)))
+    text = "\n".join(adv.lines())
+    assert 'EDMD (run.method = "edmd"): collisions that take time need positions' in text
+    assert 'duration = "resolved"' in text and 'model = "constant"' not in text
