@@ -57,7 +57,9 @@ Status codes (the Python driver raises ``granulargas.errors`` exceptions):
 2 ``max_collisions`` reached; 10 a neighbour list is full, 11 a cell is full
 (enlarge, call again: nothing was lost); 20 inelastic collapse (a particle collided
 ``collapse_count`` times in a row less than ``collapse_dt`` after its previous
-collision); 21 impact beyond the restitution table; 30 watchdog (an event in
+collision); 21 impact beyond the restitution table; 22, 23 impact beyond the
+oblique-contact table in beta, in delta (resolved rule: the driver extends the
+table and calls again, nothing was lost); 30 watchdog (an event in
 the past or an endless run of zero-time events: round-off trouble); 31 more
 simultaneous events than the event calendar's window holds.
 """
@@ -65,6 +67,8 @@ simultaneous events than the event calendar's window holds.
 import math
 
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from granulargas._numba import kernel
 from granulargas.engine._calendar import (
@@ -80,6 +84,7 @@ from granulargas.engine._collide import pair_collision, restitution, wall_collis
 from granulargas.engine._drive import kick_velocities
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image, wall_delay
 from granulargas.engine._prefetch import prefetch
+from granulargas.engine._resolved import resolved_pair
 from granulargas.engine._probe import (
     COLLIDE,
     PEEK,
@@ -168,6 +173,88 @@ def predict_pair(i, t, before, rec, nbl, nbn, period):
     return best, p
 
 
+@kernel
+def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts):
+    """:func:`predict_pair` for a particle whose contact is under way (resolved rule,
+    :mod:`granulargas.engine._resolved`).
+
+    A neighbour j with a contact under way between i and j (j = ``partner[i]``, or
+    ``partner[j]`` = i; after a third-particle collision the two differ) cannot
+    collide with i before that contact ends, at e = the later of the two ends: its
+    collision time is e plus the delay from the pair's state at e (0 if the
+    extended lines still overlap there and approach; none for the receding pair
+    of an undisturbed contact).
+    """
+    skip = contacts.partner[i]
+    until = contacts.until
+    partner = contacts.partner
+    xi = rec[i, 0]
+    yi = rec[i, 1]
+    zi = rec[i, 2]
+    vx = rec[i, 3]
+    vy = rec[i, 4]
+    vz = rec[i, 5]
+    ri = rec[i, 7]
+    best = before
+    p = -1
+    for k in range(nbn[i]):
+        j = nbl[i, k]
+        dtj = t - rec[j, 6]
+        end = until[i] if j == skip else -math.inf
+        if partner[j] == i and until[j] > end:
+            end = until[j]
+        h = end - t if end > t else 0.0
+        ux = vx - rec[j, 3]
+        uy = vy - rec[j, 4]
+        uz = vz - rec[j, 5]
+        s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj) + ux * h, period[0]),
+                            min_image(yi - (rec[j, 1] + rec[j, 4] * dtj) + uy * h, period[1]),
+                            min_image(zi - (rec[j, 2] + rec[j, 5] * dtj) + uz * h, period[2]),
+                            ux, uy, uz, ri + rec[j, 7])
+        tc = t + h + s
+        better = tc < best
+        best = tc if better else best
+        p = j if better else p
+    return best, p
+
+
+def in_contact(contacts, i, t):
+    """Whether particle i's contact is under way at t (always False without contacts:
+    ``contacts`` is None for the instantaneous rules, so that their loop compiles
+    without any of the resolved rule's code)."""
+
+
+def predict_pair_contact(i, t, before, rec, nbl, nbn, period, contacts):
+    """:func:`predict_pair_except` (``contacts`` None: never called, returns (before, -1))."""
+
+
+def collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
+    """:func:`granulargas.engine._resolved.resolved_pair` (``contacts`` None: never called)."""
+
+
+@overload(in_contact)
+def _in_contact(contacts, i, t):
+    if isinstance(contacts, types.NoneType):
+        return lambda contacts, i, t: False
+    return lambda contacts, i, t: contacts.until[i] > t
+
+
+@overload(predict_pair_contact)
+def _predict_pair_contact(i, t, before, rec, nbl, nbn, period, contacts):
+    if isinstance(contacts, types.NoneType):
+        return lambda i, t, before, rec, nbl, nbn, period, contacts: (before, np.int64(-1))
+    return lambda i, t, before, rec, nbl, nbn, period, contacts: predict_pair_except(
+        i, t, before, rec, nbl, nbn, period, contacts)
+
+
+@overload(collide_resolved)
+def _collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
+    if isinstance(contacts, types.NoneType):
+        return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: 0
+    return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: resolved_pair(
+        i, j, te, dx, dy, dz, p, contacts, c, rule, period)
+
+
 @kernel(inline="always")
 def predict_wall(i, t, rec, space):
     """Earliest wall collision of particle i (streamed to t): (time, wall index 2 a + side).
@@ -193,10 +280,17 @@ def predict_kick(c, prm):
 
 
 @kernel
-def predict(i, t, rec, count, events, lists, space, half_shell):
-    """Earliest event of particle i (streamed to t); sets its slot and returns the time."""
+def predict(i, t, rec, count, events, lists, space, half_shell, contacts):
+    """Earliest event of particle i (streamed to t); sets its slot and returns the time.
+
+    ``contacts`` (resolved rule; None otherwise): while i's contact is under way
+    (t < ``contacts.until[i]``; the end of a contact of i with j is never before j's)
+    its contact partners are left out (:func:`predict_pair_except`)."""
     best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
-    best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
+    if in_contact(contacts, i, t):
+        best, p = predict_pair_contact(i, t, best, rec, lists.nbl, lists.nbn, space.period, contacts)
+    else:
+        best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
     tag = count[p] if p >= 0 else 0
     tw, wall = predict_wall(i, t, rec, space)
     if tw < best:
@@ -209,10 +303,10 @@ def predict(i, t, rec, count, events, lists, space, half_shell):
 
 
 @kernel
-def predict_all(t, rec, count, events, lists, space, half_shell, times):
+def predict_all(t, rec, count, events, lists, space, half_shell, contacts, times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
     for i in range(rec.shape[0]):
-        times[i] = predict(i, t, rec, count, events, lists, space, half_shell)
+        times[i] = predict(i, t, rec, count, events, lists, space, half_shell, contacts)
 
 
 # --------------------------------------------------------------------- execute
@@ -227,10 +321,12 @@ def _collapse_watch(i, te, p, prm):
 
 
 @kernel(inline="always")
-def execute_pair(i, j, te, p, ev, lists, cal, c, prm):
+def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
-    Returns DONE, or TABLE_RANGE / COLLAPSE / CALENDAR (``c.err_i``, ``c.err_j`` set).
+    Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
+    ``c.err_j`` set). With ``contacts`` (the resolved rule; None otherwise) the pair collides by
+    :func:`granulargas.engine._resolved.resolved_pair`.
     """
     rec = p.rec
     period = prm.space.period
@@ -249,45 +345,50 @@ def execute_pair(i, j, te, p, ev, lists, cal, c, prm):
     b = dx * ux + dy * uy + dz * uz
     if b >= 0.0:  # receding (round-off): nothing happens
         return DONE
-    dist = math.sqrt(dx * dx + dy * dy + dz * dz)
-    inv = 1.0 / dist
-    nx = dx * inv
-    ny = dy * inv
-    nz = dz * inv
-    un = b * inv  # normal relative velocity, < 0
-    mi = p.mass[i]
-    mj = p.mass[j]
-    lastcoll = p.lastcoll
-    if rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time):
-        eps = 1.0
+    if contacts is not None:
+        status = collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period)
+        if status != DONE:
+            return status
     else:
-        r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
-        eps = restitution(rule.kind, rule.eps, rule.prefactor, rule.inv_h, rule.coeffs, -un,
-                          r_eff, mi * mj / (mi + mj))
-        if eps < 0.0:
-            c.err_i = i
-            c.err_j = j
-            return TABLE_RANGE
-    fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
-    rec[i, 3] -= fi * nx
-    rec[i, 4] -= fi * ny
-    rec[i, 5] -= fi * nz
-    rec[j, 3] += fj * nx
-    rec[j, 4] += fj * ny
-    rec[j, 5] += fj * nz
-    c.dissipated += loss
-    c.sum_mv2 -= 2.0 * loss
-    c.virial -= impulse * dist
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        inv = 1.0 / dist
+        nx = dx * inv
+        ny = dy * inv
+        nz = dz * inv
+        un = b * inv  # normal relative velocity, < 0
+        mi = p.mass[i]
+        mj = p.mass[j]
+        lastcoll = p.lastcoll
+        if rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time):
+            eps = 1.0
+        else:
+            r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
+            eps = restitution(rule.kind, rule.eps, rule.prefactor, rule.inv_h, rule.coeffs, -un,
+                              r_eff, mi * mj / (mi + mj))
+            if eps < 0.0:
+                c.err_i = i
+                c.err_j = j
+                return TABLE_RANGE
+        fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
+        rec[i, 3] -= fi * nx
+        rec[i, 4] -= fi * ny
+        rec[i, 5] -= fi * nz
+        rec[j, 3] += fj * nx
+        rec[j, 4] += fj * ny
+        rec[j, 5] += fj * nz
+        c.dissipated += loss
+        c.sum_mv2 -= 2.0 * loss
+        c.virial -= impulse * dist
     p.count[i] += 1
     p.count[j] += 1
     c.collisions += 1
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
-    tj = predict(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+    tj = predict(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
     if not cal_update(j, tj, cal):
         return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
-        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
         c.events += 1
         c.err_i = i
@@ -347,7 +448,7 @@ def execute_wall(i, wall, te, p, c, walls, prm):
 
 
 @kernel
-def execute_kick(t, p, ev, lists, cal, c, prm):
+def execute_kick(t, p, ev, lists, cal, c, prm, contacts):
     """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1);
     every event predicted anew and the calendar rebuilt (O(N))."""
     rec = p.rec
@@ -362,7 +463,7 @@ def execute_kick(t, p, ev, lists, cal, c, prm):
     c.sum_mv2 = s
     c.kick_step += 1
     c.kicks += 1
-    predict_all(t, rec, p.count, ev, lists, prm.space, prm.half_shell, cal.qt)
+    predict_all(t, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, cal.qt)
     return DONE if cal_build(t, cal) else CALENDAR
 
 
@@ -463,6 +564,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
     cal = engine.calendar
     c = engine.counters[0]
     walls = engine.walls
+    contacts = engine.contacts
     rec = p.rec
     time = c.time
     zero_advance = 0
@@ -507,7 +609,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
         clock = tick(probe, POP, clock)
         # ---- dispatch
         if j >= 0 and p.count[j] == ev.tag[i]:
-            status = execute_pair(i, j, te, p, ev, lists, cal, c, prm)
+            status = execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts)
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
@@ -521,7 +623,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:
-                    ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+                    ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
                     if not cal_update(i, ti, cal):
                         status = CALENDAR
                     c.events += 1
@@ -532,7 +634,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             c.stale += 1
             clock = tick(probe, P_STALE, clock)
         # ---- re-predict the particle of the event
-        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell)
+        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
         clock = tick(probe, PREDICT, clock)
         if not cal_update(i, ti, cal):
             status = CALENDAR
@@ -579,7 +681,7 @@ def advance_driven(engine, prm, until, max_events, max_collisions, probe):
         if status != DONE or t_kick > until:
             return status
         status = execute_kick(c.time, engine.particles, engine.events, engine.lists,
-                              engine.calendar, c, prm)
+                              engine.calendar, c, prm, engine.contacts)
         c.events += 1
         if status != DONE or c.time >= until:
             return status

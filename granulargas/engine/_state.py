@@ -38,6 +38,12 @@ Record layout
 * ``counters`` (1,) :data:`COUNTERS` record.
 * ``walls`` :class:`Walls` -- ``impulse`` (3, 2) f8: normal momentum delivered to
   the lower / upper wall of each axis since the last reset.
+* ``contacts`` :class:`Contacts` -- collisions that take time
+  (:mod:`granulargas.engine._resolved`): ``until`` f8, the time at which the
+  particle's last contact ends (-inf: none), ``partner`` i4 the slot of that
+  contact's partner (-1: none); work space ``work`` (3,) and ``out`` (5,) f8 of
+  the table lookup. None for the other rules, whose loop then compiles without
+  any of this (:func:`granulargas.engine._loop.in_contact`).
 """
 
 from __future__ import annotations
@@ -53,16 +59,20 @@ Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil", "mark
 Cells = namedtuple("Cells", ["ids", "n", "of"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])
+Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
-                               "walls"])
+                               "walls", "contacts"])
 
 # Read-only parameters.
 #: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
 #: ``eps``, ``tc_time`` (<= 0: TC model off), viscoelastic ``prefactor`` k and the
-#: restitution table (``inv_h``, ``coeffs``), and the sphere-wall ``wall_eps``
-#: (constant rule).
+#: restitution table (``inv_h``, ``coeffs``), the sphere-wall ``wall_eps``
+#: (constant rule), and for collisions that take time ``resolved`` (1: on), the
+#: compression prefactor q and the oblique-contact table (``ob_inv_hs``,
+#: ``ob_inv_hd``, ``ob_coeffs``; :mod:`granulargas.contact.oblique_lookup`).
 RuleParams = namedtuple("RuleParams", ["kind", "eps", "tc_time", "prefactor", "inv_h", "coeffs",
-                                       "wall_eps"])
+                                       "wall_eps", "resolved", "compression", "ob_inv_hs", "ob_inv_hd",
+                                       "ob_coeffs"])
 #: Geometry: ``box`` (3,) side lengths (the cell grid spans [0, L)); ``period`` (3,)
 #: the period of each axis (L when periodic, inf on a wall axis, so that the
 #: minimum image and the wrap leave wall axes alone); ``ncell`` (3,) cells per
@@ -80,13 +90,14 @@ Params = namedtuple("Params", ["rule", "space", "shell", "half_shell", "rmax", "
 #: (cumulative); ``virial`` sum of r_ij . Delta p_ij and ``kin_int`` integral of
 #: sum m v^2 dt since the last pressure reset; ``sum_mv2`` = sum m v^2 now;
 #: ``injected`` energy put in by the driving (cumulative); event counts; ``kick_step``
-#: index k of the next driving step (at time (k + 1/2) kick_interval); ``err_i``, ``err_j``
-#: the slots involved in an error.
+#: index k of the next driving step (at time (k + 1/2) kick_interval); ``three_body``
+#: collisions of a particle still in contact with another partner (resolved rule);
+#: ``err_i``, ``err_j`` the slots involved in an error.
 COUNTERS = np.dtype([
     ("time", "f8"), ("dissipated", "f8"), ("virial", "f8"), ("kin_int", "f8"),
     ("sum_mv2", "f8"), ("injected", "f8"),
     ("collisions", "i8"), ("events", "i8"), ("expiries", "i8"), ("stale", "i8"),
-    ("wall_collisions", "i8"), ("kicks", "i8"), ("kick_step", "i8"),
+    ("wall_collisions", "i8"), ("kicks", "i8"), ("kick_step", "i8"), ("three_body", "i8"),
     ("err_i", "i8"), ("err_j", "i8"),
 ], align=True)
 
@@ -98,11 +109,26 @@ CALENDAR_STATE = np.dtype([
 
 
 def rule_params(kind: int, eps: float = 1.0, tc_time: float = -1.0, prefactor: float = 0.0,
-                inv_h: float = 1.0, coeffs=None, wall_eps: float | None = None) -> RuleParams:
-    """A :class:`RuleParams` with the dtypes the kernels are compiled for."""
+                inv_h: float = 1.0, coeffs=None, wall_eps: float | None = None, oblique=None,
+                compression: float = 0.0) -> RuleParams:
+    """A :class:`RuleParams` with the dtypes the kernels are compiled for (``oblique``: an
+    :class:`~granulargas.contact.oblique_grid.ObliqueTable` for collisions that take time)."""
     coeffs = np.zeros((1, 4)) if coeffs is None else np.ascontiguousarray(coeffs, dtype=np.float64)
+    if oblique is None:
+        resolved, inv_hs, inv_hd, ob = 0, 1.0, 1.0, np.zeros((1, 1, 1, 3, 1, 1, 1))
+    else:
+        resolved, inv_hs, inv_hd = 1, float(oblique.inv_hs), float(oblique.inv_hd)
+        ob = np.ascontiguousarray(oblique.coeffs, dtype=np.float64)
     return RuleParams(int(kind), float(eps), float(tc_time), float(prefactor), float(inv_h), coeffs,
-                      float(eps if wall_eps is None else wall_eps))
+                      float(eps if wall_eps is None else wall_eps), resolved, float(compression),
+                      inv_hs, inv_hd, ob)
+
+
+def contacts(n: int, until=None, partner=None) -> Contacts:
+    """A :class:`Contacts` record for n slots (no contact under way unless given)."""
+    u = np.full(n, -np.inf) if until is None else np.ascontiguousarray(until, dtype=np.float64)
+    q = np.full(n, -1, dtype=np.int32) if partner is None else np.ascontiguousarray(partner, dtype=np.int32)
+    return Contacts(u, q, np.zeros(3), np.zeros(5))
 
 
 def space(box3, period3, ncell, wall_axes, dims) -> Space:

@@ -7,6 +7,14 @@ constant eps, TC time, prefactor and coefficient table; see
 collisions follow the same rule with R_eff = R_i and m_eff = m_i (a flat,
 infinitely heavy wall of the same material); a constant-eps rule may give the
 walls their own ``wall_restitution``.
+
+A viscoelastic rule with ``duration="resolved"`` makes collisions take time:
+the pair's outcome (outgoing velocity, contact duration, where the pair leaves
+the contact) comes from the oblique-contact table and the pair jumps onto its
+outgoing line (:mod:`granulargas.engine._resolved`). It needs the contact
+stiffness as well as the damping: the compression prefactor
+q = (2 Y / (3 (1 - nu^2)))^(-2/5) of
+:func:`granulargas.contact.oblique.compression_prefactor` in reduced units.
 """
 
 from __future__ import annotations
@@ -17,6 +25,9 @@ from typing import Any
 from granulargas.engine._collide import CONSTANT, ELASTIC, VISCOELASTIC
 from granulargas.engine._state import RuleParams, rule_params
 from granulargas.errors import ConfigError
+
+#: How long a collision takes: "instantaneous", or "resolved" (viscoelastic only).
+DURATIONS = ("instantaneous", "resolved")
 
 
 @dataclass(frozen=True)
@@ -42,6 +53,14 @@ class CollisionRule:
         Constant eps of sphere-wall collisions (kind "constant"; None: the same
         as ``restitution``). Elastic rules have elastic walls, viscoelastic rules
         eps(beta) at the sphere-plane contact.
+    duration : str
+        "instantaneous" (every kind) or "resolved" (viscoelastic: collisions
+        that take time).
+    compression : float
+        Resolved rule: compression prefactor q, X = q (m_eff^2 g_n^4 / R_eff)^(1/5).
+    oblique : object
+        Resolved rule: the oblique-contact table
+        (:class:`granulargas.contact.oblique_grid.ObliqueTable`) of the same contact end.
     """
 
     kind: str
@@ -50,6 +69,9 @@ class CollisionRule:
     prefactor: float = 0.0
     table: Any = None
     wall_restitution: float | None = None
+    duration: str = "instantaneous"
+    compression: float = 0.0
+    oblique: Any = None
 
     @classmethod
     def elastic(cls) -> "CollisionRule":
@@ -77,15 +99,45 @@ class CollisionRule:
                    wall_restitution=wall_restitution)
 
     @classmethod
-    def viscoelastic(cls, prefactor: float, table: Any, tc_time: float | None = None) -> "CollisionRule":
-        """Viscoelastic eps(beta) from a restitution table, beta = k (R_eff g_n / m_eff^2)^(1/5)."""
+    def viscoelastic(cls, prefactor: float, table: Any, tc_time: float | None = None,
+                     duration: str = "instantaneous", compression: float | None = None,
+                     oblique: Any = None) -> "CollisionRule":
+        """Viscoelastic eps(beta) from a restitution table, beta = k (R_eff g_n / m_eff^2)^(1/5).
+
+        ``duration="resolved"``: collisions take time (module docstring); needs
+        ``compression`` (q > 0) and ``oblique`` (an ObliqueTable), and no TC model.
+        """
         prefactor = float(prefactor)
         if not prefactor >= 0.0:
             raise ConfigError(f"viscoelastic prefactor = {prefactor}: must be >= 0")
         if table is None or not hasattr(table, "inv_h") or not hasattr(table, "coeffs"):
             raise ConfigError("viscoelastic rule needs a restitution table with inv_h and coeffs")
-        return cls("viscoelastic", prefactor=prefactor, table=table,
-                   tc_time=None if tc_time is None else float(tc_time))
+        if duration not in DURATIONS:
+            raise ConfigError(f"duration = {duration!r}: must be one of {', '.join(DURATIONS)}")
+        if duration == "instantaneous":
+            if compression is not None or oblique is not None:
+                raise ConfigError('compression and oblique are used only with duration = "resolved"')
+            return cls("viscoelastic", prefactor=prefactor, table=table,
+                       tc_time=None if tc_time is None else float(tc_time))
+        if tc_time is not None:
+            raise ConfigError('tc_time: the TC model is not used with duration = "resolved"')
+        compression = float("nan") if compression is None else float(compression)
+        if not (compression > 0.0 and compression < float("inf")):
+            raise ConfigError(f'duration = "resolved" needs the compression prefactor q > 0 (the contact '
+                              f'stiffness; contact.oblique.compression_prefactor), got {compression}')
+        if oblique is None or not all(hasattr(oblique, a) for a in ("inv_hs", "inv_hd", "coeffs")):
+            raise ConfigError('duration = "resolved" needs an oblique-contact table (contact.oblique_table)')
+        end = getattr(table, "end", None)
+        if end is not None and getattr(oblique, "end", end) != end:
+            raise ConfigError(f"the oblique-contact table ends at {oblique.end!r}, the restitution table "
+                              f"at {end!r}: give both for the same contact end")
+        return cls("viscoelastic", prefactor=prefactor, table=table, duration="resolved",
+                   compression=compression, oblique=oblique)
+
+    @property
+    def resolved(self) -> bool:
+        """True for collisions that take time."""
+        return self.duration == "resolved"
 
     # -- what the compiled loop sees
     def compiled(self) -> RuleParams:
@@ -95,7 +147,7 @@ class CollisionRule:
         eps = self.restitution if self.kind == "constant" else 1.0
         if self.kind == "viscoelastic":
             return rule_params(kind, eps, tc, self.prefactor, float(self.table.inv_h),
-                               self.table.coeffs)
+                               self.table.coeffs, oblique=self.oblique, compression=self.compression)
         return rule_params(kind, eps, tc, self.prefactor, wall_eps=self.wall_restitution)
 
     def kernel_arguments(self):

@@ -21,6 +21,7 @@ import math
 import numpy as np
 
 from granulargas.engine import _loop, _state
+from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
 from granulargas.engine._drive import kick_scale
@@ -148,6 +149,14 @@ class Simulation:
         Remove the centre-of-mass velocity that round-off accumulates on the
         periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
         e.g. a mean flow given on purpose.
+    contact_until : array (N,), optional
+        Resolved rule (collisions that take time): the time at which each
+        particle's contact under way ends (-inf: none); carried over on restart.
+    contact_partner : int array (N,), optional
+        Resolved rule: the particle id of that contact's partner (-1: none).
+    three_body_contacts : int
+        Resolved rule: collisions of a particle still in contact with another
+        partner so far (carried over on restart).
 
     Notes
     -----
@@ -169,7 +178,8 @@ class Simulation:
                  *, events: int = 0, dissipated_energy: float = 0.0, shell: float | None = None,
                  collapse_count: int = 100, boundary=None, wall_collisions: int = 0,
                  driving: WhiteNoise | None = None, kick_step: int | None = None,
-                 injected_energy: float = 0.0, remove_drift: bool = True):
+                 injected_energy: float = 0.0, remove_drift: bool = True, contact_until=None,
+                 contact_partner=None, three_body_contacts: int = 0):
         pos = np.array(positions, dtype=np.float64, order="C", copy=True)
         if pos.ndim != 2 or pos.shape[1] not in (2, 3):
             raise ConfigError(f"positions: shape {pos.shape}, expected (N, 2) or (N, 3)")
@@ -222,6 +232,18 @@ class Simulation:
             raise ConfigError(f"last_collision: shape {lc.shape}, expected ({n},)")
         if driving is not None and not isinstance(driving, WhiteNoise):
             raise TypeError("driving must be a granulargas.engine.driving.WhiteNoise or None")
+        if rule.resolved and np.any(wall):
+            raise ConfigError('boundary: walls are not available with collisions that take time '
+                              '(duration = "resolved"); use periodic axes')
+        cu = np.full(n, -np.inf) if contact_until is None else np.array(contact_until, dtype=np.float64)
+        cp = np.full(n, -1, dtype=np.int64) if contact_partner is None else np.array(contact_partner,
+                                                                                   dtype=np.int64)
+        if cu.shape != (n,) or cp.shape != (n,):
+            raise ConfigError(f"contact_until, contact_partner: shapes {cu.shape}, {cp.shape}, expected ({n},)")
+        if np.any((cp < -1) | (cp >= n)) or np.any(np.isnan(cu)):
+            raise ConfigError("contact_partner: particle ids in [0, N) or -1; contact_until: no NaN")
+        self._contact_until, self._contact_partner = cu, cp
+        self._three_body = int(three_body_contacts)
 
         self._positions, self._velocities, self._images, self._last_collision = pos, vel, img, lc
         self._radii, self._masses, self._box = rad, mas, bx
@@ -339,8 +361,15 @@ class Simulation:
             self._nb_width = width
         lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
         calendar = allocate_calendar(n)
+        slot = np.empty(n, dtype=np.int64)
+        slot[order] = np.arange(n)
+        cp = self._contact_partner[order]
+        # the instantaneous rules' loop is compiled without the contacts (None)
+        contacts = _state.contacts(n, self._contact_until[order],
+                                   np.where(cp >= 0, slot[np.maximum(cp, 0)], -1).astype(np.int32)
+                                   ) if self.rule.resolved else None
         _loop.predict_all(self._time, rec, particles.count, events, lists, spc,
-                          0.5 * self.shell * (1.0 - 1e-9), calendar.qt)
+                          0.5 * self.shell * (1.0 - 1e-9), contacts, calendar.qt)
         counters = np.zeros(1, dtype=_state.COUNTERS)
         c = counters[0]
         with np.errstate(over="ignore", under="ignore"):
@@ -354,9 +383,10 @@ class Simulation:
         c["events"] = self._events
         c["wall_collisions"] = self._wall_collisions
         c["kick_step"] = self._kick_step
+        c["three_body"] = self._three_body
         c["err_i"] = c["err_j"] = -1
         walls = _state.Walls(impulse=self._wall_impulse.copy())
-        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls)
+        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts)
         self._place_events(self._time)
         self._built = True
 
@@ -483,6 +513,10 @@ class Simulation:
                 continue
             if status in (_loop.DONE, _loop.MAX_COLLISIONS):
                 break
+            if status in (OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE):
+                self._extend_oblique_table()
+                prm = self._params()
+                continue
             self._raise(status)
         dt = self.time - start_time
         self._rate = 2.0 * (self.collisions - start_coll) / (self.n * dt) if dt > 0 else float("nan")
@@ -513,6 +547,39 @@ class Simulation:
             va = math.fsum((self._masses * vel[:, a]).tolist()) / mtot
             vel[:, a] -= va
         return True
+
+    def _extend_oblique_table(self):
+        """The pair ``err_i``, ``err_j`` met an impact beyond the oblique-contact table:
+        replace the rule by one with a table covering it (its shared part is
+        bit-identical, so results do not depend on when this happens)."""
+        from dataclasses import replace
+
+        from granulargas.contact.oblique import DELTA_MAX
+        from granulargas.contact.oblique_grid import BETA_MAX
+
+        c = self._counters
+        i, j = int(c["err_i"]), int(c["err_j"])
+        rec, m = self._engine.particles.rec, self._engine.particles.mass
+        d = rec[i, :3] - rec[j, :3]
+        period = self._space.period
+        d = np.where(np.isfinite(period), d - period * np.round(d / np.where(np.isfinite(period), period, 1.0)), d)
+        g_n = -float(np.dot(d, rec[i, 3:6] - rec[j, 3:6])) / float(np.linalg.norm(d))
+        r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
+        m_eff = m[i] * m[j] / (m[i] + m[j])
+        rule = self.rule
+        beta = rule.prefactor * (r_eff * g_n / m_eff**2) ** 0.2
+        delta = rule.compression * (m_eff**2 * g_n**4 / r_eff) ** 0.2 / (rec[i, 7] + rec[j, 7])
+        ids = [int(self._order[k]) for k in (i, j)]
+        if not (beta < BETA_MAX and delta < DELTA_MAX):
+            raise TableRangeError(
+                f"impact of particles {ids} at t = {float(c['time']):.12g} (normal speed {g_n:.6g}) has "
+                f"beta = {beta:.4g}, delta = {delta:.4g}: collisions that take time need beta < {BETA_MAX:g} "
+                f"and delta < {DELTA_MAX:g} (delta is the compression over the contact distance: the "
+                f"contact is too soft or the impact too fast)")
+        table = rule.oblique.extended(min(BETA_MAX, max(beta * 1.2, rule.oblique.beta_max)),
+                                      min(DELTA_MAX, max(delta * 1.2, rule.oblique.delta_max)))
+        self.rule = replace(rule, oblique=table)
+        c["err_i"] = c["err_j"] = -1
 
     def _raise(self, status):
         c = self._counters
@@ -557,7 +624,14 @@ class Simulation:
             self._collisions, self._events = int(c["collisions"]), int(c["events"])
             self._wall_collisions = int(c["wall_collisions"])
             self._kick_step = int(c["kick_step"])
+            self._three_body = int(c["three_body"])
             self._wall_impulse = e.walls.impulse.copy()
+            if e.contacts is not None:
+                self._contact_until = np.empty(n)
+                self._contact_until[inv] = e.contacts.until
+                cp = e.contacts.partner.astype(np.int64)
+                self._contact_partner = np.empty(n, dtype=np.int64)
+                self._contact_partner[inv] = np.where(cp >= 0, inv[np.maximum(cp, 0)], -1)
             self._built = False
             self._engine = None
         return self
@@ -598,6 +672,30 @@ class Simulation:
     def wall_collisions(self) -> int:
         """Sphere-wall collisions so far."""
         return int(self._counters["wall_collisions"]) if self._built else self._wall_collisions
+
+    @property
+    def three_body_contacts(self) -> int:
+        """Resolved rule: collisions of a particle still in contact with another partner so far."""
+        return int(self._counters["three_body"]) if self._built else self._three_body
+
+    @property
+    def contact_until(self) -> np.ndarray:
+        """Resolved rule: when each particle's contact under way ends (-inf: none), (N,)."""
+        if not self._built or self._engine.contacts is None:
+            return self._contact_until.copy()
+        out = np.empty(self.n)
+        out[self._order] = self._engine.contacts.until
+        return out
+
+    @property
+    def contact_partner(self) -> np.ndarray:
+        """Resolved rule: the particle id of each particle's last contact partner (-1: none), (N,)."""
+        if not self._built or self._engine.contacts is None:
+            return self._contact_partner.copy()
+        cp = self._engine.contacts.partner.astype(np.int64)
+        out = np.empty(self.n, dtype=np.int64)
+        out[self._order] = np.where(cp >= 0, self._order[np.maximum(cp, 0)], -1)
+        return out
 
     @property
     def kick_step(self) -> int:

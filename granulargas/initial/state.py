@@ -30,6 +30,11 @@ class InitialState:
         step (restarts; None: the first step after ``time``).
     last_collision : array (N,), optional
         Time of each particle's last collision (TC model restarts).
+    contact_until, contact_partner : arrays (N,), optional
+        Contacts under way of collisions that take time (restarts; see
+        :class:`granulargas.engine.Simulation`).
+    three_body_contacts : int
+        Collisions with a pair still in contact so far (restarts).
     source : str, optional
         File the state was read from (restarts).
     """
@@ -51,6 +56,9 @@ class InitialState:
     kick_step: int | None = None
     last_collision: np.ndarray | None = None
     source: str | None = None
+    contact_until: np.ndarray | None = None
+    contact_partner: np.ndarray | None = None
+    three_body_contacts: int = 0
 
     def __post_init__(self):
         if self.species is None:

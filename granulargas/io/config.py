@@ -65,6 +65,7 @@ from granulargas.errors import ConfigError
 MAX_PACKING = {3: math.pi / (3.0 * math.sqrt(2.0)), 2: math.pi / (2.0 * math.sqrt(3.0))}
 MODELS = ("elastic", "constant", "viscoelastic")
 CONTACT_ENDS = ("overlap", "force")
+DURATIONS = ("instantaneous", "resolved")
 BOUNDARIES = ("periodic", "wall")
 DRIVING_MODELS = ("white_noise",)
 #: ``run.method``: event-driven molecular dynamics, or DSMC of the homogeneous Enskog-Boltzmann equation
@@ -159,7 +160,9 @@ class CollisionConfig:
     turns it (or ``[collision.material]``) into the pair prefactor k.
     ``wall_restitution`` (constant model, with walls): the constant eps of
     sphere-wall collisions (default: ``restitution``); elastic runs have elastic
-    walls, viscoelastic runs the sphere-plane contact of the same material."""
+    walls, viscoelastic runs the sphere-plane contact of the same material.
+    ``duration``: "instantaneous" collisions, or "resolved" (viscoelastic with
+    ``[collision.material]``): collisions that take time."""
 
     model: str = "viscoelastic"
     restitution: float | None = None
@@ -168,6 +171,7 @@ class CollisionConfig:
     contact_end: str = "overlap"
     tc_time: float | None = None
     wall_restitution: float | None = None
+    duration: str = "instantaneous"
 
 
 @dataclass(frozen=True)
@@ -432,6 +436,14 @@ SCHEMA: tuple[Key, ...] = (
         '`"overlap"`: the contact ends when the compression returns to zero (Schwager & Pöschel '
         '(1997), eq. (4)); `"force"`: when the repulsive force vanishes (Schwager & Pöschel 2008).',
         default="overlap", choices=CONTACT_ENDS),
+    Key("collision", "duration", "string",
+        '`"instantaneous"`: a collision changes the velocities at the moment of touch. `"resolved"` '
+        "(viscoelastic with `[collision.material]`, periodic boundaries): collisions take time; the pair "
+        "leaves the contact with the velocity, at the time and on the line that the contact force gives "
+        "for its impact angle (the oblique-contact table), as Müller & Pöschel (2013); meant for dilute "
+        "gases, collisions with a pair still in contact are counted (`three_body_contacts`).",
+        default="instantaneous", choices=DURATIONS,
+        run_check="the impacts' compression over the contact distance stays below 0.5 and beta below 2"),
     Key("collision", "tc_time", "number",
         '`model = "constant"` only: TC model (Luding & McNamara 1998); a collision within `tc_time` '
         "of either particle's previous one is elastic, which guards against inelastic collapse. "
@@ -721,6 +733,25 @@ def _check_viscoelastic_needs_contact(v: Values):
                                     "[collision.material] table")
 
 
+def _check_resolved_needs_material(v: Values):
+    if v.get("collision.duration") != "resolved":
+        return
+    if v.get("collision.model") != "viscoelastic":
+        v.fail("collision.duration", f'"resolved" needs model = "viscoelastic" (model = '
+                                     f'"{v.get("collision.model")}" has no contact force to resolve)')
+    if not v.has("collision.material"):
+        v.fail("collision.duration", '"resolved" needs the contact stiffness: give [collision.material] '
+                                     "(young_modulus, poisson_ratio, dissipation_time, ...) instead of damping, "
+                                     "which fixes beta but not the contact time")
+    boundary = v.get("system.boundary")
+    if boundary is not None and "wall" in boundary:
+        v.fail("collision.duration", '"resolved" is available with periodic boundaries only '
+                                     "(system.boundary has a wall)")
+    if v.get("run.method") == "dsmc":
+        v.fail("collision.duration", '"resolved" needs positions: it is for run.method = "edmd" (DSMC has '
+                                     "instantaneous collisions only)")
+
+
 def _check_run_has_an_end(v: Values):
     if not (v.has("run.end_time") or v.has("run.collisions_per_particle")):
         raise ConfigError(f"{v.source}: run: needs end_time and/or collisions_per_particle (both > 0)")
@@ -804,6 +835,8 @@ RULES: tuple[Rule, ...] = (
     _only_with("collision.material", ("viscoelastic",)),
     Rule('`model = "viscoelastic"` needs `damping` or `[collision.material]`.', _check_viscoelastic_needs_contact),
     _exclusive("collision.damping", "collision.material"),
+    Rule('`duration = "resolved"` needs `model = "viscoelastic"` with `[collision.material]`, periodic '
+         'boundaries and `method = "edmd"`.', _check_resolved_needs_material),
     Rule("`diameter = { min, max }` needs both keys and min <= max (min = max is monodisperse).",
          _check_diameter_range),
     _exclusive("particles.mass", "particles.density"),

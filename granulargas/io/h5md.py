@@ -14,6 +14,10 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         velocity/  step, time (links), value (F, N, d)
         image/     step, time (links), value (F, N, d) int64 periodic image counts (0 on wall axes)
         last_collision/        (TC model only) value (F, N): time of each particle's last collision
+        contact_until/         (collisions that take time only) value (F, N) float64: when each
+                               particle's contact under way ends (-inf: none)
+        contact_partner/       (collisions that take time only) value (F, N) int64: particle id of
+                               that contact's partner (-1: none)
         dsmc/                  (DSMC runs only) the random state that continues the run bit for
                                bit: rng (F, 5) uint64, candidates (F,), pending_pair (F, 2),
                                pending_time (F,), frame_velocity (F, d); step, time linked
@@ -25,6 +29,8 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         momentum (d,), pressure:        step (S,), time (S,) shared, value (S, ...)
         wall_collisions, wall_pressure  (runs with walls)
         injected_energy, kick_step      (driven runs: energy put in, index of the next kick)
+        three_body_contacts             (collisions that take time: collisions of a particle still
+                                        in contact with another one, cumulative)
     parameters/
         config (resolved TOML text), config_source (file text), attrs
         version, seed, model, units, prefactor, ...; restitution_table/ (the
@@ -70,6 +76,7 @@ what is missing or unreadable.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import re
 import time as _time
@@ -96,7 +103,10 @@ DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_p
 #: observables of runs with walls / with driving (written only by such runs)
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
-_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step")
+RESOLVED_OBSERVABLES = ("three_body_contacts",)
+#: per-particle restart state of collisions that take time: (name, dtype)
+CONTACT_ELEMENTS = (("contact_until", np.float64), ("contact_partner", np.int64))
+_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts")
 #: H5MD box boundary of each axis kind
 _H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
 
@@ -123,6 +133,10 @@ class H5MDWriter:
         numpy arrays become datasets.
     last_collision : bool
         Also store each particle's last collision time per snapshot (TC model restart).
+    contacts : bool
+        Collisions that take time: also store each particle's contact under way per
+        snapshot (``contact_until``, ``contact_partner``; restart) and the
+        ``three_body_contacts`` observable.
     overwrite : bool
     positions : bool
         False for a DSMC run: no positions and images; each frame stores the DSMC random
@@ -130,7 +144,7 @@ class H5MDWriter:
     """
 
     def __init__(self, path, box, radii, masses, species=None, *, parameters=None,
-                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False,
+                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False, contacts=False,
                  positions=True):
         self.path = Path(path)
         box = np.ascontiguousarray(box, dtype=np.float64)
@@ -145,12 +159,13 @@ class H5MDWriter:
             raise InputFileError(f"{self.path}: cannot create output file ({_short(exc)})") from None
         self.file = f
         self.boundary = ("periodic",) * self.d if boundary is None else tuple(boundary)
-        extra = (WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
+        extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
+                 + (RESOLVED_OBSERVABLES if contacts else ()))
         names = SCALAR_OBSERVABLES + ("momentum",) + extra
         if not self.positions:  # DSMC: no pair virial, no pressure
             names = tuple(x for x in names if x != "pressure")
         try:
-            self._create(box, radii, masses, species, parameters or {}, last_collision, author, names)
+            self._create(box, radii, masses, species, parameters or {}, last_collision, author, names, contacts)
         except BaseException:
             self.file.close()
             self.path.unlink(missing_ok=True)
@@ -163,7 +178,8 @@ class H5MDWriter:
     flush_seconds = 2.0
 
     @classmethod
-    def append(cls, path, *, particles: int, dimension: int, last_collision: bool, step: int, time: float):
+    def append(cls, path, *, particles: int, dimension: int, last_collision: bool, step: int, time: float,
+               contacts: bool = False):
         """Open one of our files to continue its run in it (module docstring).
 
         The file must hold ``particles`` particles in ``dimension`` dimensions and end
@@ -175,7 +191,8 @@ class H5MDWriter:
         """
         path = Path(path)
         with open_run(path) as f, _damaged(path, "the run to continue"):
-            frames, samples = _continuation_point(f, path, particles, dimension, last_collision, step, time)
+            frames, samples = _continuation_point(f, path, particles, dimension, last_collision, step, time,
+                                                  contacts)
         f = open_run(path, "r+")
         try:
             with _damaged(path, "the run to continue"):
@@ -188,6 +205,7 @@ class H5MDWriter:
                 names = (["position", "velocity", "image"] if self.positions else
                          ["velocity"] + [f"dsmc/{k}" for k in DSMC_STATE])
                 names += ["box/edges"] + (["last_collision"] if last_collision else [])
+                names += [name for name, _ in CONTACT_ELEMENTS] if contacts else []
                 self._frame_groups = [part[name] for name in names]
                 for g in self._frame_groups:
                     g["value"].resize(frames, axis=0)
@@ -222,7 +240,7 @@ class H5MDWriter:
         self.file.flush()
 
     # ----------------------------------------------------------------- layout
-    def _create(self, box, radii, masses, species, parameters, last_collision, author, names):
+    def _create(self, box, radii, masses, species, parameters, last_collision, author, names, contacts=False):
         f, n, d = self.file, self.n, self.d
         h = f.create_group("h5md")
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
@@ -274,6 +292,11 @@ class H5MDWriter:
             g["step"], g["time"] = step, time
             g.create_dataset("value", shape=(0, n), maxshape=(None, n), dtype=np.float64, chunks=_frame_chunks(n, 0))
             groups.append(g)
+        for name, dtype in CONTACT_ELEMENTS if contacts else ():
+            g = part.create_group(name)
+            g["step"], g["time"] = step, time
+            g.create_dataset("value", shape=(0, n), maxshape=(None, n), dtype=dtype, chunks=_frame_chunks(n, 0))
+            groups.append(g)
         self._frame_groups = groups
         part.create_dataset("mass", data=np.asarray(masses, dtype=np.float64))
         part.create_dataset("radius", data=np.asarray(radii, dtype=np.float64))
@@ -318,8 +341,10 @@ class H5MDWriter:
     def frames(self) -> int:
         return int(self.file[f"particles/all/{_clock_name(self.file)}/step"].shape[0])
 
-    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None, dsmc_state=None):
-        """Append one frame (synchronised state) and flush.
+    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None, dsmc_state=None,
+                       contacts=None):
+        """Append one frame (synchronised state) and flush (``contacts``: the arrays
+        (contact_until, contact_partner) of collisions that take time).
 
         The frame's values are written before its step/time, so a reader of a
         killed run never sees a time without data. A DSMC file (``positions=False``)
@@ -331,6 +356,8 @@ class H5MDWriter:
         data = {"position": positions, "velocity": velocities, "image": images, "edges": self.box}
         if last_collision is not None:
             data["last_collision"] = last_collision
+        if contacts is not None:
+            data["contact_until"], data["contact_partner"] = contacts
         if dsmc_state is not None:
             data.update({name: np.asarray(dsmc_state[name]) for name in DSMC_STATE})
         for g in self._frame_groups:
@@ -398,7 +425,8 @@ class H5MDWriter:
         self.close()
 
 
-def _continuation_point(f, path, particles, dimension, last_collision, step, time) -> tuple[int, int]:
+def _continuation_point(f, path, particles, dimension, last_collision, step, time,
+                        contacts=False) -> tuple[int, int]:
     """(frames, samples) to keep of a file a run continues in (:meth:`H5MDWriter.append`)."""
     part = f["particles/all"]
     n, d = (int(x) for x in part[f"{_clock_name(f)}/value"].shape[1:])
@@ -407,6 +435,9 @@ def _continuation_point(f, path, particles, dimension, last_collision, step, tim
     if ("last_collision" in part) != bool(last_collision):
         raise InputFileError(f"{path}: {'has' if 'last_collision' in part else 'lacks'} the TC model's "
                              "last-collision times; continue it with the same collision model")
+    if ("contact_until" in part) != bool(contacts):
+        raise InputFileError(f"{path}: {'has' if 'contact_until' in part else 'lacks'} the contacts under way of "
+                             "collisions that take time; continue it with the same collision duration")
     frames = _frame_count(f)
     clock = _clock_name(f)
     if frames == 0 or int(part[f"{clock}/step"][frames - 1]) != step or float(
@@ -477,6 +508,8 @@ class Snapshot:
     masses: np.ndarray  # (N,)
     species: np.ndarray  # (N,)
     last_collision: np.ndarray | None = None  # (N,) TC model only
+    contact_until: np.ndarray | None = None  # (N,) collisions that take time only
+    contact_partner: np.ndarray | None = None  # (N,) int64, collisions that take time only
     boundary: tuple = ()  # "periodic" or "wall" per axis
 
     @property
@@ -587,11 +620,12 @@ def _check_layout(f, path):
         if part[name].dtype.kind not in "fiu":
             raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} holds {part[name].dtype} "
                                  "values, not numbers")
-    if "last_collision" in part:
-        lc = part.get("last_collision/value")
-        if not isinstance(lc, h5py.Dataset) or lc.shape[1:] != (n,):
-            raise InputFileError(f"{path}: damaged H5MD file: particles/all/last_collision/value is missing "
-                                 f"or not (frames, {n})")
+    for name in ("last_collision",) + tuple(name for name, _ in CONTACT_ELEMENTS):
+        if name in part:
+            lc = part.get(f"{name}/value")
+            if not isinstance(lc, h5py.Dataset) or lc.shape[1:] != (n,):
+                raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name}/value is missing "
+                                     f"or not (frames, {n})")
     if not isinstance(f.get("observables"), h5py.Group):
         raise InputFileError(f"{path}: damaged H5MD file: observables/ is missing")
     if not isinstance(f.get("parameters"), h5py.Group):
@@ -615,8 +649,9 @@ def _frame_count(f) -> int:
     lengths = [pos["step"].shape[0], pos["time"].shape[0], pos["value"].shape[0]]
     others = ("velocity/value", "image/value") if has_positions(f) else tuple(f"dsmc/{k}/value" for k in DSMC_STATE)
     lengths += [part[name].shape[0] for name in others + ("box/edges/value",)]
-    if "last_collision" in part:
-        lengths.append(part["last_collision/value"].shape[0])
+    for name in ("last_collision",) + tuple(name for name, _ in CONTACT_ELEMENTS):
+        if name in part:
+            lengths.append(part[f"{name}/value"].shape[0])
     return int(min(lengths))
 
 
@@ -625,6 +660,9 @@ def _snapshot(f, k, static) -> Snapshot:
     radii, masses, species, boundary = static
     lc = part["last_collision/value"][k] if "last_collision" in part else None
     snap = _read_snapshot(part, k, radii, masses, species, lc, boundary)
+    if "contact_until" in part and "contact_partner" in part:
+        snap = dataclasses.replace(snap, contact_until=part["contact_until/value"][k],
+                                   contact_partner=part["contact_partner/value"][k])
     for name in ("positions", "velocities", "box") if snap.positions is not None else ("velocities", "box"):
         if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")

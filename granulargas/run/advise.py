@@ -92,6 +92,8 @@ def choose_method(config, instability_length: float = math.inf) -> tuple[str, st
         return "edmd", "walls need positions (DSMC simulates a homogeneous gas)"
     if c.tc_time is not None:
         return "edmd", "the TC model needs pair histories of a spatial gas"
+    if c.duration == "resolved":
+        return "edmd", "collisions that take time need positions (DSMC's collisions are instantaneous)"
     box = _box(config)
     if box > instability_length:
         return "edmd", (f"the box {box:.4g} exceeds the instability length {instability_length:.4g}: "
@@ -263,7 +265,14 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         adv.eps_best, adv.error = best_constant(gas, curve, t_end)
         adv.constant_ok = adv.error <= tolerance
         adv.instability_length = gas.instability_length()
-        if adv.constant_ok:
+        if config.collision.duration == "resolved":
+            ratio = V.contact_time_ratio(config)
+            share = "" if ratio is None else (f"; of the order of {100 * (1 - math.exp(-2 * ratio)):.2g} % of the collisions "
+                                              "will meet a pair still in contact (three_body_contacts)")
+            notes.append('duration = "resolved": the constant-eps comparison above is one of instantaneous '
+                         "collisions, which leave out the contact's duration and the turn of the normal"
+                         + share)
+        elif adv.constant_ok:
             notes.append(f'use [collision] model = "constant", restitution = {adv.eps_best:.4f} '
                          "(cost per collision is nearly the same; the gain is a closed-form reference, Haff's law)")
     elif gas.model == "viscoelastic":

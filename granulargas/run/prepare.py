@@ -18,6 +18,15 @@ never raise the total kinetic energy E (lab frame, conserved momentum), so
 R_eff <= R_max/2, m_eff >= m_min/2 every pair has
 beta <= k (2 R_max / m_min^2)^(1/5) g_max^(1/5): a rigorous bound, so the
 engine can never leave the table.
+
+Collisions that take time (``duration = "resolved"``) also need the contact
+stiffness: the compression prefactor q = (2 Y / (3 (1 - nu^2)))^(-2/5)
+(:func:`granulargas.contact.oblique.compression_prefactor`) in reduced units,
+q = (2 Y sigma^3 / (3 (1 - nu^2) M u^2))^(-2/5), so that X = q (m_eff^2 g_n^4 / R_eff)^(1/5).
+Its oblique-contact table is built for the fastest impact of the initial state
+(twice the largest speed): no rigorous bound fits the table's range, so the
+engine extends the table when an impact leaves it
+(:meth:`granulargas.engine.Simulation.run`).
 """
 
 from __future__ import annotations
@@ -29,7 +38,9 @@ from pathlib import Path
 import numpy as np
 
 from granulargas import __version__
-from granulargas.contact import material, restitution_table
+from granulargas.contact import material, oblique_table, restitution_table
+from granulargas.contact.oblique import DELTA_MAX, compression_prefactor
+from granulargas.contact.oblique_grid import BETA_MAX as OBLIQUE_BETA_MAX
 from granulargas import theory
 from granulargas.engine import CollisionRule, WhiteNoise
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
@@ -164,7 +175,7 @@ def restart_state(config: RunConfig) -> InitialState:
         raise InputFileError(f"{where}: no observables sample at its last snapshot (t = {snap.time:g})")
     k = int(hits[-1])
     counters = {}
-    for name in ("dissipated_energy", "wall_collisions", "injected_energy", "kick_step"):
+    for name in ("dissipated_energy", "wall_collisions", "injected_energy", "kick_step", "three_body_contacts"):
         if name in obs and k >= len(obs[name][2]):
             raise InputFileError(f"{where}: damaged H5MD file: observables/{name} ends before its last snapshot")
         if name in obs and name != "dissipated_energy":
@@ -225,6 +236,9 @@ def restart_state(config: RunConfig) -> InitialState:
         kick_step=int(counters["kick_step"]) if "kick_step" in counters else None,
         last_collision=None if snap.last_collision is None else np.ascontiguousarray(snap.last_collision),
         source=str(path),
+        contact_until=None if snap.contact_until is None else np.ascontiguousarray(snap.contact_until),
+        contact_partner=None if snap.contact_partner is None else np.ascontiguousarray(snap.contact_partner),
+        three_body_contacts=int(counters.get("three_body_contacts", 0)),
     )
 
 
@@ -239,6 +253,25 @@ def reduced_prefactor(config: RunConfig) -> float:
     m = c.material
     k_si = float(material.prefactor_from_material(m.young_modulus, m.poisson_ratio, m.dissipation_time))
     return k_si * (m.diameter * m.speed_unit / reference_mass_si(m) ** 2) ** 0.2
+
+
+def reduced_compression(config: RunConfig) -> float:
+    """The compression prefactor q of ``[collision.material]`` in reduced units (module docstring)."""
+    m = config.collision.material
+    young = m.young_modulus * m.diameter**3 / (reference_mass_si(m) * m.speed_unit**2)
+    return float(compression_prefactor(young, m.poisson_ratio))
+
+
+def oblique_bounds(prefactor: float, compression: float, state: InitialState) -> tuple[float, float]:
+    """(beta, delta) of the fastest impact the initial state holds: relative speed twice the
+    largest speed, for the pair with the largest pair constants (any two particles)."""
+    m, r = state.masses, state.radii
+    g = 2.0 * float(np.sqrt((state.velocities**2).sum(axis=1)).max())
+    r_max, r_min, m_min, m_max = float(r.max()), float(r.min()), float(m.min()), float(m.max())
+    beta = float(material.pair_constant(prefactor, r_max, r_max, m_min, m_min)) * g**0.2
+    # X / D <= q (m_eff^2 / R_eff)^(1/5) g^(4/5) / (2 R_min) with m_eff <= m_max / 2, R_eff >= R_min / 2
+    delta = compression * ((0.5 * m_max) ** 2 / (0.5 * r_min)) ** 0.2 * g**0.8 / (2.0 * r_min)
+    return beta, delta
 
 
 def reference_mass_si(material) -> float:
@@ -340,6 +373,23 @@ def make_rule(config: RunConfig, state: InitialState):
         "inv_h": table.inv_h, "coeffs": np.asarray(table.coeffs), "duration_coeffs": np.asarray(table.duration_coeffs),
         "beta_max": table.beta_max, "end": table.end, **{k2: v for k2, v in table.parameters.items()},
     }
+    if c.duration == "resolved":
+        q = reduced_compression(config)
+        beta, delta = oblique_bounds(k, q, state)
+        if not (beta < OBLIQUE_BETA_MAX and delta < DELTA_MAX):
+            raise ConfigError(
+                f'{config.source}: collision.duration = "resolved": the fastest impact of the initial state '
+                f"has beta = {beta:.3g}, compression over contact distance delta = {delta:.3g}; collisions that "
+                f"take time need beta < {OBLIQUE_BETA_MAX:g} and delta < {DELTA_MAX:g} (a stiffer material, a "
+                f"lower speed_unit or less damping)")
+        oblique = oblique_table(max(beta, 1e-6), max(delta, 1e-6), end=c.contact_end)
+        params.update(duration="resolved", compression=q)
+        params["oblique_table"] = {"inv_hs": oblique.inv_hs, "inv_hd": oblique.inv_hd,
+                                   "beta_max": oblique.beta_max, "delta_max": oblique.delta_max,
+                                   **{k2: v for k2, v in oblique.parameters.items()}}
+        rule = CollisionRule.viscoelastic(prefactor=k, table=table, duration="resolved", compression=q,
+                                          oblique=oblique)
+        return rule, "viscoelastic", k, table, warns, params
     return CollisionRule.viscoelastic(prefactor=k, table=table), "viscoelastic", k, table, warns, params
 
 

@@ -86,6 +86,7 @@ class RunSummary:
     particles: int = 0
     warnings: tuple = field(default_factory=tuple)
     startup_time: float = 0.0
+    three_body_contacts: int | None = None  # collisions that take time only
     method: str = "edmd"
     candidates: int | None = None  # DSMC: candidate pairs drawn (accepted or not)
 
@@ -93,8 +94,15 @@ class RunSummary:
         per = 2.0 * self.collisions / self.particles if self.particles else float("nan")
         counts = (f"{self.events} events" if self.candidates is None else
                   f"DSMC, {self.candidates} candidate pairs drawn")
+        extra = []
+        if self.three_body_contacts is not None:
+            share = self.three_body_contacts / self.collisions if self.collisions else 0.0
+            note = ("; above 1 %: the two-body contacts of the resolved scheme are off, use DEM"
+                    if share > 0.01 else "")
+            extra.append(f"three-body   {self.three_body_contacts} collisions with a pair still in contact "
+                         f"({100.0 * share:.3g} % of the collisions{note})")
         return [
-            f"collisions   {self.collisions} ({per:.4g} per particle), {counts}",
+            f"collisions   {self.collisions} ({per:.4g} per particle), {counts}", *extra,
             f"time         {self.time:.6g} (stopped by {self.stop_reason})",
             f"wall time    {self.wall_time:.3g} s ({self.collisions_per_second:.4g} collisions/s)"
             f" + {self.startup_time:.3g} s start-up (JIT compile or cache load, queue build)",
@@ -314,6 +322,8 @@ def _observables(sim, pressure: bool) -> dict:
     if sim.driving is not None:
         out["injected_energy"] = float(sim.injected_energy)
         out["kick_step"] = int(sim.kick_step)
+    if sim.rule.resolved:
+        out["three_body_contacts"] = int(sim.three_body_contacts)
     return out
 
 
@@ -380,7 +390,8 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
             time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
             events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
             wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
-            injected_energy=st.injected_energy,
+            injected_energy=st.injected_energy, contact_until=st.contact_until,
+            contact_partner=st.contact_partner, three_body_contacts=st.three_body_contacts,
         )
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
@@ -397,14 +408,15 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         budget = collision_budget(config)
 
     tc = setup.rule_name == "constant" and config.collision.tc_time is not None
+    resolved = not dsmc and sim.rule.resolved
     if append:
         writer = H5MDWriter.append(path, particles=len(st.radii), dimension=st.box.shape[0], last_collision=tc,
-                                   step=st.events, time=st.time)
+                                   step=st.events, time=st.time, contacts=resolved)
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
                             last_collision=tc, overwrite=overwrite, boundary=sim.boundary,
-                            driven=sim.driving is not None, positions=not dsmc)
+                            driven=sim.driving is not None, positions=not dsmc, contacts=resolved)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached
@@ -436,8 +448,9 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     def snapshot():
         sim.synchronise()
         lc = np.asarray(sim.last_collision) if tc else None
+        contacts = (sim.contact_until, sim.contact_partner) if resolved else None
         writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc,
-                              dsmc_state=sim.state if dsmc else None)
+                              dsmc_state=sim.state if dsmc else None, contacts=contacts)
         frame[0] = (sim.events, sim.time)
 
     wall0 = _time.perf_counter()
@@ -522,6 +535,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         particles=len(st.radii),
         warnings=tuple(setup.warnings),
         startup_time=startup,
+        three_body_contacts=int(sim.three_body_contacts) if resolved else None,
         method=config.run.method,
         candidates=int(sim.candidates) if dsmc else None,
     )
@@ -529,6 +543,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         "stop_reason": stop_reason, "time": summary.time, "collisions": summary.collisions,
         "events": summary.events, "wall_time": wall, "collisions_per_second": summary.collisions_per_second,
         "startup_time": startup,
+        **({"three_body_contacts": summary.three_body_contacts} if resolved else {}),
     }})
     writer.close()
     if bar is not None:

@@ -133,6 +133,7 @@ class RunGas(Gas):
     tc_time: float | None = None
     material: object = None
     source: str = "<config>"
+    duration: str = "instantaneous"
 
 
 def gas_from_config(config) -> RunGas:
@@ -148,7 +149,7 @@ def gas_from_config(config) -> RunGas:
         sigma=sigma, mass=mass, temperature=config.initial.temperature, model=c.model, restitution=c.restitution,
         prefactor=k, end=c.contact_end, end_time=config.run.end_time,
         collisions_per_particle=config.run.collisions_per_particle,
-        tc_time=c.tc_time, material=c.material, source=config.source,
+        tc_time=c.tc_time, material=c.material, source=config.source, duration=c.duration,
     )
 
 
@@ -283,7 +284,12 @@ def _check_driven(config, gas) -> RunValidity:
 def _warn_contact(rv: RunValidity, gas: RunGas, spread) -> None:
     """Warnings of contacts the event-driven model misstates: contact durations that are not
     short against the mean free time, and damping beyond the quasi-static force's range."""
-    if rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN:
+    if rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN and gas.duration == "resolved":
+        rv.warnings.append(
+            f"{gas.source}: contact duration / mean free time = {rv.tc_ratio:.3g} > {TC_RATIO_WARN:g}: of the order "
+            f"of {100 * (1 - math.exp(-2 * rv.tc_ratio)):.2g} % of collisions may meet a pair still in contact, "
+            "which the resolved two-body contacts do not describe (counted as three_body_contacts)")
+    elif rv.tc_ratio is not None and rv.tc_ratio > TC_RATIO_WARN:
         what = "tc_time" if gas.model == "constant" else "contact duration"
         rv.warnings.append(
             f"{gas.source}: {what} / mean free time = {rv.tc_ratio:.3g} > {TC_RATIO_WARN:g}: about "

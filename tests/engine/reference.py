@@ -14,8 +14,12 @@ import numpy as np
 from granulargas.contact.lookup import table_lookup
 
 
-def next_collision(pos, vel, radii, box, walls=()):
-    """(delay, i, j) of the next pair collision from the current state (inf, -1, -1 if none)."""
+def next_collision(pos, vel, radii, box, walls=(), excluded=None):
+    """(delay, i, j) of the next pair collision from the current state (inf, -1, -1 if none).
+
+    ``excluded``: an array over the pairs (i < j, ``np.triu_indices`` order) of the delay
+    before which a pair cannot collide (a contact under way of the resolved rule; 0: none);
+    such a pair's collision is that delay plus the root from its state then."""
     n, d = pos.shape
     best = (np.inf, -1, -1)
     periodic = np.array([a not in walls for a in range(d)], dtype=float)
@@ -26,6 +30,8 @@ def next_collision(pos, vel, radii, box, walls=()):
     dr0 = pos[iu] - pos[ju]
     dv = vel[iu] - vel[ju]
     sig = radii[iu] + radii[ju]
+    h = np.zeros(len(iu)) if excluded is None else excluded
+    dr0 = dr0 + dv * h[:, None]
     for s in shifts:
         dr = dr0 + s
         b = np.sum(dr * dv, axis=1)
@@ -36,6 +42,7 @@ def next_collision(pos, vel, radii, box, walls=()):
         with np.errstate(invalid="ignore", divide="ignore"):
             t = np.where(ok, (-b - np.sqrt(np.where(ok, disc, 0.0))) / np.where(ok, a, 1.0), np.inf)
         t = np.where(ok & (c <= 0), 0.0, t)  # overlapping and approaching: now
+        t = t + h
         k = int(np.argmin(t))
         if t[k] < best[0]:
             best = (float(t[k]), int(iu[k]), int(ju[k]))
@@ -97,15 +104,69 @@ def bounce(vel, i, axis, eps):
     return vn
 
 
-def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None):
+def collide_resolved(pos, vel, radii, masses, box, i, j, rule):
+    """Collision that takes time (rule: a resolved CollisionRule): the pair jumps onto its
+    outgoing line, from the oblique table's Python lookup and the frame algebra of
+    :func:`granulargas.contact.oblique.frame_outcome`, in place. Returns t_c."""
+    from granulargas.contact.oblique import frame_outcome
+
+    dr = pos[i] - pos[j]
+    dr -= box * np.round(dr / box)
+    dist = radii[i] + radii[j]
+    n0 = dr / np.linalg.norm(dr)
+    u = vel[i] - vel[j]
+    g_n = -float(u @ n0)
+    vt = u + g_n * n0
+    g_t = float(np.linalg.norm(vt))
+    e_t = vt / g_t if g_t > 0 else np.zeros_like(vt)
+    mi, mj = masses[i], masses[j]
+    m_eff = mi * mj / (mi + mj)
+    r_eff = radii[i] * radii[j] / dist
+    beta = rule.prefactor * (r_eff * g_n / m_eff**2) ** 0.2
+    delta = rule.compression * (m_eff**2 * g_n**4 / r_eff) ** 0.2 / dist
+    c = delta * (g_t / g_n) ** 2
+    eps_s, tau_s, turn = rule.oblique.lookup(beta, c, delta)
+    out = frame_outcome(eps_s, tau_s, turn, beta, c, delta, eps_s, g_n, g_t, dist)
+    v_out = out.velocity[0] * n0 + out.velocity[1] * e_t
+    a = (out.position[0] - out.velocity[0] * out.duration) * n0 + (out.position[1] - out.velocity[1] * out.duration) * e_t
+    pos[i] += mj / (mi + mj) * (a - dr)
+    pos[j] -= mi / (mi + mj) * (a - dr)
+    vel[i] += mj / (mi + mj) * (v_out - u)
+    vel[j] -= mi / (mi + mj) * (v_out - u)
+    return out.duration
+
+
+def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None, rule=None):
     """Event sequence [(time, i, j)] of the first ``ncoll`` events, global clock; a wall
-    collision of particle i with a wall of axis a appears as (time, i, -1 - a)."""
+    collision of particle i with a wall of axis a appears as (time, i, -1 - a).
+
+    ``rule``: a resolved CollisionRule (collisions that take time; no walls): a pair in
+    contact is not predicted until its contact ends."""
     pos = pos.copy()
     vel = vel.copy()
     wall_eps = eps if wall_eps is None else wall_eps
     t = 0.0
     out = []
+    n = len(pos)
+    until = np.full(n, -np.inf)
+    partner = np.full(n, -1)
+    iu, ju = np.triu_indices(n, 1)
     for _ in range(ncoll):
+        if rule is not None:
+            end = np.maximum(np.where(partner[iu] == ju, until[iu], -np.inf),
+                             np.where(partner[ju] == iu, until[ju], -np.inf))
+            excluded = np.maximum(end - t, 0.0)
+            dt, i, j = next_collision(pos, vel, radii, box, excluded=excluded)
+            pos += vel * dt
+            pos %= box
+            t += dt
+            tc = collide_resolved(pos, vel, radii, masses, box, i, j, rule)
+            pos %= box
+            until[i] = max(until[i], t + tc)
+            until[j] = max(until[j], t + tc)
+            partner[i], partner[j] = j, i
+            out.append((t, min(i, j), max(i, j)))
+            continue
         kind, dt, i, j = next_event(pos, vel, radii, box, walls)
         pos += vel * dt
         for a in range(len(box)):

@@ -1,0 +1,107 @@
+"""Runs with collisions that take time (`[collision] duration = "resolved"`): config checks,
+restart equality with contacts under way in the file, the three-body observable."""
+
+import numpy as np
+import pytest
+
+from granulargas.cli import main
+from granulargas.io.config import load_config
+from granulargas.io.h5md import load_snapshot, read_observables, read_parameters
+from granulargas.run.runner import run_config
+
+#: a soft rubber-like material: t_c / t_free ~ 0.1 at packing 0.1
+RESOLVED = """
+[system]
+dimension = 3
+particles = 200
+packing_fraction = 0.1
+seed = 3
+
+[collision]
+model = "viscoelastic"
+duration = "resolved"
+
+[collision.material]
+young_modulus = 1e6
+poisson_ratio = 0.3
+dissipation_time = 1e-5
+diameter = 0.01
+density = 1000
+speed_unit = 0.5
+
+[run]
+end_time = 4.0
+
+[output]
+file = "{out}"
+snapshot_interval = 1.0
+observables_interval = 0.5
+"""
+
+
+def test_restart_equals_uninterrupted_run(write_config, tmp_path):
+    """run to 2t == run to t + restart to 2t, with the contacts under way stored in the file."""
+    path = write_config(RESOLVED)
+    full = run_config(load_config(path))
+    half = run_config(load_config(path, {"run.end_time": 2.0, "output.file": str(tmp_path / "half.h5")}))
+    mid = load_snapshot(half.output)
+    assert mid.contact_until is not None and np.any(mid.contact_until > mid.time)  # a contact under way at t
+    rest = run_config(load_config(path, {"initial.from": str(half.output), "output.file": str(tmp_path / "rest.h5")}))
+    assert (rest.collisions, rest.events) == (full.collisions, full.events)
+    assert rest.three_body_contacts == full.three_body_contacts > 0
+    a, b = load_snapshot(full.output), load_snapshot(rest.output)
+    for name in ("positions", "velocities", "images", "contact_until", "contact_partner"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+    oa, ob = read_observables(full.output), read_observables(rest.output)
+    assert np.array_equal(oa["three_body_contacts"][2][-1:], ob["three_body_contacts"][2][-1:])
+    # energy balance with the resolved collisions' losses
+    ke, diss = oa["kinetic_energy"][2], oa["dissipated_energy"][2]
+    assert np.allclose(ke + diss, ke[0], rtol=1e-12)
+    par = read_parameters(full.output)
+    assert par["collision"]["duration"] == "resolved" and par["summary"]["three_body_contacts"] > 0
+    assert par["collision"]["compression"] > 0
+
+
+def test_append_continues_the_contacts(write_config, tmp_path):
+    path = write_config(RESOLVED)
+    full = run_config(load_config(path, {"output.file": str(tmp_path / "full.h5")}))
+    part = tmp_path / "part.h5"
+    run_config(load_config(path, {"run.end_time": 2.0, "output.file": str(part)}))
+    cont = run_config(load_config(path, {"initial.from": str(part), "output.file": str(part)}), append=True)
+    assert (cont.collisions, cont.events, cont.three_body_contacts) == (full.collisions, full.events,
+                                                                       full.three_body_contacts)
+    a, b = load_snapshot(full.output), load_snapshot(part)
+    assert np.array_equal(a.positions, b.positions) and np.array_equal(a.contact_until, b.contact_until)
+
+
+@pytest.mark.parametrize("change, message", [
+    ('young_modulus = 1e6', "needs the contact stiffness"),
+    ('model = "viscoelastic"', 'needs model = "viscoelastic"'),
+])
+def test_resolved_without_stiffness_is_refused(write_config, capsys, change, message):
+    text = RESOLVED
+    if "young" in change:  # damping instead of the material
+        text = text[:text.index("[collision.material]")] + "damping = 0.1\n\n" + text[text.index("[run]"):]
+    else:
+        text = text.replace(change, 'model = "constant"\nrestitution = 0.9')
+        text = text[:text.index("[collision.material]")] + text[text.index("[run]"):]
+    path = write_config(text)
+    assert main(["run", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0] and "collision.duration" in err[0]
+
+
+def test_resolved_with_walls_is_refused(write_config, capsys):
+    text = RESOLVED.replace("seed = 3", 'seed = 3\nboundary = ["periodic", "periodic", "wall"]')
+    assert main(["run", str(write_config(text))]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "periodic boundaries only" in err[0]
+
+
+def test_advise_keeps_a_resolved_config_on_edmd(write_config):
+    from granulargas.run.advise import advise
+
+    adv = advise(load_config(write_config(RESOLVED)))
+    text = "\n".join(adv.lines())
+    assert 'EDMD (run.method = "edmd"): collisions that take time need positions' in text
+    assert 'duration = "resolved"' in text and 'model = "constant"' not in text
