@@ -20,6 +20,8 @@ import math
 
 import numpy as np
 
+from granulargas.contact.material import pair_constant
+from granulargas.contact.oblique import pair_compression_constant
 from granulargas.engine import _loop, _state
 from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
@@ -564,11 +566,10 @@ class Simulation:
         period = self._space.period
         d = np.where(np.isfinite(period), d - period * np.round(d / np.where(np.isfinite(period), period, 1.0)), d)
         g_n = -float(np.dot(d, rec[i, 3:6] - rec[j, 3:6])) / float(np.linalg.norm(d))
-        r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
-        m_eff = m[i] * m[j] / (m[i] + m[j])
         rule = self.rule
-        beta = rule.prefactor * (r_eff * g_n / m_eff**2) ** 0.2
-        delta = rule.compression * (m_eff**2 * g_n**4 / r_eff) ** 0.2 / (rec[i, 7] + rec[j, 7])
+        ri, rj = float(rec[i, 7]), float(rec[j, 7])
+        beta = float(pair_constant(rule.prefactor, ri, rj, m[i], m[j])) * g_n**0.2
+        delta = float(pair_compression_constant(rule.compression, ri, rj, m[i], m[j])) * g_n**0.8 / (ri + rj)
         ids = [int(self._order[k]) for k in (i, j)]
         if not (beta < BETA_MAX and delta < DELTA_MAX):
             raise TableRangeError(
