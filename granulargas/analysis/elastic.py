@@ -35,7 +35,9 @@ from granulargas.analysis.run import (
     RunInfo,
     _clean,
     cooling_history,
+    history_span,
     pressure_samples,
+    run_identity,
     sonine_history,
     theory_name,
 )
@@ -151,18 +153,8 @@ class ElasticAnalysis:
         drift = self.energy_drift
         ts, a2, _ = self.sonine
         return _clean({
-            "file": info.path,
-            "kind": self.kind,
-            "model": info.model,
-            "dimension": info.dimension,
-            "particles": info.particles,
-            "packing_fraction": info.packing_fraction,
-            "monodisperse": info.monodisperse,
-            "t_start": float(h.time[0]),
-            "t_final": float(h.time[-1]),
-            "T_initial": float(h.temperature[0]),
-            "T_final": float(h.temperature[-1]),
-            "collisions_per_particle": float(h.collisions_per_particle[-1]),
+            **run_identity(info, self.kind),
+            **history_span(h),
             "theory": self.theory_name,
             "T_theory_final": float(h.temperature[0]),
             "T_ratio_final": float(h.temperature[-1] / h.temperature[0]),

@@ -453,20 +453,10 @@ class CoolingAnalysis:
         a2_mean, a2_err, _ = self.a2_late if self.sonine[0].size else (math.nan, math.nan, 0)
         T_th = self.temperature_theory
         return _clean({
-            "file": info.path,
-            "kind": self.kind,
-            "model": info.model,
-            "dimension": info.dimension,
-            "particles": info.particles,
-            "packing_fraction": info.packing_fraction,
-            "monodisperse": info.monodisperse,
+            **run_identity(info, self.kind),
             "restitution": info.restitution,
             "prefactor": info.prefactor,
-            "t_start": float(h.time[0]),
-            "t_final": float(h.time[-1]),
-            "T_initial": float(h.temperature[0]),
-            "T_final": float(h.temperature[-1]),
-            "collisions_per_particle": float(h.collisions_per_particle[-1]),
+            **history_span(h),
             "theory": self.theory_name,
             "T_theory_final": float(T_th[-1]),
             "T_ratio_final": self.T_ratio_final,
@@ -487,6 +477,19 @@ class CoolingAnalysis:
             "instability_length": p.instability_length,
             "box": float(info.box.max()),
         })
+
+
+def run_identity(info: RunInfo, kind: str) -> dict:
+    """The first keys of every ``analyze --json`` summary: the file and the gas it holds."""
+    return {"file": info.path, "kind": kind, "model": info.model, "dimension": info.dimension,
+            "particles": info.particles, "packing_fraction": info.packing_fraction,
+            "monodisperse": info.monodisperse}
+
+
+def history_span(h: CoolingHistory) -> dict:
+    """Start and end of a run's observables (times, temperatures, collisions per particle)."""
+    return {"t_start": float(h.time[0]), "t_final": float(h.time[-1]), "T_initial": float(h.temperature[0]),
+            "T_final": float(h.temperature[-1]), "collisions_per_particle": float(h.collisions_per_particle[-1])}
 
 
 def _clean(d: dict) -> dict:
