@@ -19,6 +19,7 @@ Usage::
     python scripts/profile_loop.py 1e4 1e6          # N values, packing 0.3, 3D, elastic
     python scripts/profile_loop.py 1e5 --packing 0.1
     python scripts/profile_loop.py 1e4 --walls      # walls on the z axis
+    python scripts/profile_loop.py 1e4 --packing 0.05 --neighbours cells
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ import argparse
 import time
 
 
-def profile(n, packing, walls=False, seed=1):
+def profile(n, packing, walls=False, seed=1, neighbours="lists"):
     import numpy as np
 
     from granulargas.engine import CollisionRule, Simulation, _loop, _probe
@@ -40,7 +41,7 @@ def profile(n, packing, walls=False, seed=1):
         boundary = ("periodic", "periodic", "wall")
         r = kw["radii"]
         kw["positions"][:, 2] = np.clip(kw["positions"][:, 2], r, kw["box"][2] - r)
-    sim = Simulation(**kw, rule=CollisionRule.elastic(), boundary=boundary)
+    sim = Simulation(**kw, rule=CollisionRule.elastic(), boundary=boundary, neighbours=neighbours)
     sim.run(np.inf, max_collisions=2 * n)
     prm = sim._params()
     probe = np.zeros(_probe.PROBE_SIZE, np.int64)
@@ -59,7 +60,7 @@ def profile(n, packing, walls=False, seed=1):
     dt, nc = go(max(300_000, n))
     parts = _probe.PARTS
     total = probe[:parts].sum()
-    print(f"N = {n}, packing {packing}{', walls on z' if walls else ''}: {nc / dt / 1e6:.3f} M "
+    print(f"N = {n}, packing {packing}{', walls on z' if walls else ''}, {sim.neighbours}: {nc / dt / 1e6:.3f} M "
           f"collisions/s instrumented, {total / nc:.0f} cycles per collision ({dt / nc * 1e9:.0f} ns); "
           f"compile or cache load {compile_s:.1f} s")
     for k, name in enumerate(_probe.PART_NAMES):
@@ -77,11 +78,13 @@ def main(argv=None):
     p.add_argument("sizes", type=float, nargs="+", help="numbers of spheres")
     p.add_argument("--packing", type=float, default=0.3)
     p.add_argument("--walls", action="store_true", help="flat walls at z = 0 and L")
+    p.add_argument("--neighbours", choices=["lists", "cells"], default="lists",
+                   help="neighbour search (cells: the 'list rebuild' part is the cell crossing)")
     args = p.parse_args(argv)
     if any(n < 100 for n in args.sizes) or not 0.0 < args.packing <= 0.5:
         p.error("sizes must be >= 100 and 0 < --packing <= 0.5")
     for n in args.sizes:
-        profile(int(n), args.packing, args.walls)
+        profile(int(n), args.packing, args.walls, neighbours=args.neighbours)
 
 
 if __name__ == "__main__":

@@ -24,10 +24,19 @@ PAIR       >= 0  :func:`predict_pair`     :func:`execute_pair`
 EXPIRY     -1    :func:`predict_expiry`   :func:`execute_expiry`
 WALL       -2    :func:`predict_wall`     :func:`execute_wall`
 KICK       -3    :func:`predict_kick`     :func:`execute_kick`
+CROSS      -5    :func:`predict_crossing` :func:`execute_crossing`
 =========  ====  =======================  ==========================
 
 (STALE, -4, is what validation makes of a pair event whose partner changed
 course.) :func:`predict` keeps the earliest of a particle's own kinds.
+
+Two neighbour modes share the loop: neighbour lists (EXPIRY events, the
+records ``Lists`` and ``Cells``) or cell crossings (CROSS events, no lists:
+:mod:`granulargas.engine._crossing`; ``engine.lists`` is then a ``Grid`` and
+``engine.cells`` None). The functions that differ between them
+(:func:`predict_bound`, :func:`predict_neighbours`, :func:`execute_bound`,
+:func:`prefetch_next`, ...) are numba overloads selected by the type of
+``lists``, so each mode's build of the loop carries none of the other's code.
 
 Particles stream lazily: each carries its own clock and is moved to the
 current time only when it takes part in an event. The data a prediction reads
@@ -81,10 +90,18 @@ from granulargas.engine._calendar import (
 )
 from granulargas.engine._cells import prefetch_cells, rebuild_list
 from granulargas.engine._collide import pair_collision, restitution, wall_collision
+from granulargas.engine._crossing import (
+    cross,
+    predict_crossing,
+    predict_pair_cells,
+    prefetch_around,
+    scan_new_layer,
+)
 from granulargas.engine._drive import kick_velocities
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image, wall_delay
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._resolved import resolved_pair
+from granulargas.engine._state import Grid
 from granulargas.engine._probe import (
     COLLIDE,
     PEEK,
@@ -115,6 +132,7 @@ EXPIRY = -1
 WALL = -2
 KICK = -3
 STALE = -4
+CROSS = -5
 
 
 @kernel(inline="always")
@@ -224,7 +242,7 @@ def in_contact(contacts, i, t):
     without any of the resolved rule's code)."""
 
 
-def predict_pair_contact(i, t, before, rec, nbl, nbn, period, contacts):
+def predict_pair_contact(i, t, before, rec, lists, period, contacts):
     """:func:`predict_pair_except` (``contacts`` None: never called, returns (before, -1))."""
 
 
@@ -240,11 +258,11 @@ def _in_contact(contacts, i, t):
 
 
 @overload(predict_pair_contact)
-def _predict_pair_contact(i, t, before, rec, nbl, nbn, period, contacts):
+def _predict_pair_contact(i, t, before, rec, lists, period, contacts):
     if isinstance(contacts, types.NoneType):
-        return lambda i, t, before, rec, nbl, nbn, period, contacts: (before, np.int64(-1))
-    return lambda i, t, before, rec, nbl, nbn, period, contacts: predict_pair_except(
-        i, t, before, rec, nbl, nbn, period, contacts)
+        return lambda i, t, before, rec, lists, period, contacts: (before, np.int64(-1))
+    return lambda i, t, before, rec, lists, period, contacts: predict_pair_except(
+        i, t, before, rec, lists.nbl, lists.nbn, period, contacts)
 
 
 @overload(collide_resolved)
@@ -279,6 +297,78 @@ def predict_kick(c, prm):
     return (c.kick_step + 0.5) * prm.kick_interval if prm.kick_interval < math.inf else math.inf
 
 
+def _is_grid(lists):
+    return getattr(lists, "instance_class", None) is Grid
+
+
+def predict_bound(i, t, rec, lists, space, half_shell):
+    """The event that ends particle i's neighbourhood: (time, kind, tag) -- its list
+    expiry (EXPIRY, 0) or its cell crossing (CROSS, face)."""
+
+
+def predict_neighbours(i, t, before, rec, count, lists, space):
+    """:func:`predict_pair` over i's neighbour list or :func:`predict_pair_cells` over
+    the particles of its neighbour cells."""
+
+
+def bound_kind(lists):
+    """EXPIRY (lists) or CROSS (cells): the kind code of :func:`predict_bound`'s event."""
+
+
+def execute_bound(i, tag, te, p, lists, cells, c, prm):
+    """:func:`execute_expiry` or :func:`execute_crossing`."""
+
+
+def prefetch_partner_neighbours(j, rec, lists):
+    """Prefetch hints for the records :func:`predict` (j) reads (lists: j's neighbours)."""
+
+
+@overload(predict_bound)
+def _predict_bound(i, t, rec, lists, space, half_shell):
+    if _is_grid(lists):
+        def impl(i, t, rec, lists, space, half_shell):
+            tc, face = predict_crossing(i, t, rec, lists, space)
+            return tc, CROSS, face
+        return impl
+    return lambda i, t, rec, lists, space, half_shell: (
+        predict_expiry(i, t, rec, lists.centre, space.period, half_shell), EXPIRY, 0)
+
+
+@overload(predict_neighbours)
+def _predict_neighbours(i, t, before, rec, count, lists, space):
+    if _is_grid(lists):
+        return lambda i, t, before, rec, count, lists, space: predict_pair_cells(i, t, before, rec, count,
+                                                                                 lists, space)
+    return lambda i, t, before, rec, count, lists, space: predict_pair(i, t, before, rec, lists.nbl,
+                                                                       lists.nbn, space.period)
+
+
+@overload(bound_kind)
+def _bound_kind(lists):
+    if _is_grid(lists):
+        return lambda lists: CROSS
+    return lambda lists: EXPIRY
+
+
+@overload(execute_bound)
+def _execute_bound(i, tag, te, p, lists, cells, c, prm):
+    if _is_grid(lists):
+        return lambda i, tag, te, p, lists, cells, c, prm: execute_crossing(i, tag, te, p, lists, c, prm)
+    return lambda i, tag, te, p, lists, cells, c, prm: execute_expiry(i, te, p, lists, cells, c, prm)
+
+
+@overload(prefetch_partner_neighbours)
+def _prefetch_partner_neighbours(j, rec, lists):
+    if _is_grid(lists):
+        return lambda j, rec, lists: None
+
+    def impl(j, rec, lists):
+        nbl = lists.nbl
+        for k in range(lists.nbn[j]):
+            prefetch(rec, nbl[j, k])
+    return impl
+
+
 @kernel
 def predict(i, t, rec, count, events, lists, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
@@ -286,12 +376,15 @@ def predict(i, t, rec, count, events, lists, space, half_shell, contacts):
     ``contacts`` (resolved rule; None otherwise): while i's contact is under way
     (t < ``contacts.until[i]``; the end of a contact of i with j is never before j's)
     its contact partners are left out (:func:`predict_pair_except`)."""
-    best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
+    best, kind, tag = predict_bound(i, t, rec, lists, space, half_shell)
     if in_contact(contacts, i, t):
-        best, p = predict_pair_contact(i, t, best, rec, lists.nbl, lists.nbn, space.period, contacts)
+        best, p = predict_pair_contact(i, t, best, rec, lists, space.period, contacts)
     else:
-        best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
-    tag = count[p] if p >= 0 else 0
+        best, p = predict_neighbours(i, t, best, rec, count, lists, space)
+    if p >= 0:
+        tag = count[p]
+    else:
+        p = kind
     tw, wall = predict_wall(i, t, rec, space)
     if tw < best:
         best = tw
@@ -331,9 +424,7 @@ def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
     rec = p.rec
     period = prm.space.period
     rule = prm.rule
-    nbl = lists.nbl
-    for k in range(lists.nbn[j]):  # j's list row is in cache: start the misses of predict(j)
-        prefetch(rec, nbl[j, k])
+    prefetch_partner_neighbours(j, rec, lists)  # j's list row is in cache: start predict(j)'s misses
     stream(i, te, rec, p.img, period)
     stream(j, te, rec, p.img, period)
     dx = min_image(rec[i, 0] - rec[j, 0], period[0])
@@ -412,6 +503,19 @@ def execute_expiry(i, te, p, lists, cells, c, prm):
 
 
 @kernel(inline="always")
+def execute_crossing(i, face, te, p, grid, c, prm):
+    """Cell crossing of i at te through face ``face`` (2 a + side): into the next cell
+    (:func:`granulargas.engine._crossing.cross`) and its best pair updated with the
+    layer of cells that became adjacent (:func:`~granulargas.engine._crossing.scan_new_layer`);
+    the loop's prediction of i then uses it."""
+    stream(i, te, p.rec, p.img, prm.space.period)
+    cross(i, face, grid, prm.space)
+    scan_new_layer(i, te, face, p.rec, p.count, grid, prm.space)
+    c.crossings += 1
+    return DONE
+
+
+@kernel(inline="always")
 def execute_wall(i, wall, te, p, c, walls, prm):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
     m_eff = m_i. Returns DONE or TABLE_RANGE."""
@@ -486,8 +590,56 @@ def _prefetch_particle(i, p, ev, lists, cal):
     prefetch(cal.where, i)
 
 
-@kernel(inline="always")
 def prefetch_next(i1, p, ev, lists, cells, cal, prm):
+    """Prefetch hints for the next event, particle i1 (no effect on results): :func:`prefetch_next_lists`
+    or :func:`prefetch_next_cells`. Returns the guessed particle of the event after next."""
+
+
+@overload(prefetch_next)
+def _prefetch_next(i1, p, ev, lists, cells, cal, prm):
+    if _is_grid(lists):
+        return lambda i1, p, ev, lists, cells, cal, prm: prefetch_next_cells(i1, p, ev, lists, cal, prm)
+    return lambda i1, p, ev, lists, cells, cal, prm: prefetch_next_lists(i1, p, ev, lists, cells, cal, prm)
+
+
+@kernel(inline="always")
+def prefetch_next_cells(i1, p, ev, grid, cal, prm):
+    """Prefetch hints for the next event of the cell-crossing mode: the rows of particle
+    i1, its partner and the cell heads around them, and the rows of the likely event
+    after it. Returns that event's guessed particle (-1: none)."""
+    rec = p.rec
+    p1 = ev.partner[i1]
+    prefetch(grid.cell, i1)
+    prefetch(grid.next, i1)
+    prefetch(grid.prev, i1)
+    prefetch_around(i1, grid, prm.space)
+    if p1 >= 0:
+        prefetch(rec, p1)
+        prefetch(grid.cell, p1)
+        prefetch(p.mass, p1)
+        prefetch(p.count, p1)
+        prefetch(p.lastcoll, p1)
+        prefetch(p.rapid, p1)
+        prefetch(ev.partner, p1)
+        prefetch(ev.tag, p1)
+        prefetch(cal.qt, p1)
+        prefetch(cal.where, p1)
+        prefetch(p.mass, i1)
+        prefetch(p.lastcoll, i1)
+        prefetch(p.rapid, i1)
+        prefetch(p.count, i1)
+    prefetch(cal.where, i1)
+    i2 = cal_after_next(cal, p1)
+    if i2 >= 0:
+        prefetch(rec, i2)
+        prefetch(grid.cell, i2)
+        prefetch(ev.partner, i2)
+        prefetch(ev.tag, i2)
+    return i2
+
+
+@kernel(inline="always")
+def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
     """Prefetch hints for the next event, particle i1 (no effect on results).
 
     The rows of its partner, the records of its neighbours, for a list expiry the
@@ -613,8 +765,8 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
-        elif j == EXPIRY:
-            status = execute_expiry(i, te, p, lists, cells, c, prm)
+        elif j == bound_kind(lists):
+            status = execute_bound(i, ev.tag[i], te, p, lists, cells, c, prm)
             clock = tick(probe, REBUILD, clock)
             if status != DONE:
                 break
@@ -694,7 +846,8 @@ def synchronised(rec, img, period, t, out_r, out_img):
     """Positions and images of all particles streamed to time t (no side effect).
 
     Positions land in [0, L) on periodic axes: one wrap suffices because no
-    particle is more than shell/2 from its list centre, which lies in the box.
+    particle is more than shell/2 from its list centre, which lies in the box
+    (cell-crossing mode: no particle is beyond its cell by more than round-off).
     Wall axes (period inf) are not wrapped.
     """
     for i in range(rec.shape[0]):

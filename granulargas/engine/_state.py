@@ -34,6 +34,18 @@ Record layout
   ``mark`` (N,) u1 (all zero between list rebuilds).
 * ``cells`` :class:`Cells` -- ``ids`` (C, K) i4 slots of each cell, ``n`` i4 fill,
   ``of`` (N,) i4 cell of each list centre.
+* In the cell-crossing mode (:mod:`granulargas.engine._crossing`) ``lists`` is a
+  :class:`Grid` instead and ``cells`` is None: ``head`` (C,) i4 the first
+  particle of each cell (-1: empty), ``next``, ``prev`` (N,) i4 the doubly
+  linked list of each cell, ``cell`` (N, 4) i4 the cell coordinates of each
+  particle and the flat cell index, ``width`` (3,) f8 the cell side per axis;
+  ``pair_t`` f8, ``pair_j``, ``pair_tag`` i4 each particle's best pair
+  prediction (time, partner, partner's count then; partner -1: none) and
+  ``fresh`` (1,) i8 the slot whose stored pair a crossing has just brought up
+  to date (-1: none).
+  The loop is compiled for one of the two record types
+  (:func:`granulargas.engine._loop.predict`: type-dispatched overloads), so
+  each mode's build carries none of the other's code.
 * ``calendar`` :class:`Calendar` -- see :mod:`granulargas.engine._calendar`.
 * ``counters`` (1,) :data:`COUNTERS` record.
 * ``walls`` :class:`Walls` -- ``impulse`` (3, 2) f8: normal momentum delivered to
@@ -57,6 +69,8 @@ Particles = namedtuple("Particles", ["rec", "img", "mass", "count", "lastcoll", 
 Events = namedtuple("Events", ["partner", "tag"])
 Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil", "mark"])
 Cells = namedtuple("Cells", ["ids", "n", "of"])
+Grid = namedtuple("Grid", ["head", "next", "prev", "cell", "width", "pair_t", "pair_j", "pair_tag",
+                           "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
@@ -92,11 +106,12 @@ Params = namedtuple("Params", ["rule", "space", "shell", "half_shell", "rmax", "
 #: ``injected`` energy put in by the driving (cumulative); event counts; ``kick_step``
 #: index k of the next driving step (at time (k + 1/2) kick_interval); ``three_body``
 #: collisions of a particle still in contact with another partner (resolved rule);
+#: ``crossings`` cell crossings (cell-crossing mode);
 #: ``err_i``, ``err_j`` the slots involved in an error.
 COUNTERS = np.dtype([
     ("time", "f8"), ("dissipated", "f8"), ("virial", "f8"), ("kin_int", "f8"),
     ("sum_mv2", "f8"), ("injected", "f8"),
-    ("collisions", "i8"), ("events", "i8"), ("expiries", "i8"), ("stale", "i8"),
+    ("collisions", "i8"), ("events", "i8"), ("expiries", "i8"), ("crossings", "i8"), ("stale", "i8"),
     ("wall_collisions", "i8"), ("kicks", "i8"), ("kick_step", "i8"), ("three_body", "i8"),
     ("err_i", "i8"), ("err_j", "i8"),
 ], align=True)

@@ -26,6 +26,7 @@ from granulargas.engine import _loop, _state
 from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
+from granulargas.engine._crossing import MARGIN, build_grid
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
@@ -39,6 +40,13 @@ from granulargas.errors import (
 _INT_MAX = np.iinfo(np.int64).max
 #: boundary conditions of an axis
 BOUNDARIES = ("periodic", "wall")
+#: neighbour search: neighbour lists with a shell, cell crossings (no lists), or the
+#: faster of the two for the packing fraction (:func:`neighbour_mode`)
+NEIGHBOURS = ("lists", "cells", "auto")
+#: "auto" uses cell crossings below this packing fraction (3D and 2D)
+CELLS_BELOW = {3: 0.0, 2: 0.0}
+#: cell-crossing mode: at most this many cells per particle (wider cells in very dilute gases)
+CELLS_PER_PARTICLE = 8
 
 #: Smallest box side in largest diameters: 3 cells per side (so that the 27
 #: neighbour cells are distinct), each one diameter wide plus a neighbour-list
@@ -64,6 +72,29 @@ def default_shell(packing: float, dimension: int = 3) -> float:
     if packing < 0.4:
         return 0.7
     return 0.45
+
+
+def neighbour_mode(neighbours: str, packing: float, dimension: int = 3) -> str:
+    """The neighbour search a run uses: "lists" or "cells" ("auto": cells below
+    :data:`CELLS_BELOW` of the dimension, where they were measured faster,
+    ``scripts/bench_cells.py``)."""
+    if neighbours not in NEIGHBOURS:
+        raise ConfigError(f"neighbours = {neighbours!r}: must be one of {', '.join(NEIGHBOURS)}")
+    if neighbours == "auto":
+        return "cells" if packing < CELLS_BELOW[dimension] else "lists"
+    return neighbours
+
+
+def crossing_grid(box, dmax: float, n: int, extra: float = 0.0) -> np.ndarray:
+    """Cells per axis (d,) of the cell-crossing mode: sides at least (1 + extra) dmax
+    (times 1 + MARGIN), at least 3 per axis, at most ``CELLS_PER_PARTICLE`` n cells."""
+    bx = np.asarray(box, dtype=np.float64)
+    width = dmax * (1.0 + extra) * (1.0 + MARGIN)
+    while True:
+        ncell = np.maximum(3, np.floor(bx / width).astype(np.int64))
+        if np.prod(ncell) <= CELLS_PER_PARTICLE * n or np.all(ncell == 3):
+            return ncell
+        width *= 1.05
 
 
 def _part1by2(x):
@@ -151,6 +182,14 @@ class Simulation:
         Remove the centre-of-mass velocity that round-off accumulates on the
         periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
         e.g. a mean flow given on purpose.
+    neighbours : {"lists", "cells", "auto"}
+        Neighbour search: neighbour lists with a shell (list expiries as events),
+        cell crossings (no lists; each particle is predicted against the
+        particles of its own and the neighbouring cells, and a cell crossing is
+        an event; :mod:`granulargas.engine._crossing`), or "auto" (cells below
+        :data:`CELLS_BELOW`, lists otherwise). The two modes process different
+        events, so their event sequences agree only up to round-off. Cell
+        crossings do not take collisions that take time (ConfigError).
     contact_until : array (N,), optional
         Resolved rule (collisions that take time): the time at which each
         particle's contact under way ends (-inf: none); carried over on restart.
@@ -181,7 +220,7 @@ class Simulation:
                  collapse_count: int = 100, boundary=None, wall_collisions: int = 0,
                  driving: WhiteNoise | None = None, kick_step: int | None = None,
                  injected_energy: float = 0.0, remove_drift: bool = True, contact_until=None,
-                 contact_partner=None, three_body_contacts: int = 0):
+                 contact_partner=None, three_body_contacts: int = 0, neighbours: str = "lists"):
         pos = np.array(positions, dtype=np.float64, order="C", copy=True)
         if pos.ndim != 2 or pos.shape[1] not in (2, 3):
             raise ConfigError(f"positions: shape {pos.shape}, expected (N, 2) or (N, 3)")
@@ -281,8 +320,18 @@ class Simulation:
         unit = math.pi / 6.0 * 8.0 if d == 3 else math.pi
         self.packing_fraction = float(unit * np.sum(rad**d) / volume)
         dmax = 2.0 * float(rad.max())
-        want = default_shell(self.packing_fraction, d) if shell is None else float(shell)
-        if want <= 0:
+        #: the neighbour search in use, "lists" or "cells"
+        self.neighbours = neighbour_mode(neighbours, self.packing_fraction, d)
+        if self.neighbours == "cells" and rule.resolved:
+            raise ConfigError('neighbours = "cells": collisions that take time (duration = "resolved") '
+                             'need neighbour lists; use neighbours = "lists"')
+        if self.neighbours == "cells":
+            want = 0.0 if shell is None else float(shell)
+            if want < 0:
+                raise ConfigError(f"shell = {want}: must be >= 0")
+        else:
+            want = default_shell(self.packing_fraction, d) if shell is None else float(shell)
+        if want <= 0 and self.neighbours == "lists":
             raise ConfigError(f"shell = {want}: must be > 0")
         # at least 3 cells per side so that the 27 neighbour cells are distinct
         fit = float(bx.min()) / 3.0 - dmax
@@ -299,7 +348,12 @@ class Simulation:
         period3 = box3.copy()
         period3[:d][wall] = np.inf
         ncell = np.ones(3, dtype=np.int64)
-        ncell[:d] = np.floor(bx / cut).astype(np.int64)
+        if self.neighbours == "cells":
+            # the shell is the cells' width beyond the largest diameter
+            ncell[:d] = crossing_grid(bx, dmax, n, want)
+            self.shell = float(np.min(bx / ncell[:d])) - dmax
+        else:
+            ncell[:d] = np.floor(bx / cut).astype(np.int64)
         self._space = _state.space(box3, period3, ncell, np.flatnonzero(wall), d)
         self._built = False
         self._engine = None
@@ -338,6 +392,15 @@ class Simulation:
         events = _state.Events(partner=np.full(n, -1, dtype=np.int32),
                                tag=np.zeros(n, dtype=np.int32))
         ncells = int(np.prod(spc.ncell))
+        if self.neighbours == "cells":
+            lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), next=np.empty(n, dtype=np.int32),
+                                prev=np.empty(n, dtype=np.int32), cell=np.zeros((n, 4), dtype=np.int32),
+                                width=spc.box / spc.ncell, pair_t=np.full(n, np.inf),
+                                pair_j=np.full(n, -1, dtype=np.int32), pair_tag=np.zeros(n, dtype=np.int32),
+                                fresh=np.full(1, -1, dtype=np.int64))
+            build_grid(rec, lists, spc)
+            self._finish_build(particles, events, lists, None, order)
+            return
         centre = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
         pos = np.ascontiguousarray(rec[:, :3])
         stencil = np.empty(27, dtype=np.int64)
@@ -362,6 +425,13 @@ class Simulation:
             nbl = np.ascontiguousarray(nbl[:, :width])
             self._nb_width = width
         lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
+        self._finish_build(particles, events, lists, cells, order)
+
+    def _finish_build(self, particles, events, lists, cells, order):
+        """Contacts, every particle's event, counters and the calendar (after the neighbour search)."""
+        n = self.n
+        spc = self._space
+        rec = particles.rec
         calendar = allocate_calendar(n)
         slot = np.empty(n, dtype=np.int64)
         slot[order] = np.arange(n)

@@ -1,0 +1,277 @@
+"""Cell-crossing neighbour search: no lists, each particle in the cell of its position (numba leaf module).
+
+The alternative to neighbour lists for dilute gases (the "Cell" variant of
+Smallenburg's event-driven code; Smallenburg, Eur. Phys. J. E 45, 22 (2022),
+and the textbook cell method of Rapaport, "The Art of Molecular Dynamics
+Simulation", ch. 14). The box is cut into a grid of cells at least as wide as
+the largest contact distance 2 R_max; every particle belongs to the cell its
+position is in (:class:`~granulargas.engine._state.Grid`: a doubly linked list
+per cell). Two particles in cells that are not neighbours (27 around a cell,
+9 in 2D) are more than 2 R_max apart and cannot touch. A particle's events are:
+
+* a pair collision with a particle of its own or a neighbouring cell;
+* a cell crossing: the moment its position reaches a face of its cell
+  (``face`` = 2 a + side, as the wall index; on a wall axis the faces at the
+  walls are never crossed). Executing it moves the particle to the next cell
+  (periodic on periodic axes); its next prediction then covers the particles
+  of the new neighbourhood.
+
+Each particle keeps one event (:mod:`granulargas.engine._loop`), the earlier
+of its crossing and its best pair; the best pair itself is kept apart
+(``Grid.pair_t``, ``pair_j``, ``pair_tag``: time, partner, partner's collision
+count then), whether it comes before the crossing or not. A full prediction
+(after a collision, a stale event, at a build or a driving step) scans the
+particles of all 27 (2D: 9) cells around the particle. A crossing scans only
+the layer of 9 (2D: 3) cells that became adjacent, and keeps the better of
+those and the stored pair -- as the C code adds only the new cells' collisions
+to its event tree; if the stored partner has collided since, the particle
+scans all its cells instead (a stale best pair may have hidden the next
+best). Why it is complete: let i, k touch at t* on their present lines, and
+look at the last prediction of either before t* (say of i, at t1). Neither
+crosses a face in (t1, t*), so at t1 both are in the cells they touch from,
+which are neighbours. A full prediction at t1 sees k. A crossing at t1 sees
+k if k's cell is in the new layer; otherwise k's cell was adjacent to i's
+previous cell as well, and the same holds one prediction earlier -- back to
+a full prediction, which every velocity change of i or k is. On the way, each
+prediction that saw the pair computed t* (no velocity changed since), and the
+kept minimum is at most t*.
+
+A particle may sit a round-off distance outside its cell (the faces are
+multiples of the cell width L / n); :func:`crossing_delay` measures the
+position from the cell's lower face by the nearest image and returns 0 for a
+particle moving out through a face it is already beyond, and cells are wider
+than 2 R_max by a relative margin of :data:`MARGIN` that covers it.
+"""
+
+import math
+
+from granulargas._numba import kernel
+from granulargas.engine._geometry import collision_delay, min_image
+from granulargas.engine._prefetch import prefetch
+
+#: cells are at least (1 + MARGIN) times the largest contact distance wide
+MARGIN = 1e-6
+
+
+@kernel(inline="always")
+def face_delay(x, v, c, width, n, period):
+    """Time until coordinate x (in cell c of width ``width``, n cells) moving at v reaches a face.
+
+    Returns (delay, side): side 0 the lower face, 1 the upper; inf on a wall
+    axis (period inf) at the face that is a wall, and for v = 0.
+    """
+    rel = min_image(x - c * width, period)  # position from the lower face, [-round-off, width + ...]
+    if v > 0.0:
+        if c == n - 1 and period == math.inf:
+            return math.inf, 1
+        gap = width - rel
+        return (gap / v if gap > 0.0 else 0.0), 1
+    if v < 0.0:
+        if c == 0 and period == math.inf:
+            return math.inf, 0
+        return (rel / -v if rel > 0.0 else 0.0), 0
+    return math.inf, 0
+
+
+@kernel(inline="always")
+def predict_crossing(i, t, rec, grid, space):
+    """Earliest cell crossing of particle i (streamed to t): (time, face 2 a + side)."""
+    best = math.inf
+    face = 0
+    cell = grid.cell
+    for a in range(space.dims):
+        s, side = face_delay(rec[i, a], rec[i, 3 + a], cell[i, a], grid.width[a], space.ncell[a],
+                             space.period[a])
+        if s < best:
+            best = s
+            face = 2 * a + side
+    return t + best, face
+
+
+@kernel(inline="always")
+def _neighbour(c, o, n, period):
+    """Cell coordinate c + o, wrapped on a periodic axis; -1 beyond a wall."""
+    k = c + o
+    if k < 0:
+        return k + n if period < math.inf else -1
+    if k >= n:
+        return k - n if period < math.inf else -1
+    return k
+
+
+@kernel(inline="always")
+def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
+    """Earliest collision of particle i (streamed to t) with the particles of the cells at
+    offsets [x0, x1] x [y0, y1] x [z0, z1] from its cell, before ``before``: (time,
+    partner slot) or (``before``, -1).
+
+    i itself may be among the candidates and gives inf (no relative motion). The
+    cells beyond a wall do not exist; with 3 cells on a periodic axis a cell may
+    be visited twice (harmless).
+    """
+    head = grid.head
+    nxt = grid.next
+    ncell = space.ncell
+    period = space.period
+    cx = grid.cell[i, 0]
+    cy = grid.cell[i, 1]
+    cz = grid.cell[i, 2]
+    xi = rec[i, 0]
+    yi = rec[i, 1]
+    zi = rec[i, 2]
+    vx = rec[i, 3]
+    vy = rec[i, 4]
+    vz = rec[i, 5]
+    ri = rec[i, 7]
+    best = before
+    p = -1
+    for oz in range(z0, z1 + 1):
+        kz = _neighbour(cz, oz, ncell[2], period[2])
+        if kz < 0:
+            continue
+        for oy in range(y0, y1 + 1):
+            ky = _neighbour(cy, oy, ncell[1], period[1])
+            if ky < 0:
+                continue
+            row = ncell[0] * (ky + ncell[1] * kz)
+            for ox in range(x0, x1 + 1):
+                kx = _neighbour(cx, ox, ncell[0], period[0])
+                if kx < 0:
+                    continue
+                j = head[kx + row]
+                while j >= 0:
+                    dtj = t - rec[j, 6]
+                    s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), period[0]),
+                                        min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), period[1]),
+                                        min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), period[2]),
+                                        vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
+                    tc = t + s
+                    better = tc < best
+                    best = tc if better else best
+                    p = j if better else p
+                    j = nxt[j]
+    return best, p
+
+
+@kernel(inline="always")
+def predict_pair_cells(i, t, before, rec, count, grid, space):
+    """Earliest collision of particle i (streamed to t) before ``before``: (time, partner
+    slot) or (``before``, -1).
+
+    Right after a crossing of i (``grid.fresh[0] == i``) the stored best pair is
+    current; otherwise all 27 (2D: 9) cells around i are scanned and the best
+    pair stored, whether before ``before`` or not.
+    """
+    if grid.fresh[0] == i:
+        grid.fresh[0] = -1
+        pt = grid.pair_t[i]
+        pj = grid.pair_j[i]
+    else:
+        zr = 1 if space.ncell[2] >= 3 else 0
+        pt, pj = scan_cells(i, t, math.inf, rec, grid, space, -1, 1, -1, 1, -zr, zr)
+        grid.pair_t[i] = pt
+        grid.pair_j[i] = pj
+        grid.pair_tag[i] = count[pj] if pj >= 0 else 0
+    if pt < before:
+        return pt, pj
+    return before, -1
+
+
+@kernel(inline="always")
+def scan_new_layer(i, t, face, rec, count, grid, space):
+    """After i crossed ``face`` into its present cell: keep the better of the stored pair
+    and the particles of the layer of cells that became adjacent, and mark the stored
+    pair current (``grid.fresh``); if the stored partner has collided since, do
+    nothing (the prediction then scans all cells)."""
+    pj = grid.pair_j[i]
+    if pj >= 0 and count[pj] != grid.pair_tag[i]:
+        return
+    a = face >> 1
+    o = 1 if face & 1 else -1
+    zr = 1 if space.ncell[2] >= 3 else 0
+    x0 = o if a == 0 else -1
+    x1 = o if a == 0 else 1
+    y0 = o if a == 1 else -1
+    y1 = o if a == 1 else 1
+    z0 = o if a == 2 else -zr
+    z1 = o if a == 2 else zr
+    pt, pn = scan_cells(i, t, grid.pair_t[i], rec, grid, space, x0, x1, y0, y1, z0, z1)
+    if pn >= 0:
+        grid.pair_t[i] = pt
+        grid.pair_j[i] = pn
+        grid.pair_tag[i] = count[pn]
+    grid.fresh[0] = i
+
+
+@kernel(inline="always")
+def grid_insert(i, c, grid):
+    """Put particle i at the head of cell c's list."""
+    head = grid.head
+    h = head[c]
+    grid.next[i] = h
+    grid.prev[i] = -1
+    if h >= 0:
+        grid.prev[h] = i
+    head[c] = i
+    grid.cell[i, 3] = c
+
+
+@kernel(inline="always")
+def grid_remove(i, grid):
+    """Take particle i out of its cell's list."""
+    q = grid.prev[i]
+    n = grid.next[i]
+    if q >= 0:
+        grid.next[q] = n
+    else:
+        grid.head[grid.cell[i, 3]] = n
+    if n >= 0:
+        grid.prev[n] = q
+
+
+@kernel(inline="always")
+def cross(i, face, grid, space):
+    """Move particle i (at the face ``face`` of its cell) into the cell beyond that face."""
+    a = face >> 1
+    n = space.ncell[a]
+    c = grid.cell[i, a] + (1 if face & 1 else -1)
+    if c < 0:
+        c += n
+    elif c >= n:
+        c -= n
+    grid_remove(i, grid)
+    grid.cell[i, a] = c
+    ncell = space.ncell
+    grid_insert(i, grid.cell[i, 0] + ncell[0] * (grid.cell[i, 1] + ncell[1] * grid.cell[i, 2]), grid)
+
+
+@kernel
+def build_grid(rec, grid, space):
+    """Every particle into the cell of its position (slot order: a pure function of the state)."""
+    box = space.box
+    ncell = space.ncell
+    grid.head[:] = -1
+    for i in range(rec.shape[0] - 1, -1, -1):  # inserted at the head: each cell lists its slots ascending
+        for a in range(3):
+            c = int(rec[i, a] * (ncell[a] / box[a]))
+            grid.cell[i, a] = min(max(c, 0), ncell[a] - 1)
+        grid_insert(i, grid.cell[i, 0] + ncell[0] * (grid.cell[i, 1] + ncell[1] * grid.cell[i, 2]), grid)
+
+
+@kernel(inline="always")
+def prefetch_around(i, grid, space):
+    """Prefetch hints for the cell heads around particle i's cell (no effect on results)."""
+    ncell = space.ncell
+    period = space.period
+    cx = grid.cell[i, 0]
+    cy = grid.cell[i, 1]
+    cz = grid.cell[i, 2]
+    zr = 1 if ncell[2] >= 3 else 0
+    for oz in range(-zr, zr + 1):
+        kz = _neighbour(cz, oz, ncell[2], period[2])
+        if kz < 0:
+            continue
+        for oy in range(-1, 2):
+            ky = _neighbour(cy, oy, ncell[1], period[1])
+            if ky >= 0:
+                prefetch(grid.head, cx + ncell[0] * (ky + ncell[1] * kz))

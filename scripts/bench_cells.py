@@ -1,0 +1,156 @@
+"""Dilute gases: cell crossings against neighbour lists (and, optionally, Smallenburg's C code).
+
+For each N and packing fraction the same random 3D state runs with each
+neighbour search (``--modes``: ``lists`` with the default shell, ``cells`` with
+cells one diameter wide, ``cells:X`` with cells (1 + X) diameters wide) in this
+process: a warm-up of 5 collisions per particle, then ``--rounds`` alternated
+timed runs of max(2e5, N) collisions each. Printed per case: events per
+collision (list expiries or cell crossings, stale events), and the median rate
+in million collisions per second of CPU time (and of the wall clock). The
+viscoelastic rule (damping 0.1) cools the gas during the runs. The first JIT
+compile of each mode's loop (a 64-particle run; 0 s when numba's cache is
+warm) is printed separately.
+
+With ``--c-cell BINARY`` / ``--c-single BINARY`` (Smallenburg's "Cell" and
+"Single" variants, built with their own flags; not part of this repository)
+each round also runs the C code at the same N and packing from its FCC start
+(elastic only): two runs, to ``T_FROM`` = 3 and to 3 plus the time of about
+``--c-collisions`` collisions (Enskog rate), each pinned with taskset to the
+core of ``--core``; the rate is the collision difference over the difference of
+the children's CPU times. The C code fixes N = 4 n^3 (10976, 108000).
+
+Usage::
+
+    taskset -c 1 python scripts/bench_cells.py --n 10976 --packings 0.05 0.1
+    taskset -c 1 python scripts/bench_cells.py --rule viscoelastic --modes lists cells cells:0.5
+    taskset -c 1 python scripts/bench_cells.py --c-cell /path/Cell/md --c-single /path/Single/md
+"""
+
+import argparse
+import math
+import re
+import resource
+import statistics
+import subprocess
+import tempfile
+import time
+
+import numpy as np
+
+from granulargas.engine import CollisionRule, Simulation
+from granulargas.initial import random_state
+from granulargas.theory import collision_frequency
+
+
+def make_rule(name):
+    if name == "elastic":
+        return CollisionRule.elastic()
+    from granulargas.contact import restitution_table
+    from granulargas.contact.material import prefactor_from_damping
+
+    return CollisionRule.viscoelastic(prefactor=prefactor_from_damping(0.1), table=restitution_table(5.0))
+
+
+def mode_kwargs(mode):
+    """Simulation keywords of a ``--modes`` entry."""
+    if mode == "lists":
+        return dict(neighbours="lists")
+    if mode == "cells":
+        return dict(neighbours="cells")
+    name, extra = mode.split(":")
+    assert name == "cells", mode
+    return dict(neighbours="cells", shell=float(extra))
+
+
+def compile_seconds(rule, modes):
+    out = {}
+    for mode in modes:
+        st = random_state(64, 0.1, 3, seed=0)
+        t = time.perf_counter()
+        Simulation(**st.as_kwargs(), rule=rule, **mode_kwargs(mode)).run(0.1)
+        out[mode] = time.perf_counter() - t
+    return out
+
+
+def c_run(binary, n, packing, end, core):
+    """(CPU seconds, collisions) of one run of the C code to simulated time ``end``."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    text = subprocess.run(["taskset", "-c", str(core), binary, str(n), str(packing), f"{end:g}", "1"],
+                          capture_output=True, text=True, cwd=tempfile.gettempdir(), check=True).stdout
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    rows = re.findall(r"Simtime: ([\d.]+), Collisions: (\d+)", text)
+    return r1.ru_utime + r1.ru_stime - r0.ru_utime - r0.ru_stime, int(rows[-1][1])
+
+
+def c_rate(binary, n, packing, collisions, core):
+    """Million collisions per CPU second of the C code between t = 3 and 3 + the time of
+    ``collisions`` collisions (Enskog frequency at T = 1)."""
+    omega = float(collision_frequency(6.0 * packing / math.pi, 1.0, 3))
+    span = max(1.0, math.ceil(2.0 * collisions / (n * omega)))
+    c0, n0 = c_run(binary, n, packing, 3.0, core)
+    c1, n1 = c_run(binary, n, packing, 3.0 + span, core)
+    return (n1 - n0) / (c1 - c0) / 1e6
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--n", type=float, nargs="+", default=[10976])
+    p.add_argument("--packings", type=float, nargs="+", default=[0.05, 0.1])
+    p.add_argument("--modes", nargs="+", default=["lists", "cells"])
+    p.add_argument("--rule", choices=["elastic", "viscoelastic"], default="elastic")
+    p.add_argument("--rounds", type=int, default=3)
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--c-cell", help="binary of the C code's Cell variant")
+    p.add_argument("--c-single", help="binary of the C code's Single variant")
+    p.add_argument("--c-collisions", type=float, default=5e5)
+    p.add_argument("--core", type=int, default=1)
+    args = p.parse_args(argv)
+    rule = make_rule(args.rule)
+    for mode, s in compile_seconds(rule, args.modes).items():
+        print(f"first run (JIT compile, 0 when cached) {mode}: {s:.1f} s", flush=True)
+    c_codes = {k: v for k, v in (("C Cell", args.c_cell), ("C Single", args.c_single)) if v}
+    for n in (int(x) for x in args.n):
+        for eta in args.packings:
+            st = random_state(n, eta, 3, seed=args.seed)
+            runs = {}
+            for mode in args.modes:
+                sim = Simulation(**st.as_kwargs(), rule=rule, **mode_kwargs(mode))
+                sim.run(np.inf, max_collisions=max(200_000, 5 * n // 2))
+                runs[mode] = (sim, [], [], _counts(sim))
+            c_rates = {name: [] for name in c_codes}
+            per_run = max(200_000, n)
+            for _ in range(args.rounds):
+                for sim, cpu, wall, _start in runs.values():
+                    c0 = sim.collisions
+                    w0, p0 = time.perf_counter(), time.process_time()
+                    sim.run(np.inf, max_collisions=per_run)
+                    w1, p1 = time.perf_counter(), time.process_time()
+                    cpu.append((sim.collisions - c0) / (p1 - p0))
+                    wall.append((sim.collisions - c0) / (w1 - w0))
+                if args.rule == "elastic":
+                    for name, binary in c_codes.items():
+                        c_rates[name].append(c_rate(binary, n, eta, args.c_collisions, args.core))
+            for mode, (sim, cpu, wall, start) in runs.items():
+                now = _counts(sim)
+                col = now["collisions"] - start["collisions"]
+                per = {k: (now[k] - start[k]) / col for k in ("events", "expiries", "crossings", "stale")}
+                bound = (f"crossings {per['crossings']:.3f}" if sim.neighbours == "cells"
+                         else f"expiries {per['expiries']:.3f}")
+                print(f"N={n} packing {eta} {args.rule} {mode} (shell {sim.shell:.3f}): events/collision "
+                      f"{per['events']:.3f} ({bound}, stale {per['stale']:.3f}), "
+                      f"{statistics.median(cpu) / 1e6:.4f} M collisions/s CPU "
+                      f"({statistics.median(wall) / 1e6:.4f} wall; rounds "
+                      f"{' '.join(f'{x / 1e6:.4f}' for x in cpu)})", flush=True)
+            for name, rates in c_rates.items():
+                if rates:
+                    print(f"N={n} packing {eta} elastic {name}: {statistics.median(rates):.4f} M collisions/s "
+                          f"CPU (rounds {' '.join(f'{x:.4f}' for x in rates)})", flush=True)
+
+
+def _counts(sim):
+    c = sim._engine.counters[0]
+    return {k: float(c[k]) for k in ("events", "collisions", "expiries", "crossings", "stale")}
+
+
+if __name__ == "__main__":
+    main()
