@@ -1,6 +1,7 @@
 """Dilute gases: cell crossings against neighbour lists (and, optionally, Smallenburg's C code).
 
-For each N and packing fraction the same random 3D state runs with each
+For each N and packing fraction the same random state (3D, or 2D with
+``--dimension 2``) runs with each
 neighbour search (``--modes``: ``lists`` with the default shell, ``cells`` with
 cells one diameter wide, ``cells:X`` with cells (1 + X) diameters wide) in this
 process: a warm-up of 5 collisions per particle, then ``--rounds`` alternated
@@ -98,6 +99,7 @@ def main(argv=None):
     p.add_argument("--packings", type=float, nargs="+", default=[0.05, 0.1])
     p.add_argument("--modes", nargs="+", default=["lists", "cells"])
     p.add_argument("--rule", choices=["elastic", "viscoelastic"], default="elastic")
+    p.add_argument("--dimension", type=int, choices=[2, 3], default=3)
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--c-cell", help="binary of the C code's Cell variant")
@@ -111,7 +113,7 @@ def main(argv=None):
     c_codes = {k: v for k, v in (("C Cell", args.c_cell), ("C Single", args.c_single)) if v}
     for n in (int(x) for x in args.n):
         for eta in args.packings:
-            st = random_state(n, eta, 3, seed=args.seed)
+            st = random_state(n, eta, args.dimension, seed=args.seed)
             runs = {}
             for mode in args.modes:
                 sim = Simulation(**st.as_kwargs(), rule=rule, **mode_kwargs(mode))
@@ -127,7 +129,7 @@ def main(argv=None):
                     w1, p1 = time.perf_counter(), time.process_time()
                     cpu.append((sim.collisions - c0) / (p1 - p0))
                     wall.append((sim.collisions - c0) / (w1 - w0))
-                if args.rule == "elastic":
+                if args.rule == "elastic" and args.dimension == 3:
                     for name, binary in c_codes.items():
                         c_rates[name].append(c_rate(binary, n, eta, args.c_collisions, args.core))
             for mode, (sim, cpu, wall, start) in runs.items():
@@ -136,7 +138,7 @@ def main(argv=None):
                 per = {k: (now[k] - start[k]) / col for k in ("events", "expiries", "crossings", "stale")}
                 bound = (f"crossings {per['crossings']:.3f}" if sim.neighbours == "cells"
                          else f"expiries {per['expiries']:.3f}")
-                print(f"N={n} packing {eta} {args.rule} {mode} (shell {sim.shell:.3f}): events/collision "
+                print(f"{args.dimension}D N={n} packing {eta} {args.rule} {mode} (shell {sim.shell:.3f}): events/collision "
                       f"{per['events']:.3f} ({bound}, stale {per['stale']:.3f}), "
                       f"{statistics.median(cpu) / 1e6:.4f} M collisions/s CPU "
                       f"({statistics.median(wall) / 1e6:.4f} wall; rounds "

@@ -297,6 +297,11 @@ def predict_kick(c, prm):
     return (c.kick_step + 0.5) * prm.kick_interval if prm.kick_interval < math.inf else math.inf
 
 
+#: the overloads' implementations are compiled like kernels: no reference counting of the
+#: arrays they pass on (each per-event call would otherwise count every array of the state)
+_NO_REFCOUNT = {"_nrt": False}
+
+
 def _is_grid(lists):
     return getattr(lists, "instance_class", None) is Grid
 
@@ -323,7 +328,7 @@ def prefetch_partner_neighbours(j, rec, lists):
     """Prefetch hints for the records :func:`predict` (j) reads (lists: j's neighbours)."""
 
 
-@overload(predict_bound)
+@overload(predict_bound, jit_options=_NO_REFCOUNT, inline="always")
 def _predict_bound(i, t, rec, lists, space, half_shell):
     if _is_grid(lists):
         def impl(i, t, rec, lists, space, half_shell):
@@ -334,7 +339,7 @@ def _predict_bound(i, t, rec, lists, space, half_shell):
         predict_expiry(i, t, rec, lists.centre, space.period, half_shell), EXPIRY, 0)
 
 
-@overload(predict_neighbours)
+@overload(predict_neighbours, jit_options=_NO_REFCOUNT, inline="always")
 def _predict_neighbours(i, t, before, rec, count, lists, space):
     if _is_grid(lists):
         return lambda i, t, before, rec, count, lists, space: predict_pair_cells(i, t, before, rec, count,
@@ -343,21 +348,21 @@ def _predict_neighbours(i, t, before, rec, count, lists, space):
                                                                        lists.nbn, space.period)
 
 
-@overload(bound_kind)
+@overload(bound_kind, jit_options=_NO_REFCOUNT, inline="always")
 def _bound_kind(lists):
     if _is_grid(lists):
         return lambda lists: CROSS
     return lambda lists: EXPIRY
 
 
-@overload(execute_bound)
+@overload(execute_bound, jit_options=_NO_REFCOUNT, inline="always")
 def _execute_bound(i, tag, te, p, lists, cells, c, prm):
     if _is_grid(lists):
         return lambda i, tag, te, p, lists, cells, c, prm: execute_crossing(i, tag, te, p, lists, c, prm)
     return lambda i, tag, te, p, lists, cells, c, prm: execute_expiry(i, te, p, lists, cells, c, prm)
 
 
-@overload(prefetch_partner_neighbours)
+@overload(prefetch_partner_neighbours, jit_options=_NO_REFCOUNT, inline="always")
 def _prefetch_partner_neighbours(j, rec, lists):
     if _is_grid(lists):
         return lambda j, rec, lists: None
@@ -595,7 +600,7 @@ def prefetch_next(i1, p, ev, lists, cells, cal, prm):
     or :func:`prefetch_next_cells`. Returns the guessed particle of the event after next."""
 
 
-@overload(prefetch_next)
+@overload(prefetch_next, jit_options=_NO_REFCOUNT, inline="always")
 def _prefetch_next(i1, p, ev, lists, cells, cal, prm):
     if _is_grid(lists):
         return lambda i1, p, ev, lists, cells, cal, prm: prefetch_next_cells(i1, p, ev, lists, cal, prm)

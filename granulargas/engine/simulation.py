@@ -187,7 +187,8 @@ class Simulation:
         cell crossings (no lists; each particle is predicted against the
         particles of its own and the neighbouring cells, and a cell crossing is
         an event; :mod:`granulargas.engine._crossing`), or "auto" (cells below
-        :data:`CELLS_BELOW`, lists otherwise). The two modes process different
+        :data:`CELLS_BELOW`, lists otherwise and for collisions that take time).
+        The two modes process different
         events, so their event sequences agree only up to round-off. Cell
         crossings do not take collisions that take time (ConfigError).
     contact_until : array (N,), optional
@@ -322,6 +323,8 @@ class Simulation:
         dmax = 2.0 * float(rad.max())
         #: the neighbour search in use, "lists" or "cells"
         self.neighbours = neighbour_mode(neighbours, self.packing_fraction, d)
+        if neighbours == "auto" and rule.resolved:
+            self.neighbours = "lists"
         if self.neighbours == "cells" and rule.resolved:
             raise ConfigError('neighbours = "cells": collisions that take time (duration = "resolved") '
                              'need neighbour lists; use neighbours = "lists"')

@@ -70,6 +70,8 @@ BOUNDARIES = ("periodic", "wall")
 DRIVING_MODELS = ("white_noise",)
 #: ``run.method``: event-driven molecular dynamics, or DSMC of the homogeneous Enskog-Boltzmann equation
 METHODS = ("edmd", "dsmc")
+#: ``run.neighbours``: the engine's neighbour search (``engine.simulation.NEIGHBOURS``)
+NEIGHBOURS = ("auto", "lists", "cells")
 DEFAULT_SNAPSHOTS = 20
 
 #: largest particle count: the engine indexes particles (neighbour lists, cells) with int32
@@ -196,6 +198,7 @@ class RunSection:
     end_time: float | None = None
     collisions_per_particle: float | None = None
     method: str = "edmd"
+    neighbours: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -504,6 +507,14 @@ SCHEMA: tuple[Key, ...] = (
         "(no positions: `particles` is the sample size, `packing_fraction` sets n and χ; no walls, "
         "no TC model).",
         default="edmd", choices=METHODS),
+    Key("run", "neighbours", "string",
+        'How the event-driven engine finds collision partners: `"lists"` neighbour lists with a shell '
+        '(list expiries are events), `"cells"` cell crossings without lists (each particle is predicted '
+        "against the particles of its own and the neighbouring cells; a cell crossing is an event), "
+        '`"auto"` cells below the packing fraction where they were measured faster (3D and 2D: see the '
+        "engine page), lists otherwise. The choice changes which events run, so trajectories of the "
+        "two agree only up to round-off; both are exact event-driven dynamics.",
+        default="auto", choices=NEIGHBOURS),
     # [output]
     Key("output", "file", "string", "The H5MD output file, relative to the working directory.",
         default_text="runs/<config name>.h5",
@@ -750,6 +761,9 @@ def _check_resolved_needs_material(v: Values):
     if v.get("run.method") == "dsmc":
         v.fail("collision.duration", '"resolved" needs positions: it is for run.method = "edmd" (DSMC has '
                                      "instantaneous collisions only)")
+    if v.get("run.neighbours") == "cells":
+        v.fail("run.neighbours", '"cells" does not take collisions that take time (collision.duration = '
+                                 '"resolved" needs neighbour lists: use "lists" or "auto")')
 
 
 def _check_run_has_an_end(v: Values):
@@ -836,7 +850,8 @@ RULES: tuple[Rule, ...] = (
     Rule('`model = "viscoelastic"` needs `damping` or `[collision.material]`.', _check_viscoelastic_needs_contact),
     _exclusive("collision.damping", "collision.material"),
     Rule('`duration = "resolved"` needs `model = "viscoelastic"` with `[collision.material]`, periodic '
-         'boundaries and `method = "edmd"`.', _check_resolved_needs_material),
+         'boundaries, `method = "edmd"` and neighbour lists (`neighbours` not `"cells"`; `"auto"` then '
+         'uses lists).', _check_resolved_needs_material),
     Rule("`diameter = { min, max }` needs both keys and min <= max (min = max is monodisperse).",
          _check_diameter_range),
     _exclusive("particles.mass", "particles.density"),

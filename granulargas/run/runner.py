@@ -392,6 +392,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
             wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
             injected_energy=st.injected_energy, contact_until=st.contact_until,
             contact_partner=st.contact_partner, three_body_contacts=st.three_body_contacts,
+            neighbours=config.run.neighbours,
         )
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the

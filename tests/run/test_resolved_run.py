@@ -105,3 +105,19 @@ def test_advise_keeps_a_resolved_config_on_edmd(write_config):
     text = "\n".join(adv.lines())
     assert 'EDMD (run.method = "edmd"): collisions that take time need positions' in text
     assert 'duration = "resolved"' in text and 'model = "constant"' not in text
+
+
+def test_resolved_with_cell_crossings_is_refused_and_auto_uses_lists(write_config, capsys):
+    text = RESOLVED.replace("end_time = 4.0", 'end_time = 4.0\nneighbours = "cells"')
+    assert main(["run", str(write_config(text))]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "run.neighbours" in err[0] and "neighbour lists" in err[0]
+    # "auto" at this packing (0.1) keeps the resolved rule on lists
+    from granulargas.run.prepare import prepare
+    from granulargas.engine import Simulation
+
+    setup = prepare(load_config(write_config(RESOLVED, name="auto.toml")))
+    st = setup.state
+    sim = Simulation(st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
+                     neighbours="auto")
+    assert sim.neighbours == "lists"

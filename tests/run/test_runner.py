@@ -81,6 +81,11 @@ RESTART_CASES = {
     "walls-constant-2d": {"system.dimension": 2, "system.boundary": ["wall", "wall"],
                           "collision.model": "constant", "collision.damping": None,
                           "collision.restitution": 0.8, "collision.wall_restitution": 0.6},
+    "cells-viscoelastic-3d": {"run.neighbours": "cells"},
+    "cells-walls-driven-tc-2d": {"system.dimension": 2, "system.boundary": ["periodic", "wall"],
+                                 "collision.model": "constant", "collision.damping": None,
+                                 "collision.restitution": 0.7, "collision.tc_time": 1e-3,
+                                 "driving.heating_rate": 0.3, "run.neighbours": "cells"},
 }
 
 
