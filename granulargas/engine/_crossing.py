@@ -1,9 +1,8 @@
 """Cell-crossing neighbour search: no lists, each particle in the cell of its position (numba leaf module).
 
 The alternative to neighbour lists for dilute gases (the "Cell" variant of
-Smallenburg's event-driven code; Smallenburg, Eur. Phys. J. E 45, 22 (2022),
-and the textbook cell method of Rapaport, "The Art of Molecular Dynamics
-Simulation", ch. 14). The box is cut into a grid of cells at least as wide as
+the event-driven code of Smallenburg (2022), and the cell method of Rapaport
+(2004), ch. 14). The box is cut into a grid of cells at least as wide as
 the largest contact distance 2 R_max; every particle belongs to the cell its
 position is in (:class:`~granulargas.engine._state.Grid`: a doubly linked list
 per cell). Two particles in cells that are not neighbours (27 around a cell,

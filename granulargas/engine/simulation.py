@@ -44,7 +44,7 @@ BOUNDARIES = ("periodic", "wall")
 #: faster of the two for the packing fraction (:func:`neighbour_mode`)
 NEIGHBOURS = ("lists", "cells", "auto")
 #: "auto" uses cell crossings below this packing fraction (3D and 2D)
-CELLS_BELOW = {3: 0.0, 2: 0.0}
+CELLS_BELOW = {3: 0.25, 2: 0.5}
 #: cell-crossing mode: at most this many cells per particle (wider cells in very dilute gases)
 CELLS_PER_PARTICLE = 8
 
