@@ -53,38 +53,46 @@ MARGIN = 1e-6
 
 
 @kernel(inline="always")
-def face_delay(x, v, c, width, n, period):
-    """Time until coordinate x (in cell c of width ``width``, n cells) moving at v reaches a face.
+def face_gap(x, v, c, width, n, period):
+    """Distance along one axis from coordinate x (in cell c of width ``width``, n cells),
+    moving at v, to the face it moves to, and that face's side (0 lower, 1 upper).
 
-    Returns (delay, side): side 0 the lower face, 1 the upper; inf on a wall
-    axis (period inf) at the face that is a wall, and for v = 0.
+    Returns (gap >= 0, |v|, side); |v| = 0 on a wall axis at the face that is a
+    wall (never crossed) and for v = 0.
     """
     rel = min_image(x - c * width, period)  # position from the lower face, [-round-off, width + ...]
     if v > 0.0:
-        if c == n - 1 and period == math.inf:
-            return math.inf, 1
         gap = width - rel
-        return (gap / v if gap > 0.0 else 0.0), 1
-    if v < 0.0:
-        if c == 0 and period == math.inf:
-            return math.inf, 0
-        return (rel / -v if rel > 0.0 else 0.0), 0
-    return math.inf, 0
+        speed = 0.0 if c == n - 1 and period == math.inf else v
+        return (gap if gap > 0.0 else 0.0), speed, 1
+    gap = rel
+    speed = 0.0 if c == 0 and period == math.inf else -v
+    return (gap if gap > 0.0 else 0.0), speed, 0
 
 
 @kernel(inline="always")
 def predict_crossing(i, t, rec, grid, space):
-    """Earliest cell crossing of particle i (streamed to t): (time, face 2 a + side)."""
-    best = math.inf
-    face = 0
+    """Earliest cell crossing of particle i (streamed to t): (time, face 2 a + side).
+
+    The axis whose face comes first has the least gap / speed; the times are
+    compared as gap_a |v_b| < gap_b |v_a| and one division gives the delay
+    (inf if the particle crosses no face).
+    """
     cell = grid.cell
-    for a in range(space.dims):
-        s, side = face_delay(rec[i, a], rec[i, 3 + a], cell[i, a], grid.width[a], space.ncell[a],
-                             space.period[a])
-        if s < best:
-            best = s
-            face = 2 * a + side
-    return t + best, face
+    gap, speed, side = face_gap(rec[i, 0], rec[i, 3], cell[i, 0], grid.width[0], space.ncell[0],
+                                space.period[0])
+    face = side
+    for a in range(1, space.dims):
+        g, v, sd = face_gap(rec[i, a], rec[i, 3 + a], cell[i, a], grid.width[a], space.ncell[a],
+                            space.period[a])
+        if g * speed < gap * v or speed == 0.0:
+            if v > 0.0:
+                gap = g
+                speed = v
+                face = 2 * a + sd
+    if speed == 0.0:
+        return math.inf, face
+    return t + gap / speed, face
 
 
 @kernel(inline="always")
