@@ -316,10 +316,6 @@ def predict_neighbours(i, t, before, rec, count, lists, space):
     the particles of its neighbour cells."""
 
 
-def bound_kind(lists):
-    """EXPIRY (lists) or CROSS (cells): the kind code of :func:`predict_bound`'s event."""
-
-
 def execute_bound(i, tag, te, p, lists, cells, c, prm):
     """:func:`execute_expiry` or :func:`execute_crossing`."""
 
@@ -346,13 +342,6 @@ def _predict_neighbours(i, t, before, rec, count, lists, space):
                                                                                  lists, space)
     return lambda i, t, before, rec, count, lists, space: predict_pair(i, t, before, rec, lists.nbl,
                                                                        lists.nbn, space.period)
-
-
-@overload(bound_kind, jit_options=_NO_REFCOUNT, inline="always")
-def _bound_kind(lists):
-    if _is_grid(lists):
-        return lambda lists: CROSS
-    return lambda lists: EXPIRY
 
 
 @overload(execute_bound, jit_options=_NO_REFCOUNT, inline="always")
@@ -770,7 +759,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
-        elif j == bound_kind(lists):
+        elif j == EXPIRY or j == CROSS:  # the one of the two this mode has
             status = execute_bound(i, ev.tag[i], te, p, lists, cells, c, prm)
             clock = tick(probe, REBUILD, clock)
             if status != DONE:
