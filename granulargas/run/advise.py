@@ -28,6 +28,18 @@ advice predicts, with kinetic theory and no simulation
    speed-up is the ratio of collision rates measured by ``scripts/bench_dsmc.py``
    (docs/performance.md, DSMC section), interpolated in the packing fraction.
 
+7. the duration of the contacts (:func:`choose_duration`, material route only, where the
+   stiffness fixes the contact time): from the contact-time ratio ``<t_c> omega`` at T0
+   (:func:`granulargas.run.validity.contact_time_ratio`) and the errors of instantaneous
+   and resolved EDMD against LAMMPS measured at a few ratios by
+   ``scripts/resolved_lammps.py`` (:data:`RESOLVED_LAMMPS_MEASURED`; docs/validation.md,
+   "Against LAMMPS"), interpolated as a power law in the ratio: instantaneous
+   collisions where their predicted error is within the tolerance; else
+   ``[collision] duration = "resolved"`` where its error is, at about
+   :data:`RESOLVED_COST` the collisions per CPU second (``scripts/bench_resolved.py``);
+   else a time-stepped DEM (``granulargas export lammps --material-stiffness``). Above the largest measured
+   ratio the resolved scheme is not vouched for.
+
 For a constant-eps config the advice reports the config ``damping`` (beta at
 g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
@@ -57,7 +69,8 @@ from granulargas.run.prepare import mean_particle
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
-           "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line"]
+           "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line", "choose_duration",
+           "duration_error", "RESOLVED_LAMMPS_MEASURED", "RESOLVED_COST"]
 
 #: default tolerance on the relative error of T(t)
 DEFAULT_TOLERANCE = 0.02
@@ -72,6 +85,64 @@ DSMC_MAX_PACKING = 0.1
 #: (packing fraction, DSMC / engine collision rate): CPU-time medians at N = 10^5, 3D,
 #: constant eps = 0.9 (``scripts/bench_dsmc.py``; docs/performance.md, DSMC section)
 DSMC_SPEEDUP_MEASURED = ((0.02, 252.0), (0.3, 26.0))
+
+
+#: (contact-time ratio <t_c> omega at T0, largest error of instantaneous EDMD, of resolved EDMD), errors
+#: as fractions: the largest |mean| over 8 seeds of the relative deviations from LAMMPS at its finest
+#: step of T (averaged over the second half of the run), of the collision count and of the mean
+#: pressure; 3D, N = 2000, packing 0.05, damping 0.1, t = 0..20 (``scripts/resolved_lammps.py``;
+#: docs/validation.md, "Against LAMMPS")
+RESOLVED_LAMMPS_MEASURED = ((0.01, 0.003, 0.003), (0.03, 0.009, 0.003), (0.1, 0.025, 0.003))
+
+#: resolved / instantaneous collisions per CPU second, 3D N = 10^4 packing 0.1
+#: (``scripts/bench_resolved.py``; docs/performance.md)
+RESOLVED_COST = 0.80
+
+
+def duration_error(ratio: float, method: str) -> float:
+    """Predicted largest relative error against DEM of ``method`` ("instantaneous" or "resolved")
+    at the contact-time ratio ``ratio``: :data:`RESOLVED_LAMMPS_MEASURED` interpolated linearly in
+    log(error) against log(ratio); below the smallest measured ratio the error falls in proportion
+    to the ratio (the share of collisions that overlap a third contact, :mod:`granulargas.run.validity`),
+    above the largest it is extrapolated from the last two points (``nan`` if they do not grow)."""
+    col = {"instantaneous": 1, "resolved": 2}[method]
+    r = np.array([row[0] for row in RESOLVED_LAMMPS_MEASURED])
+    e = np.array([row[col] for row in RESOLVED_LAMMPS_MEASURED])
+    if ratio <= r[0]:
+        return float(e[0] * ratio / r[0])
+    if ratio <= r[-1]:
+        return float(np.exp(np.interp(math.log(ratio), np.log(r), np.log(e))))
+    slope = math.log(e[-1] / e[-2]) / math.log(r[-1] / r[-2])
+    return float(e[-1] * (ratio / r[-1]) ** slope) if slope > 0 else math.nan
+
+
+def choose_duration(config, tolerance: float = DEFAULT_TOLERANCE) -> tuple[str, str] | None:
+    """("instantaneous", "resolved" or "dem", the reason in words) for a viscoelastic config on
+    the material route (module docstring, 7.); None where the contact time is unknown (damping
+    route) or the rule is not viscoelastic."""
+    c = config.collision
+    if c.model != "viscoelastic" or c.material is None:
+        return None
+    ratio = V.contact_time_ratio(config)
+    if ratio is None:
+        return None
+    largest = RESOLVED_LAMMPS_MEASURED[-1][0]
+    e_inst = duration_error(ratio, "instantaneous")
+    measured = (f"t_c/t_free = {ratio:.3g} at T0: against LAMMPS (scripts/resolved_lammps.py, measured at "
+                f"{', '.join(f'{row[0]:g}' for row in RESOLVED_LAMMPS_MEASURED)}) instantaneous collisions are off "
+                f"by about {100 * e_inst:.2g} %")
+    if e_inst <= tolerance:
+        return "instantaneous", f"{measured} (tolerance {100 * tolerance:g} %): the contact's duration does not matter"
+    if ratio > largest:
+        return "dem", (f"{measured}; the resolved scheme was measured up to t_c/t_free = {largest:g} only: "
+                       "use a time-stepped DEM (granulargas export lammps --material-stiffness)")
+    e_res = duration_error(ratio, "resolved")
+    if e_res <= tolerance:
+        return "resolved", (f"{measured}, resolved collisions by about {100 * e_res:.2g} % (tolerance "
+                            f"{100 * tolerance:g} %): use [collision] duration = \"resolved\" (about x{RESOLVED_COST:g} "
+                            "the collisions per CPU second, scripts/bench_resolved.py)")
+    return "dem", (f"{measured}, resolved collisions by about {100 * e_res:.2g} % (tolerance {100 * tolerance:g} %): "
+                   "use a time-stepped DEM (granulargas export lammps --material-stiffness)")
 
 
 def dsmc_speedup(packing: float) -> float:
@@ -135,6 +206,9 @@ class Advice:
         Predicted DSMC / EDMD collision rate at the config's packing (:func:`dsmc_speedup`).
     configured_method : str
         The config's ``run.method``.
+    duration, duration_reason : str or None
+        The collision duration the contact time needs (:func:`choose_duration`) and why;
+        None off the material route.
     notes : list of str
     """
 
@@ -153,6 +227,8 @@ class Advice:
     method_reason: str = ""
     speedup: float = math.nan
     configured_method: str = "edmd"
+    duration: str | None = None
+    duration_reason: str = ""
     notes: tuple = ()
 
     def lines(self) -> list[str]:
@@ -181,6 +257,8 @@ class Advice:
             out.append(f"method       {name} (run.method = \"{self.method}\"): {self.method_reason}{speed}")
             if self.configured_method != self.method:
                 out.append(f"             the config has run.method = \"{self.configured_method}\"")
+        if self.duration is not None:
+            out.append(f"duration     {self.duration}: {self.duration_reason}")
         out += [f"note         {n}" for n in self.notes]
         return out
 
@@ -265,13 +343,15 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         adv.eps_best, adv.error = best_constant(gas, curve, t_end)
         adv.constant_ok = adv.error <= tolerance
         adv.instability_length = gas.instability_length()
-        if config.collision.duration == "resolved":
+        chosen = choose_duration(config, tolerance)
+        if chosen is not None:
+            adv.duration, adv.duration_reason = chosen
+        if config.collision.duration == "resolved" or adv.duration in ("resolved", "dem"):
             ratio = V.contact_time_ratio(config)
             share = "" if ratio is None else (f"; of the order of {100 * (1 - math.exp(-2 * ratio)):.2g} % of the collisions "
                                               "will meet a pair still in contact (three_body_contacts)")
-            notes.append('duration = "resolved": the constant-eps comparison above is one of instantaneous '
-                         "collisions, which leave out the contact's duration and the turn of the normal"
-                         + share)
+            notes.append("the constant-eps comparison above is one of instantaneous collisions, which leave out "
+                         "the contact's duration and the turn of the normal" + share)
         elif adv.constant_ok:
             notes.append(f'use [collision] model = "constant", restitution = {adv.eps_best:.4f} '
                          "(cost per collision is nearly the same; the gain is a closed-form reference, Haff's law)")
