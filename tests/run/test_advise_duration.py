@@ -11,7 +11,7 @@ from granulargas.cli import main
 from granulargas.contact.material import dissipation_time_from_prefactor, prefactor_from_damping
 from granulargas.io.config import parse_config
 from granulargas.run.advise import (DEFAULT_TOLERANCE, RESOLVED_COST, RESOLVED_LAMMPS_MEASURED, advise,
-                                    choose_duration, duration_error)
+                                    choose_duration, dem_cost, duration_error)
 from granulargas.run.validity import contact_time_ratio
 
 MATERIAL = """
@@ -37,6 +37,7 @@ end_time = 20.0
 
 
 def _text(young, damping=0.1):
+    young = float(young)
     a = dissipation_time_from_prefactor(prefactor_from_damping(damping), young, 0.3)
     return MATERIAL.format(young=young, dissipation=a, density=6.0 / math.pi)
 
@@ -54,25 +55,28 @@ def _young_for_ratio(ratio):
 
 
 def test_measured_points_are_reproduced_and_interpolated_as_power_laws():
-    for r, e_inst, e_res in RESOLVED_LAMMPS_MEASURED:
+    for r, e_inst, e_res, cost in RESOLVED_LAMMPS_MEASURED:
         assert duration_error(r, "instantaneous") == pytest.approx(e_inst)
         assert duration_error(r, "resolved") == pytest.approx(e_res)
-    (r0, a0, _), (r1, a1, _) = RESOLVED_LAMMPS_MEASURED[:2]
+        assert dem_cost(r) == pytest.approx(cost)
+    (r0, a0, _, c0), (r1, a1, _, c1) = RESOLVED_LAMMPS_MEASURED[:2]
     mid = math.sqrt(r0 * r1)
     assert duration_error(mid, "instantaneous") == pytest.approx(math.sqrt(a0 * a1))
+    assert dem_cost(mid) == pytest.approx(math.sqrt(c0 * c1))
+    assert math.isnan(duration_error(2 * RESOLVED_LAMMPS_MEASURED[-1][0], "resolved"))
     # below the measurements: in proportion to the ratio
     assert duration_error(r0 / 10, "instantaneous") == pytest.approx(a0 / 10)
 
 
 @pytest.mark.parametrize("row", RESOLVED_LAMMPS_MEASURED, ids=lambda row: f"ratio {row[0]:g}")
 def test_at_the_measured_ratios_the_measured_errors_decide(row):
-    ratio, e_inst, e_res = row
+    ratio, e_inst, e_res, cost = row
     config = _config(_young_for_ratio(ratio * (1 - 1e-9)))  # on the measured side of the largest ratio
     assert contact_time_ratio(config) == pytest.approx(ratio, rel=1e-6)
     duration, reason = choose_duration(config)
     assert f"t_c/t_free = {ratio:.3g}" in reason
     expected = ("instantaneous" if e_inst <= DEFAULT_TOLERANCE else
-                "resolved" if e_res <= DEFAULT_TOLERANCE else "dem")
+                "resolved" if e_res <= DEFAULT_TOLERANCE and cost >= 1 else "dem")
     assert duration == expected
 
 
@@ -126,3 +130,21 @@ def test_cli_advise_prints_the_duration(tmp_path, capsys):
     assert main(["advise", str(p)]) == 0
     out = capsys.readouterr().out
     assert "duration     dem:" in out
+
+
+@pytest.mark.parametrize("table, expected", [
+    # instantaneous off by 5 %, resolved by 1 %, DEM 3x the resolved run's time -> resolved
+    (((0.01, 0.05, 0.01, 3.0), (0.5, 0.05, 0.01, 3.0)), "resolved"),
+    # the same, but DEM at half the resolved run's time -> DEM
+    (((0.01, 0.05, 0.01, 0.5), (0.5, 0.05, 0.01, 0.5)), "dem"),
+    # resolved off by 5 % -> DEM
+    (((0.01, 0.05, 0.05, 3.0), (0.5, 0.05, 0.05, 3.0)), "dem"),
+    # instantaneous within 1 % -> instantaneous, whatever else
+    (((0.01, 0.01, 0.05, 0.5), (0.5, 0.01, 0.05, 0.5)), "instantaneous"),
+])
+def test_the_cheapest_accurate_method_is_chosen(monkeypatch, table, expected):
+    import granulargas.run.advise as A
+
+    monkeypatch.setattr(A, "RESOLVED_LAMMPS_MEASURED", table)
+    config = _config(_young_for_ratio(0.05))
+    assert choose_duration(config)[0] == expected

@@ -104,5 +104,5 @@ def test_advise_keeps_a_resolved_config_on_edmd(write_config):
     adv = advise(load_config(write_config(RESOLVED)))
     text = "\n".join(adv.lines())
     assert 'EDMD (run.method = "edmd"): collisions that take time need positions' in text
-    # the contact-time ratio (0.17 at T0) decides the duration; constant eps is never offered
-    assert "duration     " in text and "t_c/t_free = 0.17" in text and 'model = "constant"' not in text
+    # the contact-time ratio (0.168 at T0) decides the duration; constant eps is never offered
+    assert "duration     " in text and "t_c/t_free = 0.168" in text and 'model = "constant"' not in text
