@@ -187,8 +187,10 @@ def dsmc_speedup(packing: float) -> float:
     return float(r0 * math.exp(math.log(r1 / r0) * math.log(p / p0) / math.log(p1 / p0)))
 
 
-def choose_method(config, instability_length: float = math.inf) -> tuple[str, str]:
-    """("dsmc" or "edmd", the reason in words) for a config's scene (module docstring, 6.)."""
+def choose_method(config, instability_length: float = math.inf, duration: str | None = None) -> tuple[str, str]:
+    """("dsmc" or "edmd", the reason in words) for a config's scene (module docstring, 6.);
+    ``duration``: the advised collision duration (:func:`choose_duration`), "resolved" or "dem"
+    rule DSMC out."""
     s, c = config.system, config.collision
     eta = s.packing_fraction
     if "wall" in s.boundary:
@@ -197,6 +199,8 @@ def choose_method(config, instability_length: float = math.inf) -> tuple[str, st
         return "edmd", "the TC model needs pair histories of a spatial gas"
     if c.duration == "resolved":
         return "edmd", "collisions that take time need positions (DSMC's collisions are instantaneous)"
+    if duration in ("resolved", "dem"):
+        return "edmd", "the contacts last long enough to matter (duration below; DSMC's collisions are instantaneous)"
     box = _box(config)
     if box > instability_length:
         return "edmd", (f"the box {box:.4g} exceeds the instability length {instability_length:.4g}: "
@@ -419,7 +423,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
 
 def _set_method(adv: Advice, config):
     length = adv.instability_length if math.isfinite(adv.instability_length) else math.inf
-    adv.method, adv.method_reason = choose_method(config, length)
+    adv.method, adv.method_reason = choose_method(config, length, adv.duration)
     adv.speedup = dsmc_speedup(config.system.packing_fraction)
     adv.configured_method = config.run.method
 

@@ -148,3 +148,9 @@ def test_the_cheapest_accurate_method_is_chosen(monkeypatch, table, expected):
     monkeypatch.setattr(A, "RESOLVED_LAMMPS_MEASURED", table)
     config = _config(_young_for_ratio(0.05))
     assert choose_duration(config)[0] == expected
+
+
+def test_dsmc_is_not_advised_where_the_contacts_last_long_enough_to_matter():
+    stiff, soft = advise(_config(1e8)), advise(_config(1e4))  # dilute and homogeneous, both
+    assert stiff.duration == "instantaneous" and stiff.method == "dsmc"
+    assert soft.duration == "resolved" and soft.method == "edmd" and "last long enough" in soft.method_reason
