@@ -1,7 +1,7 @@
 """Instantaneous EDMD, resolved EDMD and LAMMPS: a dilute soft cooling gas at several contact times.
 
-``python scripts/resolved_lammps.py [--fractions 0.01 0.03 0.1] [--seeds 4] [--particles 1000]
-[--packing 0.05] [--damping 0.1] [--end 20] [--steps-per-contact 10 20 40] [--workdir DIR]
+``python scripts/resolved_lammps.py [--fractions 0.01 0.03 0.1 0.15 0.2] [--seeds 8] [--particles 2000]
+[--packing 0.05] [--damping 0.1] [--end 20] [--steps-per-contact 10 20 40 80] [--workdir DIR]
 [--figure PNG] [--reuse]``
 
 For each contact-time ratio f = <t_c> omega at T0
@@ -217,13 +217,13 @@ def mean_se(values):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--fractions", type=float, nargs="+", default=[0.01, 0.03, 0.1])
-    ap.add_argument("--seeds", type=int, default=4)
-    ap.add_argument("--particles", type=int, default=1000)
+    ap.add_argument("--fractions", type=float, nargs="+", default=[0.01, 0.03, 0.1, 0.15, 0.2])
+    ap.add_argument("--seeds", type=int, default=8)
+    ap.add_argument("--particles", type=int, default=2000)
     ap.add_argument("--packing", type=float, default=0.05)
     ap.add_argument("--damping", type=float, default=0.1)
     ap.add_argument("--end", type=float, default=20.0)
-    ap.add_argument("--steps-per-contact", type=int, nargs="+", default=[10, 20, 40])
+    ap.add_argument("--steps-per-contact", type=int, nargs="+", default=[10, 20, 40, 80])
     ap.add_argument("--workdir", default=str(ROOT / "runs" / "resolved_lammps"))
     ap.add_argument("--figure", default=str(ROOT / "docs" / "figures" / "resolved_lammps.png"))
     ap.add_argument("--reuse", action="store_true", help="reuse finished runs found in the work directory")
@@ -250,12 +250,13 @@ def main(argv=None):
 
     results = {"particles": args.particles, "packing_fraction": args.packing, "damping": args.damping,
                "end_time": args.end, "seeds": args.seeds, "steps_per_contact": steps_list, "fractions": {}}
+    gas = f"N{args.particles}_packing{args.packing:g}_damping{args.damping:g}_end{args.end:g}"  # runs reused per gas
     for f in args.fractions:
         young = young_for_fraction(args, f, workdir)
         runs = {"instantaneous": [], "resolved": [], **{f"lammps_n{n}": [] for n in steps_list}}
         refused = None
         for seed in range(1, args.seeds + 1):
-            d = workdir / f"f{f:g}" / f"seed{seed}"
+            d = workdir / gas / f"f{f:g}" / f"seed{seed}"
             d.mkdir(parents=True, exist_ok=True)
             runs["instantaneous"].append(run_engine(args, young, seed, "instantaneous", d, args.reuse))
             if refused is None:
