@@ -40,7 +40,9 @@ advice predicts, with kinetic theory and no simulation
    the resolved rule itself runs at about :data:`RESOLVED_COST` the collisions per CPU
    second of the instantaneous one, ``scripts/bench_resolved.py``); else a time-stepped
    DEM (``granulargas export lammps --material-stiffness``). Above the largest measured
-   ratio the resolved scheme is not vouched for.
+   ratio the resolved scheme is not vouched for, nor where the fastest impact expected
+   among the config's particles (:func:`fastest_impact_bounds`) is beyond its table,
+   which the run would refuse.
 
 For a constant-eps config the advice reports the config ``damping`` (beta at
 g = 1 for two reference particles) whose viscoelastic gas cools at the same
@@ -67,12 +69,13 @@ from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import ConfigError
 from granulargas.run import validity as V
-from granulargas.run.prepare import mean_particle
+from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds, reduced_compression,
+                                     reduced_prefactor)
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
            "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line", "choose_duration",
-           "duration_error", "dem_cost", "RESOLVED_LAMMPS_MEASURED", "RESOLVED_COST",
+           "duration_error", "dem_cost", "fastest_impact_bounds", "RESOLVED_LAMMPS_MEASURED", "RESOLVED_COST",
            "RESOLVED_THREE_BODY_CHECKED"]
 
 #: default tolerance on the relative error of T(t)
@@ -144,6 +147,24 @@ def dem_cost(ratio: float) -> float:
     return _measured(ratio, 3)
 
 
+def fastest_impact_bounds(config) -> tuple[float, float]:
+    """(beta, delta) the resolved rule's table must hold for the fastest impact of a fresh
+    Maxwellian state of the config, predicted without building it: the largest of N thermal
+    speeds stays below v with probability 0.9 (the chi distribution with d degrees of freedom,
+    F(v)^N = 0.9; 8 states of 2000 particles had their fastest at 0.94 to 1.06 of the median), as
+    :func:`granulargas.run.prepare.oblique_bounds` takes it (relative speed twice that), for
+    particles of the mean diameter and mass."""
+    from types import SimpleNamespace
+
+    from scipy.stats import chi
+
+    s = config.system
+    sigma, mass = mean_particle(config)
+    v_max = float(chi(s.dimension, scale=math.sqrt(config.initial.temperature / mass)).ppf(0.9 ** (1.0 / s.particles)))
+    state = SimpleNamespace(masses=np.array([mass]), radii=np.array([sigma / 2]), velocities=np.array([[v_max]]))
+    return oblique_bounds(reduced_prefactor(config), reduced_compression(config), state)
+
+
 def choose_duration(config, tolerance: float = DEFAULT_TOLERANCE) -> tuple[str, str] | None:
     """("instantaneous", "resolved" or "dem", the reason in words) for a viscoelastic config on
     the material route (module docstring, 7.); None where the contact time is unknown (damping
@@ -168,6 +189,12 @@ def choose_duration(config, tolerance: float = DEFAULT_TOLERANCE) -> tuple[str, 
     cost = dem_cost(ratio)
     if e_res > tolerance:
         return "dem", f"{measured}, resolved collisions by about {100 * e_res:.2g} % (tolerance {100 * tolerance:g} %): {dem}"
+    beta, delta = fastest_impact_bounds(config)
+    if not (beta < OBLIQUE_BETA_MAX and delta < DELTA_MAX):
+        return "dem", (f"{measured}, resolved collisions by about {100 * e_res:.2g} %, but the fastest impact "
+                       f"expected among {config.system.particles} particles (beta = {beta:.3g}, delta = {delta:.3g}) "
+                       f"is beyond the resolved scheme's table (beta < {OBLIQUE_BETA_MAX:g}, delta < {DELTA_MAX:g}): "
+                       f"{dem}")
     if cost < 1.0:
         return "dem", (f"{measured}, resolved collisions by about {100 * e_res:.2g} %, but a DEM at t_c/10 costs "
                        f"about x{cost:.2g} the CPU time of the resolved run: {dem}")

@@ -11,7 +11,7 @@ from granulargas.cli import main
 from granulargas.contact.material import dissipation_time_from_prefactor, prefactor_from_damping
 from granulargas.io.config import parse_config
 from granulargas.run.advise import (DEFAULT_TOLERANCE, RESOLVED_COST, RESOLVED_LAMMPS_MEASURED, advise,
-                                    choose_duration, dem_cost, duration_error)
+                                    choose_duration, dem_cost, duration_error, fastest_impact_bounds)
 from granulargas.run.validity import contact_time_ratio
 
 MATERIAL = """
@@ -154,3 +154,28 @@ def test_dsmc_is_not_advised_where_the_contacts_last_long_enough_to_matter():
     stiff, soft = advise(_config(1e8)), advise(_config(1e4))  # dilute and homogeneous, both
     assert stiff.duration == "instantaneous" and stiff.method == "dsmc"
     assert soft.duration == "resolved" and soft.method == "edmd" and "last long enough" in soft.method_reason
+
+
+def test_fastest_impact_prediction_brackets_real_initial_states():
+    from granulargas.run.prepare import initial_state, oblique_bounds, reduced_compression, reduced_prefactor
+
+    config = _config(_young_for_ratio(0.2))
+    predicted = fastest_impact_bounds(config)[1]
+    actual = []
+    for seed in range(1, 7):
+        c = parse_config(_text(config.collision.material.young_modulus).replace(
+            "packing_fraction = 0.05", f"packing_fraction = 0.05\nseed = {seed}"))
+        actual.append(oblique_bounds(reduced_prefactor(c), reduced_compression(c), initial_state(c))[1])
+    # the 0.9 quantile of the largest of N speeds: above most of the states' fastest impacts
+    assert sorted(actual)[2] < predicted < 1.2 * max(actual)
+
+
+def test_a_gas_whose_fastest_impacts_leave_the_table_gets_dem():
+    # at t_c/t_free = 0.15 a billion particles hold faster impacts than 2000 do
+    small = _config(_young_for_ratio(0.15))
+    large = parse_config(_text(small.collision.material.young_modulus).replace("particles = 2000",
+                                                                                "particles = 1000000000"))
+    assert choose_duration(small)[0] == "resolved"
+    duration, reason = choose_duration(large)
+    assert fastest_impact_bounds(large)[1] > 0.5
+    assert duration == "dem" and "beyond the resolved scheme's table" in reason
