@@ -43,8 +43,9 @@ BOUNDARIES = ("periodic", "wall")
 #: neighbour search: neighbour lists with a shell, cell crossings (no lists), or the
 #: faster of the two for the packing fraction (:func:`neighbour_mode`)
 NEIGHBOURS = ("lists", "cells", "auto")
-#: "auto" uses cell crossings below this packing fraction (3D and 2D)
-CELLS_BELOW = {3: 0.25, 2: 0.5}
+#: "auto" uses cell crossings below this packing fraction (measured faster than the lists at
+#: N = 10^4 and 10^5 with ``scripts/bench_cells.py``; in 2D they are not faster at 10^5)
+CELLS_BELOW = {3: 0.2, 2: 0.0}
 #: cell-crossing mode: at most this many cells per particle (wider cells in very dilute gases)
 CELLS_PER_PARTICLE = 8
 
