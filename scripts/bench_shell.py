@@ -1,7 +1,7 @@
-"""Events per collision and speed of dilute gases against the neighbour-list shell.
+"""Events per collision and speed against the neighbour-list shell.
 
 For each packing fraction and shell width (in diameters) the same random state
-(3D, elastic or viscoelastic) runs in this process: warm-up of 5 collisions per
+(3D or 2D, elastic or viscoelastic) runs in this process: warm-up of 5 collisions per
 particle, then ``--repeats`` timed runs of max(2e5, N) collisions; printed per
 case: events, list expiries and stale events per collision, mean neighbour-list
 length, and the median rate in collisions per second of CPU time (and of the
@@ -12,6 +12,7 @@ Usage::
 
     python scripts/bench_shell.py --n 1e4 --packings 0.05 0.1 --shells 1.2 2 3 4
     python scripts/bench_shell.py --rule viscoelastic     # damping 0.1, cooling
+    python scripts/bench_shell.py --dimension 2 --packings 0.1 0.25 0.4 --shells 0 0.5 1 1.5
 """
 
 import argparse
@@ -41,18 +42,19 @@ def main(argv=None):
     p.add_argument("--shells", type=float, nargs="+", default=[0.0, 2.0, 3.0, 4.0],
                    help="shell widths in diameters (0: the engine's default)")
     p.add_argument("--rule", choices=["elastic", "viscoelastic"], default="elastic")
+    p.add_argument("--dimension", type=int, choices=[2, 3], default=3)
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--seed", type=int, default=1)
     args = p.parse_args(argv)
     n = int(args.n)
     rule = make_rule(args.rule)
-    warm = random_state(64, 0.2, 3, seed=0)
+    warm = random_state(64, 0.2, args.dimension, seed=0)
     Simulation(**warm.as_kwargs(), rule=rule).run(0.1)
     for eta in args.packings:
-        st = random_state(n, eta, 3, seed=args.seed)
+        st = random_state(n, eta, args.dimension, seed=args.seed)
         sims = {}
         for shell in args.shells:
-            width = default_shell(eta, 3) if shell == 0.0 else shell
+            width = default_shell(eta, args.dimension) if shell == 0.0 else shell
             sim = Simulation(**st.as_kwargs(), rule=rule, shell=width)
             sim.run(np.inf, max_collisions=max(200_000, 5 * n // 2))
             sims[width] = (sim, [], [], [sim.events, sim.collisions, *_counts(sim)])
@@ -70,7 +72,7 @@ def main(argv=None):
             col = sim.collisions - c0
             x, s = _counts(sim)
             lists = sim._engine.lists.nbn
-            print(f"packing {eta} {args.rule} N={n} shell {width:.2f}: "
+            print(f"{args.dimension}D packing {eta} {args.rule} N={n} shell {width:.2f}: "
                   f"events/collision {(sim.events - ev0) / col:.3f} (expiries {(x - x0) / col:.3f}, "
                   f"stale {(s - s0) / col:.3f}), list length {float(np.mean(lists)):.1f}, "
                   f"{statistics.median(cpu) / 1e6:.4f} M collisions/s CPU "

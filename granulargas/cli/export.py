@@ -22,6 +22,9 @@ def configure_parser(parser):
                    help="output directory (default: lammps_<config name>)")
     p.add_argument("--contact-fraction", type=float, default=0.01, metavar="F",
                    help="contact time / mean free time, sets the stiffness (default 0.01)")
+    p.add_argument("--material-stiffness", action="store_true",
+                   help="the Young modulus of [collision.material] (the contact that duration = \"resolved\" "
+                        "resolves) instead of --contact-fraction")
     p.add_argument("--steps-per-contact", type=int, default=50, metavar="N",
                    help="timestep = contact time / N (default 50)")
     p.add_argument("--end-time", type=float, default=None, metavar="T",
@@ -41,12 +44,13 @@ def run(args) -> int:
         return 0
     config = load_config(args.config, overrides_from(args))
     directory = Path(args.output) if args.output else Path(f"lammps_{Path(args.config).stem}")
-    ex = export_lammps(config, directory, contact_fraction=args.contact_fraction,
+    fraction = None if args.material_stiffness else args.contact_fraction
+    ex = export_lammps(config, directory, contact_fraction=fraction,
                        steps_per_contact=args.steps_per_contact, end_time=args.end_time)
     print(f"wrote {ex.input_file} and {ex.data_file}")
     print(f"  Y = {ex.contact.young_modulus:.6g}, A = {ex.contact.dissipation_time:.6g}, end = {ex.contact.end}"
           f"{' (limit_damping)' if ex.contact.end == 'force' else ''}")
-    print(f"  contact time {ex.contact_time:.4g} = {ex.contact_fraction:g} x mean free time {ex.mean_free_time:.4g};"
+    print(f"  contact time {ex.contact_time:.4g} = {ex.contact_fraction:.4g} x mean free time {ex.mean_free_time:.4g};"
           f" timestep {ex.timestep:.4g}, {ex.steps} steps")
     print(f"  run: cd {directory} && lmp -in {ex.input_file.name}")
     return 0

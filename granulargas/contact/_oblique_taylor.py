@@ -31,17 +31,19 @@ import math
 import numpy as np
 
 from granulargas._numba import jit
-
-END_OVERLAP = 0
-END_FORCE = 1
-
-STATUS_OK = 0
-STATUS_MAX_STEPS = 1
-STATUS_BAD_INPUT = 2
-
-ORDER = 28
-TOLERANCE = 1e-17
-MAX_STEPS = 200000
+from granulargas.contact._taylor import (  # noqa: F401  (constants shared by both kernels)
+    END_FORCE,
+    END_OVERLAP,
+    MAX_STEPS,
+    ORDER,
+    STATUS_BAD_INPUT,
+    STATUS_MAX_STEPS,
+    STATUS_OK,
+    TOLERANCE,
+    end_root,
+    horner,
+    largest_compression,
+)
 
 #: Columns of the output row.
 COL_EPS = 0  # -x' at separation
@@ -54,24 +56,6 @@ COL_M_FORCE = 6  # M then
 COL_X_MAX = 7  # largest compression
 COL_STEPS = 8
 N_COLUMNS = 9
-
-
-@jit
-def _horner(c, K, sigma):
-    v = c[K]
-    for k in range(K - 1, -1, -1):
-        v = v * sigma + c[k]
-    return v
-
-
-@jit
-def _horner_d(c, K, sigma):
-    v = c[K]
-    d = 0.0
-    for k in range(K - 1, -1, -1):
-        d = d * sigma + v
-        v = v * sigma + c[k]
-    return v, d
 
 
 @jit
@@ -111,47 +95,6 @@ def _coefficients(beta, c, delta, on, K, W, P, T, M, Q, U, U2, U3, F, R, WU3, W3
         P[k + 1] = -(on * (F[k] + beta * R[k]) + c * WU3[k]) * inv
         T[k + 1] = W[k] * inv
         M[k + 1] = m * inv
-
-
-@jit
-def _root_w(W, K, a, b):
-    """Safeguarded Newton for w(sigma) = 0 on [a, b] (w(a) > 0 >= w(b))."""
-    x = 0.5 * (a + b)
-    for _ in range(200):
-        f, df = _horner_d(W, K, x)
-        if f > 0.0:
-            a = x
-        else:
-            b = x
-        xn = x - f / df if df < 0.0 else 0.5 * (a + b)
-        if not (a < xn < b):
-            xn = 0.5 * (a + b)
-        if abs(xn - x) <= 1e-15 * max(1.0, abs(x)) or b - a <= 4e-16 * max(1.0, abs(x)):
-            return xn
-        x = xn
-    return x
-
-
-@jit
-def _root_force(W, P, K, beta, a, b):
-    """Safeguarded Newton for g = w^2 + beta p = 0 on [a, b] (g(a) > 0 >= g(b))."""
-    x = 0.5 * (a + b)
-    for _ in range(200):
-        w, dw = _horner_d(W, K, x)
-        p, dp = _horner_d(P, K, x)
-        f = w * w + beta * p
-        df = 2.0 * w * dw + beta * dp
-        if f > 0.0:
-            a = x
-        else:
-            b = x
-        xn = x - f / df if df < 0.0 else 0.5 * (a + b)
-        if not (a < xn < b):
-            xn = 0.5 * (a + b)
-        if abs(xn - x) <= 1e-15 * max(1.0, abs(x)) or b - a <= 4e-16 * max(1.0, abs(x)):
-            return xn
-        x = xn
-    return x
 
 
 @jit
@@ -220,40 +163,29 @@ def oblique_solve(beta, c, delta, end, order, tol, out):
                         h = hm
         if h > 1e3:
             h = 1e3
-        w1 = _horner(W, K, h)
-        p1 = _horner(P, K, h)
+        w1 = horner(W, K, h)
+        p1 = horner(P, K, h)
         sig = h
         separated = False
         switched = False
         if w > 0.0 and w1 <= 0.0:
-            sig = _root_w(W, K, 0.0, h)
+            sig = end_root(W, P, K, beta, END_OVERLAP, 0.0, h)
             separated = True
         if force_pending and p < 0.0 or force_pending and p1 < 0.0:
             g0 = w * w + beta * p
-            ws = _horner(W, K, sig)
-            g1 = ws * ws + beta * _horner(P, K, sig)
+            ws = horner(W, K, sig)
+            g1 = ws * ws + beta * horner(P, K, sig)
             if g0 > 0.0 and g1 <= 0.0:
-                sig = _root_force(W, P, K, beta, 0.0, sig)
+                sig = end_root(W, P, K, beta, END_FORCE, 0.0, sig)
                 switched = True
                 separated = False
         if p > 0.0 and p1 <= 0.0:
             # turning point inside this step: largest compression
-            a = 0.0
-            b = h
-            for _ in range(200):
-                mid = 0.5 * (a + b)
-                if _horner(P, K, mid) > 0.0:
-                    a = mid
-                else:
-                    b = mid
-                if b - a < 1e-16:
-                    break
-            wm = _horner(W, K, 0.5 * (a + b))
-            xmax = wm * wm
-        w = _horner(W, K, sig)
-        p = _horner(P, K, sig)
-        t = _horner(T, K, sig)
-        m = _horner(M, K, sig)
+            xmax = largest_compression(W, P, K, h)
+        w = horner(W, K, sig)
+        p = horner(P, K, sig)
+        t = horner(T, K, sig)
+        m = horner(M, K, sig)
         if switched:
             out[COL_TAU_FORCE] = t
             out[COL_EPS_FORCE] = -p

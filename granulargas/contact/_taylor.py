@@ -50,7 +50,8 @@ MAX_STEPS = 200000
 
 
 @jit
-def _horner(c, K, sigma):
+def horner(c, K, sigma):
+    """sum_{k<=K} c_k sigma^k."""
     v = c[K]
     for k in range(K - 1, -1, -1):
         v = v * sigma + c[k]
@@ -58,8 +59,8 @@ def _horner(c, K, sigma):
 
 
 @jit
-def _horner_d(c, K, sigma):
-    # value and derivative of sum c_k sigma^k
+def horner_d(c, K, sigma):
+    """Value and derivative in sigma of sum_{k<=K} c_k sigma^k."""
     v = c[K]
     d = 0.0
     for k in range(K - 1, -1, -1):
@@ -104,18 +105,21 @@ def _coefficients(beta, K, W, P, T, Wb, Pb, Tb, Q, R, F, Qb, Rb, Fb):
 @jit
 def _force_poly(W, P, K, beta, sigma):
     # g = w^2 + beta p and its derivative in s
-    w, dw = _horner_d(W, K, sigma)
-    p, dp = _horner_d(P, K, sigma)
+    w, dw = horner_d(W, K, sigma)
+    p, dp = horner_d(P, K, sigma)
     return w * w + beta * p, 2.0 * w * dw + beta * dp
 
 
 @jit
-def _root(W, P, K, beta, end, a, b):
-    """Safeguarded Newton for the end condition on [a, b] (f(a) > 0 >= f(b))."""
+def end_root(W, P, K, beta, end, a, b):
+    """Safeguarded Newton for an end condition on [a, b] (f(a) > 0 >= f(b)).
+
+    END_OVERLAP: w(sigma) = 0; END_FORCE: w^2 + beta p = 0 (the regularised
+    system's series W, P of order K)."""
     x = 0.5 * (a + b)
     for _ in range(200):
         if end == END_OVERLAP:
-            f, df = _horner_d(W, K, x)
+            f, df = horner_d(W, K, x)
         else:
             f, df = _force_poly(W, P, K, beta, x)
         if f > 0.0:
@@ -134,6 +138,23 @@ def _root(W, P, K, beta, end, a, b):
             break
         x = xn
     return x
+
+
+@jit
+def largest_compression(W, P, K, h):
+    """x = w^2 at the root of p(sigma) on [0, h] (p(0) > 0 >= p(h)), by bisection."""
+    a = 0.0
+    b = h
+    for _ in range(200):
+        mid = 0.5 * (a + b)
+        if horner(P, K, mid) > 0.0:
+            a = mid
+        else:
+            b = mid
+        if b - a < 1e-16:
+            break
+    wm = horner(W, K, 0.5 * (a + b))
+    return wm * wm
 
 
 @jit
@@ -197,44 +218,31 @@ def contact_solve(beta, end, order, tol, out):
                         h = hm
         if h > 1e3:
             h = 1e3
-        w1 = _horner(W, K, h)
+        w1 = horner(W, K, h)
         g0 = w * w + beta * p
         found = False
         sig = h
         if w > 0.0 and w1 <= 0.0:
             # x returns to zero within this step
-            sig = _root(W, P, K, beta, END_OVERLAP, 0.0, h)
+            sig = end_root(W, P, K, beta, END_OVERLAP, 0.0, h)
             found = True
             if end == END_FORCE and beta > 0.0:
                 # the force vanished before x = 0: g(sig) = beta p < 0
-                sig = _root(W, P, K, beta, END_FORCE, 0.0, sig)
+                sig = end_root(W, P, K, beta, END_FORCE, 0.0, sig)
         elif end == END_FORCE and p < 0.0 and g0 > 0.0:
-            g1 = _horner(W, K, h) ** 2 + beta * _horner(P, K, h)
+            g1 = horner(W, K, h) ** 2 + beta * horner(P, K, h)
             if g1 <= 0.0:
-                sig = _root(W, P, K, beta, END_FORCE, 0.0, h)
+                sig = end_root(W, P, K, beta, END_FORCE, 0.0, h)
                 found = True
-        if p > 0.0:
+        if p > 0.0 and horner(P, K, h) <= 0.0:
             # the maximum compression lies where p = 0; track x_max on the fly
-            p1 = _horner(P, K, h)
-            if p1 <= 0.0:
-                a = 0.0
-                b = h
-                for _ in range(200):
-                    mid = 0.5 * (a + b)
-                    if _horner(P, K, mid) > 0.0:
-                        a = mid
-                    else:
-                        b = mid
-                    if b - a < 1e-16:
-                        break
-                wm = _horner(W, K, 0.5 * (a + b))
-                xmax = wm * wm
-        w, dw = _horner_d(W, K, sig)
-        p, dp = _horner_d(P, K, sig)
-        t, dt = _horner_d(T, K, sig)
-        wb = _horner(Wb, K, sig)
-        pb = _horner(Pb, K, sig)
-        tb = _horner(Tb, K, sig)
+            xmax = largest_compression(W, P, K, h)
+        w, dw = horner_d(W, K, sig)
+        p, dp = horner_d(P, K, sig)
+        t, dt = horner_d(T, K, sig)
+        wb = horner(Wb, K, sig)
+        pb = horner(Pb, K, sig)
+        tb = horner(Tb, K, sig)
         s += sig
         if found:
             if end == END_OVERLAP or beta == 0.0:

@@ -17,12 +17,13 @@ from pathlib import Path
 from granulargas.dem import lammps
 from granulargas.errors import ConfigError
 from granulargas.io.paths import existing_directory
-from granulargas.run.prepare import initial_state, reduced_prefactor
+from granulargas.run.prepare import initial_state, reduced_prefactor, reduced_young_modulus
 from granulargas.run.schedule import DEFAULT_OBSERVABLE_SAMPLES
 
 
-def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_per_contact: int = 50,
-                  end_time: float | None = None, poisson_ratio: float | None = None, name: str = "granulargas"):
+def export_lammps(config, directory, *, contact_fraction: float | None = 0.01, steps_per_contact: int = 50,
+                  end_time: float | None = None, poisson_ratio: float | None = None, name: str = "granulargas",
+                  pressure: bool = False, contact_pairs: bool = False):
     """Write LAMMPS data + input for a run config (same initial state as ``granulargas run``).
 
     Parameters
@@ -31,7 +32,11 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
         A viscoelastic (or elastic) config.
     directory : path
         Output directory for ``data.<name>``, ``in.<name>``, ``granulargas_lammps.json``.
-    contact_fraction, steps_per_contact :
+    contact_fraction : float or None
+        See :func:`granulargas.dem.lammps.write_lammps_gas`. None: the stiffness of the
+        config's ``[collision.material]`` (:func:`granulargas.run.prepare.reduced_young_modulus`),
+        the contact that ``[collision] duration = "resolved"`` resolves.
+    steps_per_contact, pressure, contact_pairs :
         See :func:`granulargas.dem.lammps.write_lammps_gas`.
     end_time : float, optional
         Simulated time (default: the config's ``run.end_time``).
@@ -57,6 +62,12 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
     end_time = config.run.end_time if end_time is None else end_time
     if end_time is None:
         raise ConfigError(f"{config.source}: run.end_time is not set: LAMMPS runs for a fixed time (use --end-time)")
+    young = None
+    if contact_fraction is None:
+        if c.material is None:
+            raise ConfigError(f"{config.source}: no [collision.material]: the material stiffness needs it "
+                              "(give a contact fraction instead)")
+        young = reduced_young_modulus(config)
     if c.model == "elastic":
         prefactor, end = 0.0, "overlap"
     else:
@@ -76,5 +87,6 @@ def export_lammps(config, directory, *, contact_fraction: float = 0.01, steps_pe
         directory, state.positions, state.velocities, state.radii, state.masses, state.box, prefactor,
         end=end, end_time=end_time, thermo_interval=interval, contact_fraction=contact_fraction,
         steps_per_contact=steps_per_contact, poisson_ratio=poisson_ratio, name=name, source=config.source,
-        time_origin=state.time, boundary=config.system.boundary,
+        time_origin=state.time, boundary=config.system.boundary, young_modulus=young, pressure=pressure,
+        contact_pairs=contact_pairs,
     )

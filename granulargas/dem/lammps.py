@@ -276,6 +276,81 @@ def loop_time(text: str) -> float:
     return sum(float(m.group(1)) for m in re.finditer(r"Loop time of ([0-9.eE+-]+) on", text))
 
 
+def read_contacts(path: str | Path, radii=None, contact: "DemContact | None" = None):
+    """Collisions and stored elastic energy of a LAMMPS gas run from its contact dump.
+
+    Reads the ``contacts.<name>`` dump of :func:`write_lammps_gas` (``contact_pairs=True``:
+    atom ids and distance of every overlapping pair at every step) and counts, at each
+    step, the pairs in contact that were not in contact at the step before: one per
+    collision, as long as a contact spans at least one step (the export's timestep is
+    a fraction of the contact time). A pair that touches again after separating counts
+    again. With ``radii`` and ``contact`` it also sums the elastic Hertz energy of the
+    contacts, (8/15) E_eff sqrt(R_eff) xi^(5/2) per pair, E_eff = Y / (2 (1 - nu^2)),
+    xi = R_i + R_j - r (the potential of the elastic force of
+    :class:`DemContact`; the kinetic temperature of a DEM gas leaves it out).
+
+    Parameters
+    ----------
+    path : path
+    radii : float array (N,), optional
+        Radius of atom id k at index k - 1 (the order :func:`write_lammps_gas` writes).
+    contact : DemContact, optional
+
+    Returns
+    -------
+    steps, new : int arrays (S,)
+        Dumped steps and the new contacts at each (0 at the first dumped step).
+    elastic : float array (S,) or None
+        Elastic energy stored in the contacts at each dumped step.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise InputFileError(f"{path}: no such LAMMPS contact dump")
+    energy = radii is not None and contact is not None
+    if energy:
+        radii = np.asarray(radii, dtype=float)
+        e_eff = contact.young_modulus / (2.0 * (1.0 - contact.poisson_ratio**2))
+    steps, new, elastic = [], [], []
+    previous: set = set()
+    with open(path) as fh:
+        while True:
+            line = fh.readline()
+            if not line:
+                break
+            if not line.startswith("ITEM: TIMESTEP"):
+                raise InputFileError(f"{path}: expected 'ITEM: TIMESTEP', found {line.strip()!r}")
+            step = int(fh.readline())
+            fh.readline()  # ITEM: NUMBER OF ENTRIES
+            count = int(fh.readline())
+            line = fh.readline()
+            while line and not line.startswith("ITEM: ENTRIES"):  # box bounds
+                line = fh.readline()
+            current = set()
+            e = 0.0
+            for _ in range(count):
+                words = fh.readline().split()
+                i, j = int(float(words[0])), int(float(words[1]))
+                current.add((i, j) if i < j else (j, i))
+                if energy:
+                    ri, rj = radii[i - 1], radii[j - 1]
+                    xi = ri + rj - float(words[2])
+                    if xi > 0.0:
+                        e += (8.0 / 15.0) * e_eff * math.sqrt(ri * rj / (ri + rj)) * xi**2.5
+            steps.append(step)
+            new.append(len(current - previous) if len(steps) > 1 else 0)
+            elastic.append(e)
+            previous = current
+    return (np.array(steps, dtype=np.int64), np.array(new, dtype=np.int64),
+            np.array(elastic) if energy else None)
+
+
+def output_time(text: str) -> float:
+    """Sum of the ``Output`` rows of the timing breakdowns of a log (s): the time
+    LAMMPS spent writing thermo lines and dumps, part of :func:`loop_time`."""
+    return sum(float(m.group(1)) for m in re.finditer(r"^Output\s*\|\s*[0-9.eE+-]+\s*\|\s*([0-9.eE+-]+)", text,
+                                                      flags=re.M))
+
+
 # --------------------------------------------------------------------------- head-on collisions
 
 
@@ -477,7 +552,7 @@ MAX_MASS_TYPES = 32
 def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefactor, *, end="overlap",
                      end_time, thermo_interval=None, contact_fraction=0.01, steps_per_contact=50,
                      poisson_ratio=DEFAULT_POISSON, name="granulargas", source="", time_origin=0.0,
-                     boundary=None) -> LammpsExport:
+                     boundary=None, young_modulus=None, pressure=False, contact_pairs=False) -> LammpsExport:
     """Write a LAMMPS data file and input script equivalent to one of our runs.
 
     Parameters
@@ -510,6 +585,19 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         "periodic" or "wall" per axis (default all periodic). A wall axis becomes a
         fixed (``f``) LAMMPS boundary with a ``fix wall/gran`` of the same contact law
         at 0 and L for each atom type (:meth:`DemContact.wall_fix`).
+    young_modulus : float, optional
+        The stiffness Y (reduced units) instead of the one ``contact_fraction``
+        gives, e.g. that of a config's ``[collision.material]``; the export then
+        reports the contact fraction this Y has.
+    pressure : bool
+        Add the thermo column ``f_granP``: the pressure (kinetic with the peculiar
+        velocities + pair virial, ``compute pressure`` of ``c_granT``) averaged over
+        every step of the thermo interval that ends at the row (``fix ave/time``).
+    contact_pairs : bool
+        Dump the atom ids and the distance of every pair in contact (overlap > 0)
+        at every step to ``contacts.<name>`` (``compute property/local`` and
+        ``compute pair/local ... cutoff radius``); :func:`read_contacts` turns it
+        into the number of collisions and the elastic energy stored in the contacts.
 
     Notes
     -----
@@ -526,7 +614,7 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     n, d = positions.shape
     if d not in (2, 3):
         raise ValueError(f"dimension must be 2 or 3, not {d}")
-    if not 0.0 < contact_fraction < 1.0:  # also rejects nan
+    if young_modulus is None and not 0.0 < contact_fraction < 1.0:  # also rejects nan
         raise UserError(f"contact fraction = {contact_fraction}: must lie in (0, 1)")
     if steps_per_contact < 2:
         raise UserError(f"steps per contact = {steps_per_contact}: must be an integer >= 2")
@@ -551,8 +639,15 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     tau_free = enskog_mean_free_time(d, packing, sigma, mass, temperature)
     r_eff, m_eff = sigma / 4.0, mass / 2.0
     g_thermal = math.sqrt(2.0 * temperature / m_eff)
-    t_contact = contact_fraction * tau_free
-    young = stiffness_for_contact_time(t_contact, g_thermal, r_eff, m_eff, poisson_ratio)
+    if young_modulus is None:
+        t_contact = contact_fraction * tau_free
+        young = stiffness_for_contact_time(t_contact, g_thermal, r_eff, m_eff, poisson_ratio)
+    else:
+        if not young_modulus > 0.0:
+            raise UserError(f"Young modulus = {young_modulus}: must be > 0")
+        young = float(young_modulus)
+        t_contact = DemContact(young, poisson_ratio, 0.0).hertz_contact_time(g_thermal, r_eff, m_eff)
+        contact_fraction = t_contact / tau_free
     contact = DemContact.from_prefactor(prefactor, young, poisson_ratio, end)
     # timestep <= t_contact / steps_per_contact, and a whole number of steps to end_time
     steps = end_time * steps_per_contact / t_contact
@@ -621,7 +716,19 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     lines += [
         "compute granT all temp/com",
         "compute_modify granT extra/dof 0",
-        "thermo_style custom step time c_granT cpu",
+    ]
+    columns = "step time c_granT"
+    if pressure:
+        lines += ["compute granPress all pressure granT",
+                  f"fix granP all ave/time 1 {thermo_every} {thermo_every} c_granPress"]
+        columns += " f_granP"
+    if contact_pairs:
+        lines += ["compute granPairs all property/local patom1 patom2 cutoff radius",
+                  "compute granDist all pair/local dist cutoff radius",
+                  f"dump granPairs all local 1 contacts.{name} c_granPairs[1] c_granPairs[2] c_granDist",
+                  f"dump_modify granPairs format float %.17g"]
+    lines += [
+        f"thermo_style custom {columns} cpu",
         "thermo_modify norm no flush yes format float %.12g",
         f"thermo {thermo_every}",
         f"run {steps}",

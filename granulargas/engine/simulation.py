@@ -49,21 +49,28 @@ MIN_BOX_DIAMETERS = 3.15
 def default_shell(packing: float, dimension: int = 3) -> float:
     """Neighbour-list shell width in units of the largest diameter.
 
-    A thin shell means short lists but frequent expiries; the optimum drops
-    with density (tuned with ``scripts/bench_engine.py`` and, for dilute
-    gases, ``scripts/bench_shell.py``). Below packing 0.15 in 3D the shell
-    keeps about 12 list centres within the cut-off 1 + shell of a particle
-    (number density 6 eta / pi): ``(1 + shell)^3 = 1.5 / eta``, between 1.2 and
-    3.5 (the range measured, packing 0.15 down to 0.016). A fixed shell would let
-    the expiries per collision grow as the mean free path, 1 / eta.
+    A thin shell means short lists but frequent expiries (a particle leaves its
+    shell every shell/2 of travel), a wide one long lists that every prediction
+    scans. The fastest shells measured (``scripts/bench_shell.py``, 3D packing 0.05
+    to 0.45, 2D 0.05 to 0.55) keep about 12 list centres within the cut-off
+    1 + shell of a particle, whatever the packing:
+
+    * 3D (number density 6 eta / pi): ``(1 + shell)^3 = 1.5 / eta``, between 0.4
+      and 3.5;
+    * 2D (number density 4 eta / pi): ``(1 + shell)^2 = 3 / eta``, at most 8, below
+      packing 0.5; 0.7 from 0.5 on, where the disks' near-crystalline order makes
+      longer lists cost more than the expiries they save.
+
+    A fixed shell would let the expiries per collision grow as the mean free path,
+    1 / eta.
     """
-    if packing < 0.15:
-        if dimension == 3 and packing > 0.0:
-            return min(3.5, max(1.2, (1.5 / packing) ** (1.0 / 3.0) - 1.0))
-        return 1.2
-    if packing < 0.4:
+    if not packing > 0.0:
+        return 3.5 if dimension == 3 else 8.0
+    if dimension == 3:
+        return min(3.5, max(0.4, (1.5 / packing) ** (1.0 / 3.0) - 1.0))
+    if packing >= 0.5:
         return 0.7
-    return 0.45
+    return min(8.0, math.sqrt(3.0 / packing) - 1.0)
 
 
 def _part1by2(x):

@@ -28,6 +28,22 @@ advice predicts, with kinetic theory and no simulation
    speed-up is the ratio of collision rates measured by ``scripts/bench_dsmc.py``
    (docs/performance.md, DSMC section), interpolated in the packing fraction.
 
+7. the duration of the contacts (:func:`choose_duration`, material route only, where the
+   stiffness fixes the contact time): from the contact-time ratio ``<t_c> omega`` at T0
+   (:func:`granulargas.run.validity.contact_time_ratio`) and the errors of instantaneous
+   and resolved EDMD against LAMMPS measured at a few ratios by
+   ``scripts/resolved_lammps.py`` (:data:`RESOLVED_LAMMPS_MEASURED`; docs/validation.md,
+   "Against LAMMPS"), interpolated as a power law in the ratio: instantaneous
+   collisions where their predicted error is within the tolerance; else
+   ``[collision] duration = "resolved"`` where its error is and a DEM at t_c/10 (whose error
+   stayed within 1 %) would take longer (measured CPU-time ratio, :func:`dem_cost`;
+   the resolved rule itself runs at about :data:`RESOLVED_COST` the collisions per CPU
+   second of the instantaneous one, ``scripts/bench_resolved.py``); else a time-stepped
+   DEM (``granulargas export lammps --material-stiffness``). Above the largest measured
+   ratio the resolved scheme is not vouched for, nor where the fastest impact expected
+   among the config's particles (:func:`fastest_impact_bounds`) is beyond its table,
+   which the run would refuse.
+
 For a constant-eps config the advice reports the config ``damping`` (beta at
 g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
@@ -53,11 +69,14 @@ from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import ConfigError
 from granulargas.run import validity as V
-from granulargas.run.prepare import mean_particle
+from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds, reduced_compression,
+                                     reduced_prefactor)
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
-           "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line"]
+           "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line", "choose_duration",
+           "duration_error", "dem_cost", "fastest_impact_bounds", "RESOLVED_LAMMPS_MEASURED", "RESOLVED_COST",
+           "RESOLVED_THREE_BODY_CHECKED"]
 
 #: default tolerance on the relative error of T(t)
 DEFAULT_TOLERANCE = 0.02
@@ -74,6 +93,117 @@ DSMC_MAX_PACKING = 0.1
 DSMC_SPEEDUP_MEASURED = ((0.02, 252.0), (0.3, 26.0))
 
 
+#: (contact-time ratio <t_c> omega at T0, error of instantaneous EDMD, error of resolved EDMD, CPU time
+#: of LAMMPS at t_c/10 over that of resolved EDMD). Errors as fractions: the largest, over T averaged
+#: over the second half of the run (LAMMPS's with and without the elastic energy of its contacts), the
+#: collision count, the mean pressure and the mean P / (n T), of |mean| + 2 standard errors over 8 seeds
+#: of the relative deviation from LAMMPS at t_c/80 (LAMMPS at t_c/10 stays within 1 % of it). 3D,
+#: N = 2000, packing 0.05, damping 0.1, t = 0..20 (about 12 collisions per particle), one core each
+#: (``scripts/resolved_lammps.py``; docs/validation.md, "Against LAMMPS"). At t_c/t_free = 0.2 the
+#: resolved scheme refuses some initial states of this gas: the fastest impact is beyond its table.
+RESOLVED_LAMMPS_MEASURED = ((0.01, 0.0168, 0.0098, 7.16), (0.03, 0.0255, 0.0089, 2.98), (0.1, 0.0756, 0.0182, 1.42),
+                            (0.15, 0.1101, 0.0166, 1.15))
+
+#: share of the resolved collisions that met a pair still in contact at the largest contact-time
+#: ratio of :data:`RESOLVED_LAMMPS_MEASURED` (same runs)
+RESOLVED_THREE_BODY_CHECKED = 0.166
+
+#: resolved / instantaneous collisions per CPU second, 3D N = 10^4 packing 0.1
+#: (``scripts/bench_resolved.py``; docs/performance.md)
+RESOLVED_COST = 0.80
+
+
+def _measured(ratio: float, column: int) -> float:
+    """Column ``column`` of :data:`RESOLVED_LAMMPS_MEASURED` at ``ratio``: a power law between
+    neighbouring measured ratios, the outer segments' power laws beyond them."""
+    r = np.log([row[0] for row in RESOLVED_LAMMPS_MEASURED])
+    y = np.log([row[column] for row in RESOLVED_LAMMPS_MEASURED])
+    x = math.log(ratio)
+    k = int(np.clip(np.searchsorted(r, x) - 1, 0, len(r) - 2))
+    slope = (y[k + 1] - y[k]) / (r[k + 1] - r[k])
+    return float(math.exp(y[k] + slope * (x - r[k])))
+
+
+def duration_error(ratio: float, method: str) -> float:
+    """Predicted largest relative error against DEM of ``method`` ("instantaneous" or "resolved")
+    at the contact-time ratio ``ratio``: :data:`RESOLVED_LAMMPS_MEASURED` interpolated linearly in
+    log(error) against log(ratio); below the smallest measured ratio the error falls in proportion
+    to the ratio (the share of collisions that overlap a third contact, :mod:`granulargas.run.validity`);
+    above the largest the instantaneous error follows the power law of the last two points and the
+    resolved one is not known (``nan``)."""
+    col = {"instantaneous": 1, "resolved": 2}[method]
+    r0, e0 = RESOLVED_LAMMPS_MEASURED[0][0], RESOLVED_LAMMPS_MEASURED[0][col]
+    if ratio <= r0:
+        return float(e0 * ratio / r0)
+    if ratio > RESOLVED_LAMMPS_MEASURED[-1][0] and method == "resolved":
+        return math.nan
+    return _measured(ratio, col)
+
+
+def dem_cost(ratio: float) -> float:
+    """Predicted CPU time of a DEM run at t_c/10 over that of resolved EDMD at the contact-time
+    ratio ``ratio`` (:data:`RESOLVED_LAMMPS_MEASURED`, a power law in the ratio; the DEM's steps per
+    mean free time fall as 1 / ratio)."""
+    return _measured(ratio, 3)
+
+
+def fastest_impact_bounds(config) -> tuple[float, float]:
+    """(beta, delta) the resolved rule's table must hold for the fastest impact of a fresh
+    Maxwellian state of the config, predicted without building it: the largest of N thermal
+    speeds stays below v with probability 0.9 (the chi distribution with d degrees of freedom,
+    F(v)^N = 0.9; 8 states of 2000 particles had their fastest at 0.94 to 1.06 of the median), as
+    :func:`granulargas.run.prepare.oblique_bounds` takes it (relative speed twice that), for
+    particles of the mean diameter and mass."""
+    from types import SimpleNamespace
+
+    from scipy.stats import chi
+
+    s = config.system
+    sigma, mass = mean_particle(config)
+    v_max = float(chi(s.dimension, scale=math.sqrt(config.initial.temperature / mass)).ppf(0.9 ** (1.0 / s.particles)))
+    state = SimpleNamespace(masses=np.array([mass]), radii=np.array([sigma / 2]), velocities=np.array([[v_max]]))
+    return oblique_bounds(reduced_prefactor(config), reduced_compression(config), state)
+
+
+def choose_duration(config, tolerance: float = DEFAULT_TOLERANCE) -> tuple[str, str] | None:
+    """("instantaneous", "resolved" or "dem", the reason in words) for a viscoelastic config on
+    the material route (module docstring, 7.); None where the contact time is unknown (damping
+    route) or the rule is not viscoelastic."""
+    c = config.collision
+    if c.model != "viscoelastic" or c.material is None:
+        return None
+    ratio = V.contact_time_ratio(config)
+    if ratio is None:
+        return None
+    largest = RESOLVED_LAMMPS_MEASURED[-1][0]
+    e_inst = duration_error(ratio, "instantaneous")
+    dem = "use a time-stepped DEM (granulargas export lammps --material-stiffness)"
+    measured = (f"t_c/t_free = {ratio:.3g} at T0: against LAMMPS (scripts/resolved_lammps.py, measured at "
+                f"{', '.join(f'{row[0]:g}' for row in RESOLVED_LAMMPS_MEASURED)}) instantaneous collisions are off "
+                f"by about {100 * e_inst:.2g} %")
+    if e_inst <= tolerance:
+        return "instantaneous", f"{measured} (tolerance {100 * tolerance:g} %): the contact's duration does not matter"
+    if ratio > largest:
+        return "dem", f"{measured}; the resolved scheme was measured up to t_c/t_free = {largest:g} only: {dem}"
+    e_res = duration_error(ratio, "resolved")
+    cost = dem_cost(ratio)
+    if e_res > tolerance:
+        return "dem", f"{measured}, resolved collisions by about {100 * e_res:.2g} % (tolerance {100 * tolerance:g} %): {dem}"
+    beta, delta = fastest_impact_bounds(config)
+    if not (beta < OBLIQUE_BETA_MAX and delta < DELTA_MAX):
+        return "dem", (f"{measured}, resolved collisions by about {100 * e_res:.2g} %, but the fastest impact "
+                       f"expected among {config.system.particles} particles (beta = {beta:.3g}, delta = {delta:.3g}) "
+                       f"is beyond the resolved scheme's table (beta < {OBLIQUE_BETA_MAX:g}, delta < {DELTA_MAX:g}): "
+                       f"{dem}")
+    if cost < 1.0:
+        return "dem", (f"{measured}, resolved collisions by about {100 * e_res:.2g} %, but a DEM at t_c/10 costs "
+                       f"about x{cost:.2g} the CPU time of the resolved run: {dem}")
+    return "resolved", (f"{measured}, resolved collisions by about {100 * e_res:.2g} % (tolerance "
+                        f"{100 * tolerance:g} %): use [collision] duration = \"resolved\" (about x{RESOLVED_COST:g} "
+                        f"the collisions per CPU second of instantaneous ones, scripts/bench_resolved.py; a DEM at "
+                        f"t_c/10 about x{cost:.2g} its CPU time)")
+
+
 def dsmc_speedup(packing: float) -> float:
     """Predicted DSMC / EDMD collision rate at ``packing``: the measured ratios
     (:data:`DSMC_SPEEDUP_MEASURED`) interpolated as a power law in the packing fraction
@@ -84,8 +214,10 @@ def dsmc_speedup(packing: float) -> float:
     return float(r0 * math.exp(math.log(r1 / r0) * math.log(p / p0) / math.log(p1 / p0)))
 
 
-def choose_method(config, instability_length: float = math.inf) -> tuple[str, str]:
-    """("dsmc" or "edmd", the reason in words) for a config's scene (module docstring, 6.)."""
+def choose_method(config, instability_length: float = math.inf, duration: str | None = None) -> tuple[str, str]:
+    """("dsmc" or "edmd", the reason in words) for a config's scene (module docstring, 6.);
+    ``duration``: the advised collision duration (:func:`choose_duration`), "resolved" or "dem"
+    rule DSMC out."""
     s, c = config.system, config.collision
     eta = s.packing_fraction
     if "wall" in s.boundary:
@@ -94,6 +226,8 @@ def choose_method(config, instability_length: float = math.inf) -> tuple[str, st
         return "edmd", "the TC model needs pair histories of a spatial gas"
     if c.duration == "resolved":
         return "edmd", "collisions that take time need positions (DSMC's collisions are instantaneous)"
+    if duration in ("resolved", "dem"):
+        return "edmd", "the contacts last long enough to matter (duration below; DSMC's collisions are instantaneous)"
     box = _box(config)
     if box > instability_length:
         return "edmd", (f"the box {box:.4g} exceeds the instability length {instability_length:.4g}: "
@@ -135,6 +269,9 @@ class Advice:
         Predicted DSMC / EDMD collision rate at the config's packing (:func:`dsmc_speedup`).
     configured_method : str
         The config's ``run.method``.
+    duration, duration_reason : str or None
+        The collision duration the contact time needs (:func:`choose_duration`) and why;
+        None off the material route.
     notes : list of str
     """
 
@@ -153,6 +290,8 @@ class Advice:
     method_reason: str = ""
     speedup: float = math.nan
     configured_method: str = "edmd"
+    duration: str | None = None
+    duration_reason: str = ""
     notes: tuple = ()
 
     def lines(self) -> list[str]:
@@ -181,6 +320,8 @@ class Advice:
             out.append(f"method       {name} (run.method = \"{self.method}\"): {self.method_reason}{speed}")
             if self.configured_method != self.method:
                 out.append(f"             the config has run.method = \"{self.configured_method}\"")
+        if self.duration is not None:
+            out.append(f"duration     {self.duration}: {self.duration_reason}")
         out += [f"note         {n}" for n in self.notes]
         return out
 
@@ -265,13 +406,15 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         adv.eps_best, adv.error = best_constant(gas, curve, t_end)
         adv.constant_ok = adv.error <= tolerance
         adv.instability_length = gas.instability_length()
-        if config.collision.duration == "resolved":
+        chosen = choose_duration(config, tolerance)
+        if chosen is not None:
+            adv.duration, adv.duration_reason = chosen
+        if config.collision.duration == "resolved" or adv.duration in ("resolved", "dem"):
             ratio = V.contact_time_ratio(config)
             share = "" if ratio is None else (f"; of the order of {100 * (1 - math.exp(-2 * ratio)):.2g} % of the collisions "
                                               "will meet a pair still in contact (three_body_contacts)")
-            notes.append('duration = "resolved": the constant-eps comparison above is one of instantaneous '
-                         "collisions, which leave out the contact's duration and the turn of the normal"
-                         + share)
+            notes.append("the constant-eps comparison above is one of instantaneous collisions, which leave out "
+                         "the contact's duration and the turn of the normal" + share)
         elif adv.constant_ok:
             notes.append(f'use [collision] model = "constant", restitution = {adv.eps_best:.4f} '
                          "(cost per collision is nearly the same; the gain is a closed-form reference, Haff's law)")
@@ -307,7 +450,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
 
 def _set_method(adv: Advice, config):
     length = adv.instability_length if math.isfinite(adv.instability_length) else math.inf
-    adv.method, adv.method_reason = choose_method(config, length)
+    adv.method, adv.method_reason = choose_method(config, length, adv.duration)
     adv.speedup = dsmc_speedup(config.system.packing_fraction)
     adv.configured_method = config.run.method
 

@@ -255,11 +255,17 @@ def reduced_prefactor(config: RunConfig) -> float:
     return k_si * (m.diameter * m.speed_unit / reference_mass_si(m) ** 2) ** 0.2
 
 
+def reduced_young_modulus(config: RunConfig) -> float:
+    """The Young modulus of ``[collision.material]`` in reduced units (energy / length^3):
+    Y diameter^3 / (m_ref speed_unit^2)."""
+    m = config.collision.material
+    return float(m.young_modulus * m.diameter**3 / (reference_mass_si(m) * m.speed_unit**2))
+
+
 def reduced_compression(config: RunConfig) -> float:
     """The compression prefactor q of ``[collision.material]`` in reduced units (module docstring)."""
     m = config.collision.material
-    young = m.young_modulus * m.diameter**3 / (reference_mass_si(m) * m.speed_unit**2)
-    return float(compression_prefactor(young, m.poisson_ratio))
+    return float(compression_prefactor(reduced_young_modulus(config), m.poisson_ratio))
 
 
 def oblique_bounds(prefactor: float, compression: float, state: InitialState) -> tuple[float, float]:

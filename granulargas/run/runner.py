@@ -58,6 +58,7 @@ from granulargas.io.config import RunConfig, parse_config
 from granulargas.io.h5md import H5MDWriter, read_parameters
 from granulargas.io.paths import existing_directory, output_file
 from granulargas.observables import sonine_coefficients
+from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
 from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
@@ -97,8 +98,9 @@ class RunSummary:
         extra = []
         if self.three_body_contacts is not None:
             share = self.three_body_contacts / self.collisions if self.collisions else 0.0
-            note = ("; above 1 %: the two-body contacts of the resolved scheme are off, use DEM"
-                    if share > 0.01 else "")
+            note = (f"; more than the {100 * RESOLVED_THREE_BODY_CHECKED:.2g} % met at the longest contacts for which "
+                    "the resolved scheme was checked against LAMMPS (scripts/resolved_lammps.py): use DEM"
+                    if share > RESOLVED_THREE_BODY_CHECKED else "")
             extra.append(f"three-body   {self.three_body_contacts} collisions with a pair still in contact "
                          f"({100.0 * share:.3g} % of the collisions{note})")
         return [

@@ -146,15 +146,29 @@ def output_counts(config: RunConfig) -> tuple[float, float]:
     return float(out.snapshot_count), float(DEFAULT_OBSERVABLE_SAMPLES + 1)
 
 
+def frame_columns(config: RunConfig) -> int:
+    """Float64/int64 values stored per particle in one snapshot of the run's H5MD file.
+
+    Event-driven runs: position, velocity and image (3 d), plus the last collision
+    times of the TC model (1) or the contacts under way of collisions that take time
+    (2: ``contact_until``, ``contact_partner``). DSMC runs store velocities only (d).
+    """
+    d = config.system.dimension
+    if config.run.method == "dsmc":
+        return d
+    c = config.collision
+    extra = 1 if c.model == "constant" and c.tc_time is not None else 0
+    return 3 * d + extra + (2 if c.duration == "resolved" else 0)
+
+
 def check_output_size(config: RunConfig, n: int | None = None, *, available: float | None = None,
                       free_disk: float | None = None) -> tuple[float, float]:
     """Refuse a schedule that does not fit in memory, or an output file that does not fit
     on its disk (one line naming the key), before :func:`output_schedule` allocates it.
 
     Memory: 64 B per output time (the arrays the schedule builds and merges). Disk:
-    24 d B per particle and frame (positions, velocities, images; 8 B more with the TC
-    model's last collision times), 8 (8 + d) B per observables sample. Returns
-    (schedule bytes, file bytes)."""
+    8 B per particle, frame and stored column (:func:`frame_columns`), 8 (8 + d) B per
+    observables sample. Returns (schedule bytes, file bytes)."""
     s, out = config.system, config.output
     n = s.particles if n is None else int(n)
     d = s.dimension
@@ -173,8 +187,7 @@ def check_output_size(config: RunConfig, n: int | None = None, *, available: flo
     if not math.isfinite(samples) or (available is not None and schedule > available):
         raise ConfigError(f"{src}: {key} = {value!r}: {samples:.3g} output times; the schedule alone needs "
                           f"{format_bytes(schedule)} of memory, {format_bytes(available) if available is not None else 'an unknown amount'} are available")
-    tc = config.collision.model == "constant" and config.collision.tc_time is not None
-    frame = n * 8.0 * (3 * d + (1 if tc else 0))
+    frame = n * 8.0 * frame_columns(config)
     file_bytes = snaps * frame + samples * 8.0 * (8 + d) + n * 24.0
     if free_disk is None:
         directory = Path(out.file).parent

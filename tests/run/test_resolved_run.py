@@ -104,4 +104,19 @@ def test_advise_keeps_a_resolved_config_on_edmd(write_config):
     adv = advise(load_config(write_config(RESOLVED)))
     text = "\n".join(adv.lines())
     assert 'EDMD (run.method = "edmd"): collisions that take time need positions' in text
-    assert 'duration = "resolved"' in text and 'model = "constant"' not in text
+    # the contact-time ratio (0.168 at T0) decides the duration; constant eps is never offered
+    assert "duration     " in text and "t_c/t_free = 0.168" in text and 'model = "constant"' not in text
+
+
+@pytest.mark.parametrize("three_body, says_dem", [(100, False), (300, True)])
+def test_summary_says_dem_beyond_the_three_body_share_checked_against_lammps(three_body, says_dem):
+    from pathlib import Path
+
+    from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
+    from granulargas.run.runner import RunSummary
+
+    summary = RunSummary(Path("x.h5"), 1000, 2000, 1.0, 1.0, 1000.0, 1.0, 2, "end time", particles=100,
+                         three_body_contacts=three_body)
+    assert (three_body / 1000 > RESOLVED_THREE_BODY_CHECKED) == says_dem
+    line = next(ln for ln in summary.lines() if ln.startswith("three-body"))
+    assert ("use DEM" in line) == says_dem

@@ -149,3 +149,42 @@ def test_beta_beyond_the_table_names_the_damping(tmp_path):
     with pytest.raises(ConfigError, match=r"collision.damping = 39: the fastest impact the run's kinetic energy "
                                           r"allows reaches beta = .*beyond the restitution table's 40"):
         prepare(parse_config(text, "c.toml"))
+
+
+SIZED = """
+[system]
+dimension = 3
+particles = 2000
+packing_fraction = 0.1
+[collision]
+{collision}
+[run]
+end_time = 0.4
+{run}
+[output]
+file = "{out}"
+snapshots = 40
+observables_interval = 0.25
+"""
+MATERIAL = """model = "viscoelastic"
+duration = "resolved"
+[collision.material]
+young_modulus = 1e6
+poisson_ratio = 0.3
+dissipation_time = 1e-5
+diameter = 0.01
+density = 1000
+speed_unit = 0.5"""
+
+
+@pytest.mark.parametrize("collision, run", [('model = "elastic"', ""), ('model = "elastic"', 'method = "dsmc"'),
+                                            (MATERIAL, "")], ids=["edmd", "dsmc", "resolved"])
+def test_output_size_estimate_matches_the_file_written(tmp_path, collision, run):
+    """The disk estimate of check_output_size against the size of the file a run writes: the
+    frame's columns differ by method (DSMC stores no positions, resolved runs their contacts)."""
+    from granulargas.run.runner import run_config
+
+    cfg = parse_config(SIZED.format(collision=collision, run=run, out=tmp_path / "out.h5"), "c.toml")
+    _, estimate = check_output_size(cfg, available=1e10, free_disk=1e15)
+    written = run_config(cfg, quiet=True).output.stat().st_size
+    assert 0.8 < written / estimate < 1.25, (written, estimate)
