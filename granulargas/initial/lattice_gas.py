@@ -178,7 +178,9 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     sweeps : int, optional
         Monte Carlo sweeps of the melt (at packing <= 0.25) and of the final relaxation
         (default: :data:`MELT_SWEEPS` for the melt; for the relaxation the same up to
-        10^5 particles, 6 beyond).
+        10^5 particles, 6 beyond). Without growth (packing <= 0.25, lattice wide
+        enough) the final sweeps are the melt: the default is :data:`MELT_SWEEPS` for
+        every N.
 
     Raises
     ------
@@ -230,6 +232,8 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     # overlaps each step creates are pushed apart (Gauss-Seidel descent on the
     # overlaps, :func:`_montecarlo.push_some`), and a hard-sphere sweep follows.
     lam = min(1.0, dist / dmax * (1.0 - 1e-9), (0.25 / eta) ** (1.0 / d))
+    if lam == 1.0:  # no growth: the final sweeps melt the lattice, at least MELT_SWEEPS of them
+        sweeps = max(int(melt), int(sweeps))
     if lam < 1.0:
         for _ in range(int(melt)):
             do_sweep(radii * lam)
