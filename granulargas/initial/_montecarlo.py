@@ -44,13 +44,15 @@ def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
 
 
 @jit
-def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, disp):
-    """One sweep of displacement moves r_i += step * disp[i]; returns accepted count."""
+def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, u):
+    """One sweep of displacement moves r_i += step (2 u[i] - 1) (u (N, d) uniform in
+    [0, 1), d = 2 or 3); returns the accepted count."""
     accepted = 0
+    three = u.shape[1] == 3
     for i in range(r.shape[0]):
-        x = r[i, 0] + step * disp[i, 0]
-        y = r[i, 1] + step * disp[i, 1]
-        z = r[i, 2] + step * disp[i, 2]
+        x = r[i, 0] + step * (2.0 * u[i, 0] - 1.0)
+        y = r[i, 1] + step * (2.0 * u[i, 1] - 1.0)
+        z = r[i, 2] + step * (2.0 * u[i, 2] - 1.0) if three else r[i, 2]
         x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
         y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
         z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
@@ -96,10 +98,10 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
 
 
 @jit
-def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, disp):
+def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, u):
     """Sweep of moves accepted when the moved particle's overlap depth does not grow.
 
-    Non-overlapping particles therefore move as hard spheres while overlapping
+    Moves r_i += step (2 u[i] - 1) as in :func:`sweep`. Non-overlapping particles therefore move as hard spheres while overlapping
     ones are pushed apart (zero-temperature overlap relaxation). Returns the
     number of particles still overlapping after their move.
     """
@@ -107,9 +109,9 @@ def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of,
     for i in range(r.shape[0]):
         old = overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
                             cell_next)
-        x = r[i, 0] + step * disp[i, 0]
-        y = r[i, 1] + step * disp[i, 1]
-        z = r[i, 2] + step * disp[i, 2]
+        x = r[i, 0] + step * (2.0 * u[i, 0] - 1.0)
+        y = r[i, 1] + step * (2.0 * u[i, 1] - 1.0)
+        z = r[i, 2] + step * (2.0 * u[i, 2] - 1.0) if u.shape[1] == 3 else r[i, 2]
         x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
         y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
         z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)

@@ -178,7 +178,9 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     sweeps : int, optional
         Monte Carlo sweeps of the melt (at packing <= 0.25) and of the final relaxation
         (default: :data:`MELT_SWEEPS` for the melt; for the relaxation the same up to
-        10^5 particles, 6 beyond).
+        10^5 particles, 6 beyond). Without growth (packing <= 0.25, lattice wide
+        enough) the final sweeps are the melt: the default is :data:`MELT_SWEEPS` for
+        every N.
 
     Raises
     ------
@@ -216,12 +218,12 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     melt = MELT_SWEEPS if sweeps is None else sweeps
     if sweeps is None:
         sweeps = MELT_SWEEPS if n <= 100_000 else 6
-    disp = np.zeros((n, 3))
+    u = np.empty((n, d))  # uniform random numbers of a sweep
     state = {"step": 0.1 * dmax}
 
     def do_sweep(rad):
-        disp[:, :d] = rng.uniform(-1.0, 1.0, size=(n, d))
-        acc = mc.sweep(r3, rad, box3, ncell, head, nxt, prv, cof, state["step"], disp) / n
+        rng.random(out=u)
+        acc = mc.sweep(r3, rad, box3, ncell, head, nxt, prv, cof, state["step"], u) / n
         state["step"] = min(0.5 * float(box.min()), state["step"] * min(2.0, max(0.5, acc / 0.4)))
 
     # Dense systems (and lattices too tight for the largest particles) start
@@ -230,6 +232,8 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     # overlaps each step creates are pushed apart (Gauss-Seidel descent on the
     # overlaps, :func:`_montecarlo.push_some`), and a hard-sphere sweep follows.
     lam = min(1.0, dist / dmax * (1.0 - 1e-9), (0.25 / eta) ** (1.0 / d))
+    if lam == 1.0:  # no growth: the final sweeps melt the lattice, at least MELT_SWEEPS of them
+        sweeps = max(int(melt), int(sweeps))
     if lam < 1.0:
         for _ in range(int(melt)):
             do_sweep(radii * lam)
@@ -250,14 +254,15 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             if len(idx) == 0:
                 break
             if it % 100 == 99:  # jammed spots: let the hard-sphere surroundings make room
-                disp[:, :d] = rng.uniform(-1.0, 1.0, size=(n, d))
-                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, disp)
+                rng.random(out=u)
+                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, u)
                 idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
                 continue
             kick = rng.uniform(0.5, 1.5, size=len(idx))
             m = mc.push_some(idx, r3, rad, box3, ncell, head, nxt, prv, cof, kick, PUSH_MARGIN * grow,
                              near, buf)
-            idx = np.sort(uniq[: mc.distinct(buf, m, seen, uniq)])  # = np.unique(buf[:m])
+            # in order of first appearance (a pushed particle's new partners, then itself)
+            idx = uniq[: mc.distinct(buf, m, seen, uniq)].copy()
         if len(idx):  # stuck: undo, grow more gently
             r3[:] = saved
             mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)

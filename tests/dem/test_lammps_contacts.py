@@ -18,6 +18,7 @@ from granulargas.dem.export import export_lammps
 from granulargas.dem.lammps import DemContact, find_lmp, read_contacts, read_thermo, run_lammps
 from granulargas.io.config import parse_config
 from granulargas.run.prepare import reduced_prefactor
+from tests.materials import RUBBER
 
 needs_lmp = pytest.mark.skipif(find_lmp() is None, reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
 
@@ -40,14 +41,6 @@ end_time = {end}
 observables_interval = {interval}
 """
 
-RUBBER = """[collision.material]
-young_modulus = 1e6
-poisson_ratio = 0.3
-dissipation_time = 1e-5
-diameter = 0.01
-density = 1000
-speed_unit = 0.5
-"""
 
 
 def test_material_stiffness_is_the_configs_young_modulus_in_reduced_units(tmp_path):

@@ -98,9 +98,9 @@ def test_neighbour_lists_grow_when_full():
     """Lists cut to their current fullest length overflow during the run, grow, and
     the trajectory is bit-identical to an undisturbed run."""
     # whether a list outgrows the fullest initial one by t = 2 depends on the state:
-    # about half of the seeds do (10 of seeds 0-19); seed 0 does
-    ref = make_sim(n=300, packing=0.45, seed=0, shell=1.0)
-    sim = make_sim(n=300, packing=0.45, seed=0, shell=1.0)
+    # about half of the seeds do (11 of seeds 0-19); seed 1 does
+    ref = make_sim(n=300, packing=0.45, seed=1, shell=1.0)
+    sim = make_sim(n=300, packing=0.45, seed=1, shell=1.0)
     sim._nb_width = 4  # overflow in the first build
     sim._build()
     lists = sim._engine.lists

@@ -8,6 +8,7 @@ from granulargas.cli import main
 from granulargas.io.config import load_config
 from granulargas.io.h5md import load_snapshot, read_observables, read_parameters
 from granulargas.run.runner import run_config
+from tests.materials import RUBBER
 
 #: a soft rubber-like material: t_c / t_free ~ 0.1 at packing 0.1
 RESOLVED = """
@@ -21,14 +22,7 @@ seed = 3
 model = "viscoelastic"
 duration = "resolved"
 
-[collision.material]
-young_modulus = 1e6
-poisson_ratio = 0.3
-dissipation_time = 1e-5
-diameter = 0.01
-density = 1000
-speed_unit = 0.5
-
+""" + RUBBER + """
 [run]
 end_time = 4.0
 

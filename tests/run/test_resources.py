@@ -14,6 +14,7 @@ from granulargas.io.config import parse_config
 from granulargas.run import resources
 from granulargas.run.schedule import check_output_size, output_counts, output_schedule, pacing_stops
 from granulargas.run.validity import check_run
+from tests.materials import RUBBER
 
 BASE = """
 [system]
@@ -166,15 +167,7 @@ file = "{out}"
 snapshots = 40
 observables_interval = 0.25
 """
-MATERIAL = """model = "viscoelastic"
-duration = "resolved"
-[collision.material]
-young_modulus = 1e6
-poisson_ratio = 0.3
-dissipation_time = 1e-5
-diameter = 0.01
-density = 1000
-speed_unit = 0.5"""
+MATERIAL = 'model = "viscoelastic"\nduration = "resolved"\n' + RUBBER
 
 
 @pytest.mark.parametrize("collision, run", [('model = "elastic"', ""), ('model = "elastic"', 'method = "dsmc"'),
