@@ -49,7 +49,8 @@ def profile(n, packing, walls=False, seed=1, neighbours="lists"):
     def go(ncoll):
         c0 = sim.collisions
         w = time.perf_counter()
-        status = _loop.advance(sim._engine, prm, np.inf, 10**12, c0 + ncoll, probe)
+        e = sim._engine
+        status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, np.inf, 10**12, c0 + ncoll, probe)
         assert status == _loop.MAX_COLLISIONS, status
         return time.perf_counter() - w, sim.collisions - c0
 

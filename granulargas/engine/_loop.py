@@ -33,10 +33,12 @@ course.) :func:`predict` keeps the earliest of a particle's own kinds.
 Two neighbour modes share the loop: neighbour lists (EXPIRY events, the
 records ``Lists`` and ``Cells``) or cell crossings (CROSS events, no lists:
 :mod:`granulargas.engine._crossing`; ``engine.lists`` is then a ``Grid`` and
-``engine.cells`` None). The functions that differ between them
-(:func:`predict_bound`, :func:`predict_neighbours`, :func:`execute_bound`,
-:func:`prefetch_next`, ...) are numba overloads selected by the type of
-``lists``, so each mode's build of the loop carries none of the other's code.
+``engine.cells`` None). :func:`advance` and :func:`predict` take the mode as two
+arguments, ``onlists`` and ``oncells``, one of them 1 and the other None
+(:func:`mode_flags`), and branch on ``is not None``: numba removes the branches
+of a None-typed argument before typing, so each mode's build of the loop carries
+none of the other's code (numba overloads would do the same at about twice the
+first compile time).
 
 Particles stream lazily: each carries its own clock and is moved to the
 current time only when it takes part in an event. The data a prediction reads
@@ -101,7 +103,6 @@ from granulargas.engine._drive import kick_velocities
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image, wall_delay
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._resolved import resolved_pair
-from granulargas.engine._state import Grid
 from granulargas.engine._probe import (
     COLLIDE,
     PEEK,
@@ -297,86 +298,44 @@ def predict_kick(c, prm):
     return (c.kick_step + 0.5) * prm.kick_interval if prm.kick_interval < math.inf else math.inf
 
 
-#: the overloads' implementations are compiled like kernels: no reference counting of the
-#: arrays they pass on (each per-event call would otherwise count every array of the state)
-_NO_REFCOUNT = {"_nrt": False}
-
-
-def _is_grid(lists):
-    return getattr(lists, "instance_class", None) is Grid
-
-
-def predict_bound(i, t, rec, lists, space, half_shell):
-    """The event that ends particle i's neighbourhood: (time, kind, tag) -- its list
-    expiry (EXPIRY, 0) or its cell crossing (CROSS, face)."""
-
-
-def predict_neighbours(i, t, before, rec, count, lists, space):
-    """:func:`predict_pair` over i's neighbour list or :func:`predict_pair_cells` over
-    the particles of its neighbour cells."""
-
-
-def execute_bound(i, tag, te, p, lists, cells, c, prm):
-    """:func:`execute_expiry` or :func:`execute_crossing`."""
-
-
-def prefetch_partner_neighbours(j, rec, lists):
-    """Prefetch hints for the records :func:`predict` (j) reads (lists: j's neighbours)."""
-
-
-@overload(predict_bound, jit_options=_NO_REFCOUNT, inline="always")
-def _predict_bound(i, t, rec, lists, space, half_shell):
-    if _is_grid(lists):
-        def impl(i, t, rec, lists, space, half_shell):
-            tc, face = predict_crossing(i, t, rec, lists, space)
-            return tc, CROSS, face
-        return impl
-    return lambda i, t, rec, lists, space, half_shell: (
-        predict_expiry(i, t, rec, lists.centre, space.period, half_shell), EXPIRY, 0)
-
-
-@overload(predict_neighbours, jit_options=_NO_REFCOUNT, inline="always")
-def _predict_neighbours(i, t, before, rec, count, lists, space):
-    if _is_grid(lists):
-        return lambda i, t, before, rec, count, lists, space: predict_pair_cells(i, t, before, rec, count,
-                                                                                 lists, space)
-    return lambda i, t, before, rec, count, lists, space: predict_pair(i, t, before, rec, lists.nbl,
-                                                                       lists.nbn, space.period)
-
-
-@overload(execute_bound, jit_options=_NO_REFCOUNT, inline="always")
-def _execute_bound(i, tag, te, p, lists, cells, c, prm):
-    if _is_grid(lists):
-        return lambda i, tag, te, p, lists, cells, c, prm: execute_crossing(i, tag, te, p, lists, c, prm)
-    return lambda i, tag, te, p, lists, cells, c, prm: execute_expiry(i, te, p, lists, cells, c, prm)
-
-
-@overload(prefetch_partner_neighbours, jit_options=_NO_REFCOUNT, inline="always")
-def _prefetch_partner_neighbours(j, rec, lists):
-    if _is_grid(lists):
-        return lambda j, rec, lists: None
-
-    def impl(j, rec, lists):
-        nbl = lists.nbl
-        for k in range(lists.nbn[j]):
-            prefetch(rec, nbl[j, k])
-    return impl
+def mode_flags(cells):
+    """(onlists, oncells) of :func:`advance` and :func:`predict`: (1, None) for the
+    neighbour lists (``cells`` the cell record), (None, 1) for cell crossings (``cells`` None)."""
+    return (1, None) if cells is not None else (None, 1)
 
 
 @kernel
-def predict(i, t, rec, count, events, lists, space, half_shell, contacts):
+def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
+
+    ``lists`` is the neighbour lists (``onlists`` = 1, ``oncells`` = None) or the cell
+    grid of the cell-crossing mode (``onlists`` = None, ``oncells`` = 1). Each mode's
+    build keeps only its own branches: numba removes a branch on ``x is not None`` of
+    a None-typed argument before typing (overloads would too, at about twice the first
+    compile time).
 
     ``contacts`` (resolved rule; None otherwise): while i's contact is under way
     (t < ``contacts.until[i]``; the end of a contact of i with j is never before j's)
     its contact partners are left out (:func:`predict_pair_except`)."""
-    best, kind, tag = predict_bound(i, t, rec, lists, space, half_shell)
+    best = math.inf
+    kind = np.int64(EXPIRY)
+    tag = np.int64(0)
+    p = np.int64(-1)
+    if onlists is not None:
+        best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
+    if oncells is not None:
+        best, face = predict_crossing(i, t, rec, lists, space)
+        kind = np.int64(CROSS)
+        tag = np.int64(face)
     if in_contact(contacts, i, t):
         best, p = predict_pair_contact(i, t, best, rec, lists, space.period, contacts)
     else:
-        best, p = predict_neighbours(i, t, best, rec, count, lists, space)
+        if onlists is not None:
+            best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
+        if oncells is not None:
+            best, p = predict_pair_cells(i, t, best, rec, count, lists, space)
     if p >= 0:
-        tag = count[p]
+        tag = np.int64(count[p])
     else:
         p = kind
     tw, wall = predict_wall(i, t, rec, space)
@@ -390,10 +349,10 @@ def predict(i, t, rec, count, events, lists, space, half_shell, contacts):
 
 
 @kernel
-def predict_all(t, rec, count, events, lists, space, half_shell, contacts, times):
+def predict_all(t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
     for i in range(rec.shape[0]):
-        times[i] = predict(i, t, rec, count, events, lists, space, half_shell, contacts)
+        times[i] = predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts)
 
 
 # --------------------------------------------------------------------- execute
@@ -408,7 +367,7 @@ def _collapse_watch(i, te, p, prm):
 
 
 @kernel(inline="always")
-def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
+def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
     Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
@@ -418,7 +377,6 @@ def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
     rec = p.rec
     period = prm.space.period
     rule = prm.rule
-    prefetch_partner_neighbours(j, rec, lists)  # j's list row is in cache: start predict(j)'s misses
     stream(i, te, rec, p.img, period)
     stream(j, te, rec, p.img, period)
     dx = min_image(rec[i, 0] - rec[j, 0], period[0])
@@ -469,11 +427,11 @@ def execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts):
     c.collisions += 1
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
-    tj = predict(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
+    tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
     if not cal_update(j, tj, cal):
         return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
-        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
+        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
         c.events += 1
         c.err_i = i
@@ -546,7 +504,7 @@ def execute_wall(i, wall, te, p, c, walls, prm):
 
 
 @kernel
-def execute_kick(t, p, ev, lists, cal, c, prm, contacts):
+def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
     """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1);
     every event predicted anew and the calendar rebuilt (O(N))."""
     rec = p.rec
@@ -561,7 +519,7 @@ def execute_kick(t, p, ev, lists, cal, c, prm, contacts):
     c.sum_mv2 = s
     c.kick_step += 1
     c.kicks += 1
-    predict_all(t, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, cal.qt)
+    predict_all(t, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts, cal.qt)
     return DONE if cal_build(t, cal) else CALENDAR
 
 
@@ -582,18 +540,6 @@ def _prefetch_particle(i, p, ev, lists, cal):
     prefetch(ev.partner, i)
     prefetch(cal.qt, i)
     prefetch(cal.where, i)
-
-
-def prefetch_next(i1, p, ev, lists, cells, cal, prm):
-    """Prefetch hints for the next event, particle i1 (no effect on results): :func:`prefetch_next_lists`
-    or :func:`prefetch_next_cells`. Returns the guessed particle of the event after next."""
-
-
-@overload(prefetch_next, jit_options=_NO_REFCOUNT, inline="always")
-def _prefetch_next(i1, p, ev, lists, cells, cal, prm):
-    if _is_grid(lists):
-        return lambda i1, p, ev, lists, cells, cal, prm: prefetch_next_cells(i1, p, ev, lists, cal, prm)
-    return lambda i1, p, ev, lists, cells, cal, prm: prefetch_next_lists(i1, p, ev, lists, cells, cal, prm)
 
 
 @kernel(inline="always")
@@ -678,7 +624,7 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
 
 # ------------------------------------------------------------------------ loop
 @kernel
-def advance(engine, prm, until, max_events, max_collisions, probe):
+def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, probe):
     """Process events in time order until ``until`` (or a budget); see module doc.
 
     Parameters
@@ -755,12 +701,18 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
         clock = tick(probe, POP, clock)
         # ---- dispatch
         if j >= 0 and p.count[j] == ev.tag[i]:
-            status = execute_pair(i, j, te, p, ev, lists, cal, c, prm, contacts)
+            if onlists is not None:  # j's list row is in cache: start the misses of predict(j)
+                for k in range(lists.nbn[j]):
+                    prefetch(rec, lists.nbl[j, k])
+            status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts)
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
         elif j == EXPIRY or j == CROSS:  # the one of the two this mode has
-            status = execute_bound(i, ev.tag[i], te, p, lists, cells, c, prm)
+            if onlists is not None:
+                status = execute_expiry(i, te, p, lists, cells, c, prm)
+            if oncells is not None:
+                status = execute_crossing(i, ev.tag[i], te, p, lists, c, prm)
             clock = tick(probe, REBUILD, clock)
             if status != DONE:
                 break
@@ -769,7 +721,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:
-                    ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
+                    ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
                     if not cal_update(i, ti, cal):
                         status = CALENDAR
                     c.events += 1
@@ -780,7 +732,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
             c.stale += 1
             clock = tick(probe, P_STALE, clock)
         # ---- re-predict the particle of the event
-        ti = predict(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
+        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         clock = tick(probe, PREDICT, clock)
         if not cal_update(i, ti, cal):
             status = CALENDAR
@@ -797,7 +749,10 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
         pending = guess
         guess = -1
         if i1 >= 0:
-            guess = prefetch_next(i1, p, ev, lists, cells, cal, prm)
+            if onlists is not None:
+                guess = prefetch_next_lists(i1, p, ev, lists, cells, cal, prm)
+            if oncells is not None:
+                guess = prefetch_next_cells(i1, p, ev, lists, cal, prm)
         clock = tick(probe, PREFETCH, clock)
         if c.collisions >= max_collisions:
             status = MAX_COLLISIONS
@@ -810,7 +765,7 @@ def advance(engine, prm, until, max_events, max_collisions, probe):
 
 
 @kernel
-def advance_driven(engine, prm, until, max_events, max_collisions, probe):
+def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisions, probe):
     """:func:`advance` with the white-noise driving: the driving step is a global event.
 
     Runs :func:`advance` up to the next driving step (k + 1/2) dt_k (:func:`predict_kick`;
@@ -823,10 +778,10 @@ def advance_driven(engine, prm, until, max_events, max_collisions, probe):
     while True:
         t_kick = predict_kick(c, prm)
         stop = t_kick if t_kick < until else until
-        status = advance(engine, prm, stop, events_end - c.events, max_collisions, probe)
+        status = advance(engine, onlists, oncells, prm, stop, events_end - c.events, max_collisions, probe)
         if status != DONE or t_kick > until:
             return status
-        status = execute_kick(c.time, engine.particles, engine.events, engine.lists,
+        status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
                               engine.calendar, c, prm, engine.contacts)
         c.events += 1
         if status != DONE or c.time >= until:

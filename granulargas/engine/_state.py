@@ -43,9 +43,9 @@ Record layout
   prediction (time, partner, partner's count then; partner -1: none) and
   ``fresh`` (1,) i8 the slot whose stored pair a crossing has just brought up
   to date (-1: none).
-  The loop is compiled for one of the two record types
-  (:func:`granulargas.engine._loop.predict`: type-dispatched overloads), so
-  each mode's build carries none of the other's code.
+  The loop is compiled for one of the two modes (the flags ``onlists`` and
+  ``oncells`` of :func:`granulargas.engine._loop.predict`), so each mode's build
+  carries none of the other's code.
 * ``calendar`` :class:`Calendar` -- see :mod:`granulargas.engine._calendar`.
 * ``counters`` (1,) :data:`COUNTERS` record.
 * ``walls`` :class:`Walls` -- ``impulse`` (3, 2) f8: normal momentum delivered to

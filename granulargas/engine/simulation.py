@@ -451,7 +451,7 @@ class Simulation:
         contacts = _state.contacts(n, self._contact_until[order],
                                    np.where(cp >= 0, slot[np.maximum(cp, 0)], -1).astype(np.int32)
                                    ) if self.rule.resolved else None
-        _loop.predict_all(self._time, rec, particles.count, events, lists, spc,
+        _loop.predict_all(self._time, rec, particles.count, events, lists, *_loop.mode_flags(cells), spc,
                           0.5 * self.shell * (1.0 - 1e-9), contacts, calendar.qt)
         counters = np.zeros(1, dtype=_state.COUNTERS)
         c = counters[0]
@@ -580,7 +580,8 @@ class Simulation:
                 self._place_events(self.time)
         advance = _loop.advance if self.driving is None else _loop.advance_driven
         while True:
-            status = advance(self._engine, prm, until, chunk, target, None)
+            e = self._engine
+            status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
