@@ -45,7 +45,7 @@ than 2 R_max by a relative margin of :data:`MARGIN` that covers it.
 import math
 
 from granulargas._numba import kernel
-from granulargas.engine._geometry import collision_delay, min_image
+from granulargas.engine._geometry import min_image, pair_delay
 from granulargas.engine._prefetch import prefetch
 
 #: cells are at least (1 + MARGIN) times the largest contact distance wide
@@ -147,12 +147,7 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
                     continue
                 j = head[kx + row]
                 while j >= 0:
-                    dtj = t - rec[j, 6]
-                    s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), period[0]),
-                                        min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), period[1]),
-                                        min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), period[2]),
-                                        vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
-                    tc = t + s
+                    tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
                     better = tc < best
                     best = tc if better else best
                     p = j if better else p

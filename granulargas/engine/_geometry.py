@@ -72,6 +72,18 @@ def collision_delay(dx, dy, dz, ux, uy, uz, sigma):
 
 
 @kernel(inline="always")
+def pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period):
+    """Time from t until particle i (centre (xi, yi, zi) at t, velocity v, radius ri)
+    touches particle j, streamed from its own clock: (1) with the record of j
+    (``rec[j]``: position at its clock ``rec[j, 6]``, velocity, radius ``rec[j, 7]``)."""
+    dtj = t - rec[j, 6]
+    return collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), period[0]),
+                           min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), period[1]),
+                           min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), period[2]),
+                           vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
+
+
+@kernel(inline="always")
 def exit_delay(dx, dy, dz, vx, vy, vz, radius):
     """Time until a particle at offset d from its list centre is at distance ``radius``.
 

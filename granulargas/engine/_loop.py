@@ -100,7 +100,7 @@ from granulargas.engine._crossing import (
     scan_new_layer,
 )
 from granulargas.engine._drive import kick_velocities
-from granulargas.engine._geometry import collision_delay, exit_delay, min_image, wall_delay
+from granulargas.engine._geometry import collision_delay, exit_delay, min_image, pair_delay, wall_delay
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._resolved import resolved_pair
 from granulargas.engine._probe import (
@@ -180,12 +180,7 @@ def predict_pair(i, t, before, rec, nbl, nbn, period):
     p = -1
     for k in range(nbn[i]):
         j = nbl[i, k]
-        dtj = t - rec[j, 6]
-        s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), period[0]),
-                            min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), period[1]),
-                            min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), period[2]),
-                            vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
-        tc = t + s
+        tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
         better = tc < best
         best = tc if better else best
         p = j if better else p
