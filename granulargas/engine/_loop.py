@@ -87,8 +87,10 @@ from granulargas.engine._calendar import (
     cal_build,
     cal_look_ahead,
     cal_next_time,
+    cal_first,
     cal_peek,
     cal_update,
+    cal_update_root,
 )
 from granulargas.engine._cells import prefetch_cells, rebuild_list
 from granulargas.engine._collide import pair_collision, restitution, wall_collision
@@ -299,8 +301,7 @@ def mode_flags(cells):
     return (1, None) if cells is not None else (None, 1)
 
 
-@kernel
-def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
+def _predict_impl(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
 
     ``lists`` is the neighbour lists (``onlists`` = 1, ``oncells`` = None) or the cell
@@ -333,6 +334,32 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
         tag = np.int64(count[p])
     else:
         p = kind
+    tw, wall = predict_wall(i, t, rec, space)
+    if tw < best:
+        best = tw
+        p = WALL
+        tag = wall
+    events.partner[i] = p
+    events.tag[i] = tag
+    return best
+
+
+predict = kernel(_predict_impl)
+
+
+@kernel(inline="always")
+def predict_fresh(i, t, rec, count, events, grid, space):
+    """:func:`predict` in the cell-crossing mode right after a crossing of i (``grid.fresh[0] == i``):
+    the same result, without the full scan's code (the loop inlines it; ``predict`` itself is a call)."""
+    best, face = predict_crossing(i, t, rec, grid, space)
+    tag = np.int64(face)
+    p = np.int64(CROSS)
+    grid.fresh[0] = -1
+    pt = grid.pair_t[i]
+    if pt < best:
+        best = pt
+        p = np.int64(grid.pair_j[i])
+        tag = np.int64(count[p])
     tw, wall = predict_wall(i, t, rec, space)
     if tw < best:
         best = tw
@@ -666,7 +693,10 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             status = BUDGET
             break
         # ---- pop
-        i = cal_peek(cal)
+        if onlists is not None:
+            i = cal_peek(cal)
+        if oncells is not None:  # the peek after the previous event has opened the window
+            i = cal_first(cal)
         if i < 0:
             if i == -2:
                 status = CALENDAR
@@ -727,15 +757,29 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             c.stale += 1
             clock = tick(probe, P_STALE, clock)
         # ---- re-predict the particle of the event
-        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
-        clock = tick(probe, PREDICT, clock)
-        if not cal_update(i, ti, cal):
-            status = CALENDAR
-            break
+        if onlists is not None:
+            ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
+            clock = tick(probe, PREDICT, clock)
+            if not cal_update(i, ti, cal):
+                status = CALENDAR
+                break
+        if oncells is not None:
+            if lists.fresh[0] == i:  # after a crossing: the stored best pair is current
+                ti = predict_fresh(i, te, rec, p.count, ev, lists, prm.space)
+            else:
+                ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
+                             contacts)
+            clock = tick(probe, PREDICT, clock)
+            if not cal_update_root(i, ti, cal):
+                status = CALENDAR
+                break
         c.events += 1
         clock = tick(probe, UPDATE, clock)
         # ---- prefetch hints for the next events (no effect on results)
-        i1 = cal_peek(cal)
+        if onlists is not None:
+            i1 = cal_peek(cal)
+        if oncells is not None:
+            i1 = cal_first(cal)
         clock = tick(probe, PEEK, clock)
         if i1 == -2:
             status = CALENDAR
