@@ -90,6 +90,7 @@ from granulargas.engine._calendar import (
     cal_first,
     cal_peek,
     cal_update,
+    cal_update_ring,
     cal_update_root,
 )
 from granulargas.engine._cells import prefetch_cells, rebuild_list
@@ -450,8 +451,12 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
     tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
-    if not cal_update(j, tj, cal):
-        return CALENDAR
+    if onlists is not None:
+        if not cal_update(j, tj, cal):
+            return CALENDAR
+    if oncells is not None:
+        if not cal_update_ring(j, tj, cal):
+            return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
         ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
