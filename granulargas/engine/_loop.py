@@ -451,12 +451,8 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
     tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
-    if onlists is not None:
-        if not cal_update(j, tj, cal):
-            return CALENDAR
-    if oncells is not None:
-        if not cal_update_ring(j, tj, cal):
-            return CALENDAR
+    if not cal_update_ring(j, tj, cal):
+        return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
         ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
@@ -697,11 +693,8 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         if c.events >= events_end:
             status = BUDGET
             break
-        # ---- pop
-        if onlists is not None:
-            i = cal_peek(cal)
-        if oncells is not None:  # the peek after the previous event has opened the window
-            i = cal_first(cal)
+        # ---- pop (the peek after the previous event has opened the window)
+        i = cal_first(cal)
         if i < 0:
             if i == -2:
                 status = CALENDAR
@@ -764,27 +757,20 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         # ---- re-predict the particle of the event
         if onlists is not None:
             ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
-            clock = tick(probe, PREDICT, clock)
-            if not cal_update(i, ti, cal):
-                status = CALENDAR
-                break
         if oncells is not None:
             if lists.fresh[0] == i:  # after a crossing: the stored best pair is current
                 ti = predict_fresh(i, te, rec, p.count, ev, lists, prm.space)
             else:
                 ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
                              contacts)
-            clock = tick(probe, PREDICT, clock)
-            if not cal_update_root(i, ti, cal):
-                status = CALENDAR
-                break
+        clock = tick(probe, PREDICT, clock)
+        if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
+            status = CALENDAR
+            break
         c.events += 1
         clock = tick(probe, UPDATE, clock)
         # ---- prefetch hints for the next events (no effect on results)
-        if onlists is not None:
-            i1 = cal_peek(cal)
-        if oncells is not None:
-            i1 = cal_first(cal)
+        i1 = cal_first(cal)
         clock = tick(probe, PEEK, clock)
         if i1 == -2:
             status = CALENDAR
