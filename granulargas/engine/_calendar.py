@@ -56,6 +56,11 @@ events, from the mean event delay (:func:`cal_width`); at the start of a
 N = 10^6) only when w is off from that by more than a factor 2, which keeps w
 matched to a cooling gas. Ties are broken by heap node order, deterministically.
 
+The loop inlines the common cases (:func:`cal_first`, :func:`cal_update_root`,
+:func:`cal_update_ring`) and calls :func:`cal_peek` / :func:`cal_update` for the rest:
+a call passes every array of the calendar as separate arguments, which costs more
+than most updates do.
+
 State: :class:`granulargas.engine._state.Calendar` -- ``qt`` (N,) event times,
 ``chunks`` (pool, CHUNK) i4, ``where`` (N,) i4, ``small`` (capacity, 2) f8 nodes
 (time, id), ``buckets`` (nb + 1, 2) i4 (newest chunk, ids in it), and ``state``,
