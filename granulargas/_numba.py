@@ -45,9 +45,17 @@ def jit(*args, **kwargs):
     return numba.njit(*args, **kwargs)
 
 
-def kernel(*args, **kwargs):
-    """:func:`jit` without reference counting (``_nrt=False``): for code that allocates nothing."""
+def kernel(*args, python=True, **kwargs):
+    """:func:`jit` without reference counting (``_nrt=False``): for code that allocates nothing.
+
+    ``python=False``: no Python entry point (numba's CPython and C wrappers, which
+    unbox every argument, are not built; calling the kernel from Python crashes),
+    for a kernel that only compiled code calls.
+    """
     kwargs.setdefault("_nrt", False)
+    if not python:
+        kwargs["no_cpython_wrapper"] = True
+        kwargs["no_cfunc_wrapper"] = True
     return jit(*args, **kwargs)
 
 
@@ -59,7 +67,4 @@ def inlined(*args, python=False, **kwargs):
     keeps them, for a kernel that tests call from Python.
     """
     kwargs["forceinline"] = True
-    if not python:
-        kwargs["no_cpython_wrapper"] = True
-        kwargs["no_cfunc_wrapper"] = True
-    return kernel(*args, **kwargs)
+    return kernel(*args, python=python, **kwargs)

@@ -224,7 +224,8 @@ def _release(c, chunks, cs):
 _OK, _HEAP_FULL, _POOL_EMPTY = 0, 1, 2
 
 
-def _insert_impl(i, t, cal, cs):
+@inlined
+def _insert(i, t, cal, cs):
     """Place the event of particle i at time t; returns _OK, _HEAP_FULL or _POOL_EMPTY."""
     cal.qt[i] = t
     x = (t - cs.t0) / cs.width
@@ -244,13 +245,14 @@ def _insert_impl(i, t, cal, cs):
     return _OK
 
 
-# the hot path inlines it; the cold paths (rebuilds, overflow) share one compiled copy,
-# which keeps the first compile short
-_insert = inlined(_insert_impl)
-_insert_call = kernel(_insert_impl)
+@kernel(python=False)
+def _insert_call(i, t, cal, cs):
+    """:func:`_insert` for the cold paths (rebuilds, overflow): one compiled copy that they
+    share, which keeps the first compile short (the hot path inlines :func:`_insert`)."""
+    return _insert(i, t, cal, cs)
 
 
-@kernel
+@kernel(python=False)
 def _place_all(t0, w, cal):
     """Empty the calendar and insert every event ``qt`` (windows from t0, width w).
 
@@ -281,7 +283,7 @@ def _place_all(t0, w, cal):
     return True
 
 
-@kernel
+@kernel(python=False)
 def _replace(failure, cal):
     """Place all events anew from ``qt`` (which always holds every event time).
 
@@ -328,7 +330,7 @@ def cal_update(i, t, cal):
     return True
 
 
-@kernel
+@kernel(python=False)
 def _redistribute_overflow(cal):
     """Place the live overflow events anew; returns an insert status (_OK or the failure)."""
     cs = cal.state[0]

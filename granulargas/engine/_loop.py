@@ -187,7 +187,7 @@ def predict_pair(i, t, before, rec, nbl, nbn, period):
     return best, p
 
 
-@kernel
+@kernel(python=False)
 def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts):
     """:func:`predict_pair` for a particle whose contact is under way (resolved rule,
     :mod:`granulargas.engine._resolved`).
@@ -299,7 +299,7 @@ def mode_flags(cells):
     return (1, None) if cells is not None else (None, 1)
 
 
-@kernel
+@kernel(python=False)
 def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
 
@@ -498,7 +498,7 @@ def execute_wall(i, wall, te, p, c, walls, prm):
     return DONE
 
 
-@kernel
+@kernel(python=False)
 def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
     """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1);
     every event predicted anew and the calendar rebuilt (O(N))."""

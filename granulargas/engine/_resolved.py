@@ -70,7 +70,7 @@ def _wrap(i, a, x, rec, img, period):
     rec[i, a] = x
 
 
-@kernel
+@kernel(python=False)
 def resolved_pair(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
     """Collision that takes time of slots i, j (streamed to te, touching, approaching).
 
