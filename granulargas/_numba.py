@@ -16,7 +16,7 @@ is given and call other kernels or jit functions.
 :func:`inlined` is a kernel that every compiled caller inlines: it is compiled
 and optimised once, as a function of its own, and LLVM inlines the optimised
 code at each call site (the ``alwaysinline`` attribute: numba's
-``forceinline``). The event loop's kernels are of this kind. Numba's own
+``forceinline``). The event loop's hot kernels are of this kind. Numba's own
 ``inline="always"`` inlines at the level of numba's IR instead: the callee's IR
 is rebuilt, deep-copied (once per block, with the whole variable scope) and
 typed again at every call site, and nested inlining repeats that at every
