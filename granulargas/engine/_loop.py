@@ -449,8 +449,12 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
     tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
-    if not cal_update_ring(j, tj, cal):
-        return CALENDAR
+    if onlists is not None:
+        if not cal_update(j, tj, cal):
+            return CALENDAR
+    if oncells is not None:
+        if not cal_update_ring(j, tj, cal):
+            return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
         ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
@@ -691,8 +695,11 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         if c.events >= events_end:
             status = BUDGET
             break
-        # ---- pop (the peek after the previous event has opened the window)
-        i = cal_first(cal)
+        # ---- pop (cell mode: the peek after the previous event has opened the window)
+        if onlists is not None:
+            i = cal_peek(cal)
+        if oncells is not None:
+            i = cal_first(cal)
         if i < 0:
             if i == -2:
                 status = CALENDAR
@@ -762,13 +769,21 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
                 ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
                              contacts)
         clock = tick(probe, PREDICT, clock)
-        if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
-            status = CALENDAR
-            break
+        if onlists is not None:
+            if not cal_update(i, ti, cal):
+                status = CALENDAR
+                break
+        if oncells is not None:
+            if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
+                status = CALENDAR
+                break
         c.events += 1
         clock = tick(probe, UPDATE, clock)
         # ---- prefetch hints for the next events (no effect on results)
-        i1 = cal_first(cal)
+        if onlists is not None:
+            i1 = cal_peek(cal)
+        if oncells is not None:
+            i1 = cal_first(cal)
         clock = tick(probe, PEEK, clock)
         if i1 == -2:
             status = CALENDAR
