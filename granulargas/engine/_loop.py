@@ -88,7 +88,6 @@ from granulargas.engine._calendar import (
     cal_look_ahead,
     cal_next_time,
     cal_first,
-    cal_peek,
     cal_update,
     cal_update_ring,
     cal_update_root,
@@ -695,11 +694,8 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         if c.events >= events_end:
             status = BUDGET
             break
-        # ---- pop (cell mode: the peek after the previous event has opened the window)
-        if onlists is not None:
-            i = cal_peek(cal)
-        if oncells is not None:
-            i = cal_first(cal)
+        # ---- pop (the peek after the previous event has opened the window)
+        i = cal_first(cal)
         if i < 0:
             if i == -2:
                 status = CALENDAR
@@ -769,21 +765,13 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
                 ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
                              contacts)
         clock = tick(probe, PREDICT, clock)
-        if onlists is not None:
-            if not cal_update(i, ti, cal):
-                status = CALENDAR
-                break
-        if oncells is not None:
-            if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
-                status = CALENDAR
-                break
+        if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
+            status = CALENDAR
+            break
         c.events += 1
         clock = tick(probe, UPDATE, clock)
         # ---- prefetch hints for the next events (no effect on results)
-        if onlists is not None:
-            i1 = cal_peek(cal)
-        if oncells is not None:
-            i1 = cal_first(cal)
+        i1 = cal_first(cal)
         clock = tick(probe, PEEK, clock)
         if i1 == -2:
             status = CALENDAR
