@@ -301,6 +301,20 @@ def mode_flags(cells):
     return (1, None) if cells is not None else (None, 1)
 
 
+@inlined
+def settle_event(i, t, best, p, tag, rec, events, space):
+    """The earlier of i's predicted event (time ``best``, partner or kind ``p``, ``tag``) and
+    its next wall impact into i's event slot; returns that event's time."""
+    tw, wall = predict_wall(i, t, rec, space)
+    if tw < best:
+        best = tw
+        p = WALL
+        tag = wall
+    events.partner[i] = p
+    events.tag[i] = tag
+    return best
+
+
 @kernel(python=False)
 def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
@@ -335,14 +349,7 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
         tag = np.int64(count[p])
     else:
         p = kind
-    tw, wall = predict_wall(i, t, rec, space)
-    if tw < best:
-        best = tw
-        p = WALL
-        tag = wall
-    events.partner[i] = p
-    events.tag[i] = tag
-    return best
+    return settle_event(i, t, best, p, tag, rec, events, space)
 
 
 @inlined
@@ -358,14 +365,7 @@ def predict_fresh(i, t, rec, count, events, grid, space):
         best = pt
         p = np.int64(grid.pair_j[i])
         tag = np.int64(count[p])
-    tw, wall = predict_wall(i, t, rec, space)
-    if tw < best:
-        best = tw
-        p = WALL
-        tag = wall
-    events.partner[i] = p
-    events.tag[i] = tag
-    return best
+    return settle_event(i, t, best, p, tag, rec, events, space)
 
 
 @kernel
