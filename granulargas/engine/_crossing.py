@@ -17,8 +17,8 @@ per cell). Two particles in cells that are not neighbours (27 around a cell,
 
 Each particle keeps one event (:mod:`granulargas.engine._loop`), the earlier
 of its crossing and its best pair; the best pair itself is kept apart
-(``Grid.pair_t``, ``pair_j``, ``pair_tag``: time, partner, partner's collision
-count then), whether it comes before the crossing or not. A full prediction
+(``Grid.pair_t`` and the columns ``PAIR_J``, ``PAIR_TAG`` of ``Grid.cell``: time,
+partner, partner's collision count then), whether it comes before the crossing or not. A full prediction
 (after a collision, a stale event, at a build or a driving step) scans the
 particles of all 27 (2D: 9) cells around the particle. A crossing scans only
 the layer of 9 (2D: 3) cells that became adjacent, and keeps the better of
@@ -44,12 +44,32 @@ than 2 R_max by a relative margin of :data:`MARGIN` that covers it.
 
 import math
 
+import numpy as np
+
 from granulargas._numba import inlined, kernel
 from granulargas.engine._geometry import min_image, pair_delay
 from granulargas.engine._prefetch import prefetch
 
 #: cells are at least (1 + MARGIN) times the largest contact distance wide
 MARGIN = 1e-6
+
+# columns of a particle's row of Grid.cell: cell coordinates, flat cell index, the
+# links of its cell's list, its best pair's partner and that partner's count then
+FLAT = 3
+NEXT = 4
+PREV = 5
+PAIR_J = 6
+PAIR_TAG = 7
+
+
+def grid_rows(n):
+    """``Grid.cell`` for n particles: (n, 8) int32 rows on 32-byte boundaries (each row in one
+    cache line), partners -1."""
+    buf = np.zeros(n * 8 + 8, dtype=np.int32)
+    offset = (-buf.ctypes.data % 32) // 4
+    rows = buf[offset : offset + n * 8].reshape(n, 8)
+    rows[:, PAIR_J] = -1
+    return rows
 
 
 @inlined
@@ -117,7 +137,7 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     be visited twice (harmless).
     """
     head = grid.head
-    nxt = grid.next
+    row_of = grid.cell
     ncell = space.ncell
     period = space.period
     cx = grid.cell[i, 0]
@@ -151,8 +171,59 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
                     better = tc < best
                     best = tc if better else best
                     p = j if better else p
-                    j = nxt[j]
+                    j = row_of[j, NEXT]
     return best, p
+
+
+@inlined
+def _interior(i, grid, space):
+    """Whether particle i's cell and all its neighbours lie inside the grid (3D; no wrap)."""
+    ncell = space.ncell
+    cell = grid.cell
+    return (cell[i, 0] >= 1 and cell[i, 0] <= ncell[0] - 2 and cell[i, 1] >= 1 and cell[i, 1] <= ncell[1] - 2
+            and cell[i, 2] >= 1 and cell[i, 2] <= ncell[2] - 2)
+
+
+@inlined
+def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
+    """:func:`scan_cells` over cells of flat index c0 + u s1 + w s2 + v (w, u in 0..2,
+    v in 0..n0-1, in this order) -- the cells around an interior cell, without wraps."""
+    head = grid.head
+    row_of = grid.cell
+    period = space.period
+    xi = rec[i, 0]
+    yi = rec[i, 1]
+    zi = rec[i, 2]
+    vx = rec[i, 3]
+    vy = rec[i, 4]
+    vz = rec[i, 5]
+    ri = rec[i, 7]
+    best = before
+    p = -1
+    for w in range(3):
+        for u in range(3):
+            b = c0 + u * s1 + w * s2
+            for v in range(n0):
+                j = head[b + v]
+                while j >= 0:
+                    tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
+                    better = tc < best
+                    best = tc if better else best
+                    p = j if better else p
+                    j = row_of[j, NEXT]
+    return best, p
+
+
+@inlined
+def scan_around(i, t, rec, grid, space):
+    """Earliest collision of particle i (streamed to t) with the particles of the 27 (2D: 9)
+    cells around its cell: (time, partner slot) or (inf, -1)."""
+    if _interior(i, grid, space):
+        nx = space.ncell[0]
+        sz = nx * space.ncell[1]
+        return scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz, 3)
+    zr = 1 if space.ncell[2] >= 3 else 0
+    return scan_cells(i, t, math.inf, rec, grid, space, -1, 1, -1, 1, -zr, zr)
 
 
 @inlined
@@ -167,13 +238,12 @@ def predict_pair_cells(i, t, before, rec, count, grid, space):
     if grid.fresh[0] == i:
         grid.fresh[0] = -1
         pt = grid.pair_t[i]
-        pj = grid.pair_j[i]
+        pj = grid.cell[i, PAIR_J]
     else:
-        zr = 1 if space.ncell[2] >= 3 else 0
-        pt, pj = scan_cells(i, t, math.inf, rec, grid, space, -1, 1, -1, 1, -zr, zr)
+        pt, pj = scan_around(i, t, rec, grid, space)
         grid.pair_t[i] = pt
-        grid.pair_j[i] = pj
-        grid.pair_tag[i] = count[pj] if pj >= 0 else 0
+        grid.cell[i, PAIR_J] = pj
+        grid.cell[i, PAIR_TAG] = count[pj] if pj >= 0 else 0
     if pt < before:
         return pt, pj
     return before, -1
@@ -185,23 +255,33 @@ def scan_new_layer(i, t, face, rec, count, grid, space):
     and the particles of the layer of cells that became adjacent, and mark the stored
     pair current (``grid.fresh``); if the stored partner has collided since, do
     nothing (the prediction then scans all cells)."""
-    pj = grid.pair_j[i]
-    if pj >= 0 and count[pj] != grid.pair_tag[i]:
+    pj = grid.cell[i, PAIR_J]
+    if pj >= 0 and count[pj] != grid.cell[i, PAIR_TAG]:
         return
     a = face >> 1
     o = 1 if face & 1 else -1
-    zr = 1 if space.ncell[2] >= 3 else 0
-    x0 = o if a == 0 else -1
-    x1 = o if a == 0 else 1
-    y0 = o if a == 1 else -1
-    y1 = o if a == 1 else 1
-    z0 = o if a == 2 else -zr
-    z1 = o if a == 2 else zr
-    pt, pn = scan_cells(i, t, grid.pair_t[i], rec, grid, space, x0, x1, y0, y1, z0, z1)
+    if _interior(i, grid, space):
+        # the layer's cells in the order of scan_cells: the other two axes, the slower outside
+        nx = space.ncell[0]
+        sz = nx * space.ncell[1]
+        sa = 1 if a == 0 else (nx if a == 1 else sz)
+        s1 = nx if a == 0 else 1
+        s2 = nx if a == 2 else sz
+        pt, pn = scan_block(i, t, grid.pair_t[i], rec, grid, space, grid.cell[i, FLAT] + o * sa - s1 - s2,
+                            s1, s2, 1)
+    else:
+        zr = 1 if space.ncell[2] >= 3 else 0
+        x0 = o if a == 0 else -1
+        x1 = o if a == 0 else 1
+        y0 = o if a == 1 else -1
+        y1 = o if a == 1 else 1
+        z0 = o if a == 2 else -zr
+        z1 = o if a == 2 else zr
+        pt, pn = scan_cells(i, t, grid.pair_t[i], rec, grid, space, x0, x1, y0, y1, z0, z1)
     if pn >= 0:
         grid.pair_t[i] = pt
-        grid.pair_j[i] = pn
-        grid.pair_tag[i] = count[pn]
+        grid.cell[i, PAIR_J] = pn
+        grid.cell[i, PAIR_TAG] = count[pn]
     grid.fresh[0] = i
 
 
@@ -209,26 +289,28 @@ def scan_new_layer(i, t, face, rec, count, grid, space):
 def grid_insert(i, c, grid):
     """Put particle i at the head of cell c's list."""
     head = grid.head
+    row = grid.cell
     h = head[c]
-    grid.next[i] = h
-    grid.prev[i] = -1
+    row[i, NEXT] = h
+    row[i, PREV] = -1
     if h >= 0:
-        grid.prev[h] = i
+        row[h, PREV] = i
     head[c] = i
-    grid.cell[i, 3] = c
+    row[i, FLAT] = c
 
 
 @inlined
 def grid_remove(i, grid):
     """Take particle i out of its cell's list."""
-    q = grid.prev[i]
-    n = grid.next[i]
+    row = grid.cell
+    q = row[i, PREV]
+    n = row[i, NEXT]
     if q >= 0:
-        grid.next[q] = n
+        row[q, NEXT] = n
     else:
-        grid.head[grid.cell[i, 3]] = n
+        grid.head[row[i, FLAT]] = n
     if n >= 0:
-        grid.prev[n] = q
+        row[n, PREV] = q
 
 
 @inlined
@@ -277,3 +359,43 @@ def prefetch_around(i, grid, space):
             ky = _neighbour(cy, oy, ncell[1], period[1])
             if ky >= 0:
                 prefetch(grid.head, cx + ncell[0] * (ky + ncell[1] * kz))
+
+
+@inlined
+def prefetch_layer(i, face, grid, space):
+    """Prefetch hints for the cell heads of the layer that a crossing of particle i through
+    ``face`` makes adjacent: two cells beyond i's cell on the face's axis (no effect on results)."""
+    ncell = space.ncell
+    period = space.period
+    a = face >> 1
+    o = 2 if face & 1 else -2
+    cx = grid.cell[i, 0]
+    cy = grid.cell[i, 1]
+    cz = grid.cell[i, 2]
+    zr = 1 if ncell[2] >= 3 else 0
+    if a == 0:
+        kx = _neighbour(cx, o, ncell[0], period[0])
+        if kx < 0:
+            return
+        for oz in range(-zr, zr + 1):
+            kz = _neighbour(cz, oz, ncell[2], period[2])
+            if kz < 0:
+                continue
+            for oy in range(-1, 2):
+                ky = _neighbour(cy, oy, ncell[1], period[1])
+                if ky >= 0:
+                    prefetch(grid.head, kx + ncell[0] * (ky + ncell[1] * kz))
+        return
+    ky = _neighbour(cy, o, ncell[1], period[1]) if a == 1 else cy
+    kz = _neighbour(cz, o, ncell[2], period[2]) if a == 2 else cz
+    if ky < 0 or kz < 0:
+        return
+    for ob in range(-1, 2):
+        if a == 1:
+            kb = _neighbour(cz, ob, ncell[2], period[2]) if zr else (kz if ob == 0 else -1)
+            if kb >= 0:
+                prefetch(grid.head, cx + ncell[0] * (ky + ncell[1] * kb))
+        else:
+            kb = _neighbour(cy, ob, ncell[1], period[1])
+            if kb >= 0:
+                prefetch(grid.head, cx + ncell[0] * (kb + ncell[1] * kz))

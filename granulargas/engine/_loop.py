@@ -95,10 +95,12 @@ from granulargas.engine._calendar import (
 from granulargas.engine._cells import prefetch_cells, rebuild_list
 from granulargas.engine._collide import pair_collision, restitution, wall_collision
 from granulargas.engine._crossing import (
+    PAIR_J,
     cross,
     predict_crossing,
     predict_pair_cells,
     prefetch_around,
+    prefetch_layer,
     scan_new_layer,
 )
 from granulargas.engine._drive import kick_velocities
@@ -363,7 +365,7 @@ def predict_fresh(i, t, rec, count, events, grid, space):
     pt = grid.pair_t[i]
     if pt < best:
         best = pt
-        p = np.int64(grid.pair_j[i])
+        p = np.int64(grid.cell[i, PAIR_J])
         tag = np.int64(count[p])
     return settle_event(i, t, best, p, tag, rec, events, space)
 
@@ -574,10 +576,12 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     rec = p.rec
     p1 = ev.partner[i1]
     prefetch(grid.cell, i1)
-    prefetch(grid.next, i1)
-    prefetch(grid.prev, i1)
+    prefetch(grid.pair_t, i1)
     prefetch_around(i1, grid, prm.space)
+    if p1 == CROSS:
+        prefetch_layer(i1, ev.tag[i1], grid, prm.space)
     if p1 >= 0:
+        prefetch_around(p1, grid, prm.space)
         prefetch(rec, p1)
         prefetch(grid.cell, p1)
         prefetch(p.mass, p1)

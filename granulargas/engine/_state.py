@@ -36,13 +36,13 @@ Record layout
   ``of`` (N,) i4 cell of each list centre.
 * In the cell-crossing mode (:mod:`granulargas.engine._crossing`) ``lists`` is a
   :class:`Grid` instead and ``cells`` is None: ``head`` (C,) i4 the first
-  particle of each cell (-1: empty), ``next``, ``prev`` (N,) i4 the doubly
-  linked list of each cell, ``cell`` (N, 4) i4 the cell coordinates of each
-  particle and the flat cell index, ``width`` (3,) f8 the cell side per axis;
-  ``pair_t`` f8, ``pair_j``, ``pair_tag`` i4 each particle's best pair
-  prediction (time, partner, partner's count then; partner -1: none) and
-  ``fresh`` (1,) i8 the slot whose stored pair a crossing has just brought up
-  to date (-1: none).
+  particle of each cell (-1: empty); ``cell`` (N, 8) i4 one 32-byte row per
+  particle (the int32 data of a crossing in one cache line; columns named in
+  :mod:`~granulargas.engine._crossing`): its cell coordinates, flat cell index,
+  next and previous particle of its cell's doubly linked list, its best pair's
+  partner (-1: none) and that partner's count then; ``pair_t`` f8 the time of
+  that best pair; ``width`` (3,) f8 the cell side per axis; ``fresh`` (1,) i8
+  the slot whose stored pair a crossing has just brought up to date (-1: none).
   The loop is compiled for one of the two modes (the flags ``onlists`` and
   ``oncells`` of :func:`granulargas.engine._loop.predict`), so each mode's build
   carries none of the other's code.
@@ -69,8 +69,7 @@ Particles = namedtuple("Particles", ["rec", "img", "mass", "count", "lastcoll", 
 Events = namedtuple("Events", ["partner", "tag"])
 Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil", "mark"])
 Cells = namedtuple("Cells", ["ids", "n", "of"])
-Grid = namedtuple("Grid", ["head", "next", "prev", "cell", "width", "pair_t", "pair_j", "pair_tag",
-                           "fresh"])
+Grid = namedtuple("Grid", ["head", "cell", "width", "pair_t", "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from granulargas.engine._calendar import cal_check
+from granulargas.engine._crossing import FLAT, NEXT, PREV
 
 
 def _min_image(d, period):
@@ -86,14 +87,14 @@ def _check_grid(sim, grid, r):
         j, prev = int(grid.head[c]), -1
         while j >= 0:
             seen[j] += 1
-            if grid.cell[j, 3] != c or grid.prev[j] != prev:
+            if grid.cell[j, FLAT] != c or grid.cell[j, PREV] != prev:
                 problems.append(f"cell list of cell {c} broken at particle {j}")
                 break
-            prev, j = j, int(grid.next[j])
+            prev, j = j, int(grid.cell[j, NEXT])
     if np.any(seen != 1):
         problems.append(f"particles not listed exactly once: {np.flatnonzero(seen != 1)[:5].tolist()}")
     flat = grid.cell[:, 0] + space.ncell[0] * (grid.cell[:, 1] + space.ncell[1] * grid.cell[:, 2])
-    if np.any(flat != grid.cell[:, 3]):
+    if np.any(flat != grid.cell[:, FLAT]):
         problems.append("cell coordinates and flat cell index disagree")
     tol = 1e-9 * float(np.max(space.box[:d]))
     for a in range(d):

@@ -26,7 +26,7 @@ from granulargas.engine import _loop, _state
 from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
-from granulargas.engine._crossing import MARGIN, build_grid
+from granulargas.engine._crossing import MARGIN, build_grid, grid_rows
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
@@ -404,10 +404,8 @@ class Simulation:
                                tag=np.zeros(n, dtype=np.int32))
         ncells = int(np.prod(spc.ncell))
         if self.neighbours == "cells":
-            lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), next=np.empty(n, dtype=np.int32),
-                                prev=np.empty(n, dtype=np.int32), cell=np.zeros((n, 4), dtype=np.int32),
+            lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), cell=grid_rows(n),
                                 width=spc.box / spc.ncell, pair_t=np.full(n, np.inf),
-                                pair_j=np.full(n, -1, dtype=np.int32), pair_tag=np.zeros(n, dtype=np.int32),
                                 fresh=np.full(1, -1, dtype=np.int64))
             build_grid(rec, lists, spc)
             self._finish_build(particles, events, lists, None, order)
