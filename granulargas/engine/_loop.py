@@ -95,7 +95,6 @@ from granulargas.engine._calendar import (
 from granulargas.engine._cells import prefetch_cells, rebuild_list
 from granulargas.engine._collide import pair_collision, restitution, wall_collision
 from granulargas.engine._crossing import (
-    PAIR_J,
     cross,
     predict_crossing,
     predict_pair_cells,
@@ -355,17 +354,16 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
 
 
 @inlined
-def predict_fresh(i, t, rec, count, events, grid, space):
-    """:func:`predict` in the cell-crossing mode right after a crossing of i (``grid.fresh[0] == i``):
-    the same result, without the full scan's code (the loop inlines it; ``predict`` itself is a call)."""
+def predict_cells(i, t, rec, count, events, grid, space):
+    """:func:`predict` in the cell-crossing mode (no contacts there), for the loop to inline:
+    the crossing, the best pair (the stored one right after a crossing of i, else the
+    scan of the cells around i), the walls."""
     best, face = predict_crossing(i, t, rec, grid, space)
     tag = np.int64(face)
     p = np.int64(CROSS)
-    grid.fresh[0] = -1
-    pt = grid.pair_t[i]
-    if pt < best:
-        best = pt
-        p = np.int64(grid.cell[i, PAIR_J])
+    best, pj = predict_pair_cells(i, t, best, rec, count, grid, space)
+    if pj >= 0:
+        p = np.int64(pj)
         tag = np.int64(count[p])
     return settle_event(i, t, best, p, tag, rec, events, space)
 
@@ -449,11 +447,12 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     c.collisions += 1
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
-    tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
     if onlists is not None:
+        tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         if not cal_update(j, tj, cal):
             return CALENDAR
     if oncells is not None:
+        tj = predict_cells(j, te, rec, p.count, ev, lists, prm.space)
         if not cal_update_ring(j, tj, cal):
             return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
@@ -763,11 +762,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         if onlists is not None:
             ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         if oncells is not None:
-            if lists.fresh[0] == i:  # after a crossing: the stored best pair is current
-                ti = predict_fresh(i, te, rec, p.count, ev, lists, prm.space)
-            else:
-                ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
-                             contacts)
+            ti = predict_cells(i, te, rec, p.count, ev, lists, prm.space)
         clock = tick(probe, PREDICT, clock)
         if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
             status = CALENDAR
