@@ -126,7 +126,7 @@ def _neighbour(c, o, n, period):
     return k
 
 
-@inlined
+@kernel(python=False)
 def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     """Earliest collision of particle i (streamed to t) with the particles of the cells at
     offsets [x0, x1] x [y0, y1] x [z0, z1] from its cell, before ``before``: (time,
@@ -134,7 +134,8 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
 
     i itself may be among the candidates and gives inf (no relative motion). The
     cells beyond a wall do not exist; with 3 cells on a periodic axis a cell may
-    be visited twice (harmless).
+    be visited twice (harmless). A call: the loop inlines only the scans of
+    cells inside the grid (:func:`scan_block`), the common case.
     """
     head = grid.head
     row_of = grid.cell
@@ -364,38 +365,16 @@ def prefetch_around(i, grid, space):
 @inlined
 def prefetch_layer(i, face, grid, space):
     """Prefetch hints for the cell heads of the layer that a crossing of particle i through
-    ``face`` makes adjacent: two cells beyond i's cell on the face's axis (no effect on results)."""
+    ``face`` makes adjacent, two cells beyond i's cell (no effect on results). Through
+    an x face they lie mostly in the lines :func:`prefetch_around` fetches."""
+    a = face >> 1
+    if a == 0:
+        return
+    o = 2 if face & 1 else -2
     ncell = space.ncell
     period = space.period
-    a = face >> 1
-    o = 2 if face & 1 else -2
-    cx = grid.cell[i, 0]
-    cy = grid.cell[i, 1]
-    cz = grid.cell[i, 2]
-    zr = 1 if ncell[2] >= 3 else 0
-    if a == 0:
-        kx = _neighbour(cx, o, ncell[0], period[0])
-        if kx < 0:
-            return
-        for oz in range(-zr, zr + 1):
-            kz = _neighbour(cz, oz, ncell[2], period[2])
-            if kz < 0:
-                continue
-            for oy in range(-1, 2):
-                ky = _neighbour(cy, oy, ncell[1], period[1])
-                if ky >= 0:
-                    prefetch(grid.head, kx + ncell[0] * (ky + ncell[1] * kz))
-        return
-    ky = _neighbour(cy, o, ncell[1], period[1]) if a == 1 else cy
-    kz = _neighbour(cz, o, ncell[2], period[2]) if a == 2 else cz
-    if ky < 0 or kz < 0:
-        return
     for ob in range(-1, 2):
-        if a == 1:
-            kb = _neighbour(cz, ob, ncell[2], period[2]) if zr else (kz if ob == 0 else -1)
-            if kb >= 0:
-                prefetch(grid.head, cx + ncell[0] * (ky + ncell[1] * kb))
-        else:
-            kb = _neighbour(cy, ob, ncell[1], period[1])
-            if kb >= 0:
-                prefetch(grid.head, cx + ncell[0] * (kb + ncell[1] * kz))
+        ky = _neighbour(grid.cell[i, 1], o if a == 1 else ob, ncell[1], period[1])
+        kz = _neighbour(grid.cell[i, 2], ob if a == 1 else o, ncell[2], period[2])
+        if ky >= 0 and kz >= 0:
+            prefetch(grid.head, grid.cell[i, 0] + ncell[0] * (ky + ncell[1] * kz))
