@@ -570,8 +570,9 @@ def _prefetch_particle(i, p, ev, lists, cal):
 @inlined
 def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     """Prefetch hints for the next event of the cell-crossing mode: the rows of particle
-    i1, its partner and the cell heads around them, and the rows of the likely event
-    after it. Returns that event's guessed particle (-1: none)."""
+    i1 and its partner, the cell heads around i1 (for a crossing also those of the layer
+    it makes adjacent), and the rows of the likely event after it. Returns that event's
+    guessed particle (-1: none)."""
     rec = p.rec
     p1 = ev.partner[i1]
     prefetch(grid.cell, i1)
@@ -580,7 +581,6 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     if p1 == CROSS:
         prefetch_layer(i1, ev.tag[i1], grid, prm.space)
     if p1 >= 0:
-        prefetch_around(p1, grid, prm.space)
         prefetch(rec, p1)
         prefetch(grid.cell, p1)
         prefetch(p.mass, p1)
@@ -600,6 +600,7 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     if i2 >= 0:
         prefetch(rec, i2)
         prefetch(grid.cell, i2)
+        prefetch(grid.pair_t, i2)
         prefetch(ev.partner, i2)
         prefetch(ev.tag, i2)
     return i2
