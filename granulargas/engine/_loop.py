@@ -355,9 +355,10 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
 
 @inlined
 def predict_cells(i, t, rec, count, events, grid, space):
-    """:func:`predict` in the cell-crossing mode (no contacts there), for the loop to inline:
-    the crossing, the best pair (the stored one right after a crossing of i, else the
-    scan of the cells around i), the walls."""
+    """:func:`predict` in the cell-crossing mode (no contacts there), for the loop to inline
+    at the event's own particle: the crossing, the best pair (the stored one right after a
+    crossing of i, else the scan of the cells around i), the walls. (A collision partner's
+    prediction stays a call: inlining it too compiles ~1.2 s longer for ~35 ns per collision.)"""
     best, face = predict_crossing(i, t, rec, grid, space)
     tag = np.int64(face)
     p = np.int64(CROSS)
@@ -447,12 +448,11 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     c.collisions += 1
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
+    tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
     if onlists is not None:
-        tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         if not cal_update(j, tj, cal):
             return CALENDAR
     if oncells is not None:
-        tj = predict_cells(j, te, rec, p.count, ev, lists, prm.space)
         if not cal_update_ring(j, tj, cal):
             return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
