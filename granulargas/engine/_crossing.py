@@ -216,18 +216,6 @@ def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
 
 
 @inlined
-def scan_around(i, t, rec, grid, space):
-    """Earliest collision of particle i (streamed to t) with the particles of the 27 (2D: 9)
-    cells around its cell: (time, partner slot) or (inf, -1)."""
-    if _interior(i, grid, space):
-        nx = space.ncell[0]
-        sz = nx * space.ncell[1]
-        return scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz, 3)
-    zr = 1 if space.ncell[2] >= 3 else 0
-    return scan_cells(i, t, math.inf, rec, grid, space, -1, 1, -1, 1, -zr, zr)
-
-
-@inlined
 def predict_pair_cells(i, t, before, rec, count, grid, space):
     """Earliest collision of particle i (streamed to t) before ``before``: (time, partner
     slot) or (``before``, -1).
@@ -241,7 +229,13 @@ def predict_pair_cells(i, t, before, rec, count, grid, space):
         pt = grid.pair_t[i]
         pj = grid.cell[i, PAIR_J]
     else:
-        pt, pj = scan_around(i, t, rec, grid, space)
+        if _interior(i, grid, space):
+            nx = space.ncell[0]
+            sz = nx * space.ncell[1]
+            pt, pj = scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz, 3)
+        else:
+            zr = 1 if space.ncell[2] >= 3 else 0
+            pt, pj = scan_cells(i, t, math.inf, rec, grid, space, -1, 1, -1, 1, -zr, zr)
         grid.pair_t[i] = pt
         grid.cell[i, PAIR_J] = pj
         grid.cell[i, PAIR_TAG] = count[pj] if pj >= 0 else 0
@@ -360,21 +354,3 @@ def prefetch_around(i, grid, space):
             ky = _neighbour(cy, oy, ncell[1], period[1])
             if ky >= 0:
                 prefetch(grid.head, cx + ncell[0] * (ky + ncell[1] * kz))
-
-
-@inlined
-def prefetch_layer(i, face, grid, space):
-    """Prefetch hints for the cell heads of the layer that a crossing of particle i through
-    ``face`` makes adjacent, two cells beyond i's cell (no effect on results). Through
-    an x face they lie mostly in the lines :func:`prefetch_around` fetches."""
-    a = face >> 1
-    if a == 0:
-        return
-    o = 2 if face & 1 else -2
-    ncell = space.ncell
-    period = space.period
-    for ob in range(-1, 2):
-        ky = _neighbour(grid.cell[i, 1], o if a == 1 else ob, ncell[1], period[1])
-        kz = _neighbour(grid.cell[i, 2], ob if a == 1 else o, ncell[2], period[2])
-        if ky >= 0 and kz >= 0:
-            prefetch(grid.head, grid.cell[i, 0] + ncell[0] * (ky + ncell[1] * kz))

@@ -99,7 +99,6 @@ from granulargas.engine._crossing import (
     predict_crossing,
     predict_pair_cells,
     prefetch_around,
-    prefetch_layer,
     scan_new_layer,
 )
 from granulargas.engine._drive import kick_velocities
@@ -578,8 +577,6 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     prefetch(grid.cell, i1)
     prefetch(grid.pair_t, i1)
     prefetch_around(i1, grid, prm.space)
-    if p1 == CROSS:
-        prefetch_layer(i1, ev.tag[i1], grid, prm.space)
     if p1 >= 0:
         prefetch(rec, p1)
         prefetch(grid.cell, p1)
