@@ -34,6 +34,9 @@ from granulargas.engine._prefetch import prefetch
 
 OVERFLOW = 10
 CELL_OVERFLOW = 11
+#: Below this many particles the list centres (12 bytes each) stay in the L2 cache and
+#: the rebuild's prefetch pass over the candidates' centres only costs time.
+PREFETCH_CENTRES_FROM = 32768
 
 
 @inlined(python=True)  # tests call it from Python
@@ -212,7 +215,8 @@ def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     Passes, so that the cache misses of one pass overlap: (1) the cells around
     (x, y, z) that the cut-off sphere reaches (:func:`_reach`) into
     ``stencil``, with a prefetch for each cell's row, (2) a prefetch for the
-    centre of every particle in them, (3) the distance tests against
+    centre of every particle in them (beyond :data:`PREFETCH_CENTRES_FROM`
+    particles), (3) the distance tests against
     R_i + R_max + shell, branch-free (every candidate is written, the count
     advances on a hit: a branch on data still in flight would serialise the
     misses), each cell with the query point shifted by the cell's periodic
@@ -238,10 +242,11 @@ def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     ns = _reach(x, y, z, cut_max, space, stencil)
     for k in range(ns):
         prefetch(cell_ids, stencil[k] >> 5)
-    for k in range(ns):
-        c = stencil[k] >> 5
-        for q in range(cell_n[c]):
-            prefetch(centre, cell_ids[c, q])
+    if centre.shape[0] > PREFETCH_CENTRES_FROM:
+        for k in range(ns):
+            c = stencil[k] >> 5
+            for q in range(cell_n[c]):
+                prefetch(centre, cell_ids[c, q])
     count = 0
     for k in range(ns):
         c = stencil[k] >> 5
