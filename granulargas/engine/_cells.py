@@ -34,6 +34,9 @@ from granulargas.engine._prefetch import prefetch
 
 OVERFLOW = 10
 CELL_OVERFLOW = 11
+#: Below this many particles the list centres (12 bytes each) stay in the L2 cache and
+#: the rebuild's prefetch pass over the candidates' centres only costs time.
+PREFETCH_CENTRES_FROM = 32768
 
 
 @inlined(python=True)  # tests call it from Python
@@ -144,7 +147,7 @@ def _pick(o, lo2, hi2):
     return 0.0
 
 
-@kernel
+@inlined(python=True)  # tests call it from Python
 def _reach(x, y, z, cut, space, stencil):
     """Cells around (x, y, z) that a sphere of radius ``cut`` can reach, into ``stencil``.
 
@@ -155,6 +158,8 @@ def _reach(x, y, z, cut, space, stencil):
     beyond a wall never. The gap test keeps a margin of 1e-9 cut
     plus 1e-12 box lengths against round-off in the cell assignment. Entries are
     ``32 c + code`` with code = (ox + 1) + 3 (oy + 1) + 9 (oz + 1); returns their number.
+    ``stencil`` needs room for 27 entries whatever the number (every cell of a row is
+    written, the count advances when the cell is reached).
     """
     box = space.box
     ncell = space.ncell
@@ -180,21 +185,26 @@ def _reach(x, y, z, cut, space, stencil):
     if zr == 0:
         zl = 0.0
         zh = 0.0
+    # no branches on the gap tests (coin tosses for the branch predictor)
+    nx = ncell[0]
+    x0 = _wrap(cx - 1, nx)
+    x2 = _wrap(cx + 1, nx)
+    y0 = nx * _wrap(cy - 1, ncell[1])
+    y1 = nx * cy
+    y2 = nx * _wrap(cy + 1, ncell[1])
     ns = 0
     for oz in range(-zr, zr + 1):
         gz = _pick(oz, zl, zh)
-        kz = _wrap(cz + oz, ncell[2])
+        kz = nx * ncell[1] * _wrap(cz + oz, ncell[2])
         for oy in range(-1, 2):
             gyz = _pick(oy, yl, yh) + gz
-            if gyz >= lim2:
-                continue
-            ky = _wrap(cy + oy, ncell[1])
-            row = ncell[0] * (ky + ncell[1] * kz)
-            code = 3 * (oy + 1) + 9 * (oz + 1)
-            for ox in range(-1, 2):
-                if _pick(ox, xl, xh) + gyz < lim2:
-                    stencil[ns] = 32 * (_wrap(cx + ox, ncell[0]) + row) + ox + 1 + code
-                    ns += 1
+            row = 32 * (kz + (y0 if oy < 0 else (y2 if oy > 0 else y1))) + 3 * (oy + 1) + 9 * (oz + 1)
+            stencil[ns] = row + 32 * x0
+            ns += xl + gyz < lim2
+            stencil[ns] = row + 32 * cx + 1
+            ns += gyz < lim2
+            stencil[ns] = row + 32 * x2 + 2
+            ns += xh + gyz < lim2
     return ns
 
 
@@ -205,7 +215,8 @@ def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     Passes, so that the cache misses of one pass overlap: (1) the cells around
     (x, y, z) that the cut-off sphere reaches (:func:`_reach`) into
     ``stencil``, with a prefetch for each cell's row, (2) a prefetch for the
-    centre of every particle in them, (3) the distance tests against
+    centre of every particle in them (beyond :data:`PREFETCH_CENTRES_FROM`
+    particles), (3) the distance tests against
     R_i + R_max + shell, branch-free (every candidate is written, the count
     advances on a hit: a branch on data still in flight would serialise the
     misses), each cell with the query point shifted by the cell's periodic
@@ -231,10 +242,11 @@ def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     ns = _reach(x, y, z, cut_max, space, stencil)
     for k in range(ns):
         prefetch(cell_ids, stencil[k] >> 5)
-    for k in range(ns):
-        c = stencil[k] >> 5
-        for q in range(cell_n[c]):
-            prefetch(centre, cell_ids[c, q])
+    if centre.shape[0] > PREFETCH_CENTRES_FROM:
+        for k in range(ns):
+            c = stencil[k] >> 5
+            for q in range(cell_n[c]):
+                prefetch(centre, cell_ids[c, q])
     count = 0
     for k in range(ns):
         c = stencil[k] >> 5

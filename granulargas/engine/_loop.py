@@ -353,6 +353,23 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
 
 
 @inlined
+def predict_listed(i, t, rec, count, events, lists, space, half_shell, contacts):
+    """:func:`predict` in the neighbour-list mode, inlined into the loop's two hot sites
+    (the particle of the event and its collision partner; ``predict`` itself is a call)."""
+    best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
+    tag = np.int64(0)
+    if in_contact(contacts, i, t):
+        best, p = predict_pair_contact(i, t, best, rec, lists, space.period, contacts)
+    else:
+        best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
+    if p >= 0:
+        tag = np.int64(count[p])
+    else:
+        p = np.int64(EXPIRY)
+    return settle_event(i, t, best, p, tag, rec, events, space)
+
+
+@inlined
 def predict_cells(i, t, rec, count, events, grid, space):
     """:func:`predict` in the cell-crossing mode (no contacts there), for the loop to inline
     at the event's own particle: the crossing, the best pair (the stored one right after a
@@ -447,13 +464,12 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     c.collisions += 1
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
-    tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
     if onlists is not None:
-        if not cal_update(j, tj, cal):
-            return CALENDAR
+        tj = predict_listed(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
     if oncells is not None:
-        if not cal_update_ring(j, tj, cal):
-            return CALENDAR
+        tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
+    if not cal_update_ring(j, tj, cal):
+        return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
         ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
@@ -491,7 +507,7 @@ def execute_crossing(i, face, te, p, grid, c, prm):
     return DONE
 
 
-@inlined
+@kernel(python=False)
 def execute_wall(i, wall, te, p, c, walls, prm):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
     m_eff = m_i. Returns DONE or TABLE_RANGE."""
@@ -758,7 +774,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             clock = tick(probe, P_STALE, clock)
         # ---- re-predict the particle of the event
         if onlists is not None:
-            ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
+            ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
         if oncells is not None:
             ti = predict_cells(i, te, rec, p.count, ev, lists, prm.space)
         clock = tick(probe, PREDICT, clock)
