@@ -2,13 +2,65 @@
 
 Random single-particle displacements, rejected on overlap; candidates come
 from a cell grid of width >= 2 R_max (doubly linked cell lists, reused from
-:mod:`granulargas.engine._cells`). Random numbers are drawn in Python (seeded
-numpy Generator) and passed in, so the result is reproducible everywhere.
+:mod:`granulargas.engine._cells`).
+
+Random numbers of a sweep: the displacement of particle i along axis a uses
+the (d i + a)-th output of the SplitMix64 generator (Steele, Lea & Flood 2014)
+started from a 64-bit ``key`` that Python draws per sweep from the seeded numpy
+Generator; SplitMix64's n-th output is a closed function of (key, n), so each
+is computed where it is used (no array of N d random numbers to fill and read
+per sweep), and the result is reproducible everywhere.
 """
+
+import math
+
+import numpy as np
 
 from granulargas._numba import jit
 from granulargas.engine._cells import _wrap, cell_coord, cell_index, cell_insert, cell_remove
 from granulargas.engine._geometry import min_image
+
+
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+_MIX1 = np.uint64(0xBF58476D1CE4E5B9)
+_MIX2 = np.uint64(0x94D049BB133111EB)
+
+
+@jit(inline="always")
+def splitmix_uniform(key, n):
+    """The n-th (n >= 0) output of SplitMix64 started from ``key``, as a double in [0, 1)
+    (its top 53 bits); key and n uint64."""
+    z = key + (n + np.uint64(1)) * _GOLDEN
+    z = (z ^ (z >> np.uint64(30))) * _MIX1
+    z = (z ^ (z >> np.uint64(27))) * _MIX2
+    z = z ^ (z >> np.uint64(31))
+    return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@jit(inline="always")
+def _trial(r, i, step, key, dim, box):
+    """Trial position r_i + step (2 u - 1) (u of particle i from the sweep's key), wrapped
+    into the box; x = box[0] flags a move to skip (-tiny + L rounded to L)."""
+    n = np.uint64(dim * i)
+    x = r[i, 0] + step * (2.0 * splitmix_uniform(key, n) - 1.0)
+    y = r[i, 1] + step * (2.0 * splitmix_uniform(key, n + np.uint64(1)) - 1.0)
+    z = r[i, 2] + step * (2.0 * splitmix_uniform(key, n + np.uint64(2)) - 1.0) if dim == 3 else r[i, 2]
+    x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
+    y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
+    z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
+    if x >= box[0] or y >= box[1] or z >= box[2]:
+        x = box[0]
+    return x, y, z
+
+
+@jit
+def sweep_uniforms(key, n, dim):
+    """The (n, dim) uniforms a sweep with ``key`` uses (for tests and analysis)."""
+    out = np.empty((n, dim))
+    for i in range(n):
+        for a in range(dim):
+            out[i, a] = splitmix_uniform(key, np.uint64(dim * i + a))
+    return out
 
 
 @jit
@@ -44,20 +96,14 @@ def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
 
 
 @jit
-def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, u):
-    """One sweep of displacement moves r_i += step (2 u[i] - 1) (u (N, d) uniform in
-    [0, 1), d = 2 or 3); returns the accepted count."""
+def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, dim):
+    """One sweep of displacement moves r_i += step (2 u_i - 1), u_i the sweep's uniforms
+    (key uint64, dim = 2 or 3; module docstring); returns the accepted count."""
     accepted = 0
-    three = u.shape[1] == 3
     for i in range(r.shape[0]):
-        x = r[i, 0] + step * (2.0 * u[i, 0] - 1.0)
-        y = r[i, 1] + step * (2.0 * u[i, 1] - 1.0)
-        z = r[i, 2] + step * (2.0 * u[i, 2] - 1.0) if three else r[i, 2]
-        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
-        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
-        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
-        if x >= box[0] or y >= box[1] or z >= box[2]:
-            continue  # -tiny + L rounded to L: skip this move
+        x, y, z = _trial(r, i, step, key, dim, box)
+        if x >= box[0]:
+            continue
         if overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
             continue
         c = cell_index(x, y, z, box, ncell)
@@ -98,10 +144,10 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
 
 
 @jit
-def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, u):
+def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, dim):
     """Sweep of moves accepted when the moved particle's overlap depth does not grow.
 
-    Moves r_i += step (2 u[i] - 1) as in :func:`sweep`. Non-overlapping particles therefore move as hard spheres while overlapping
+    Moves r_i += step (2 u_i - 1) as in :func:`sweep`. Non-overlapping particles therefore move as hard spheres while overlapping
     ones are pushed apart (zero-temperature overlap relaxation). Returns the
     number of particles still overlapping after their move.
     """
@@ -109,13 +155,8 @@ def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of,
     for i in range(r.shape[0]):
         old = overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
                             cell_next)
-        x = r[i, 0] + step * (2.0 * u[i, 0] - 1.0)
-        y = r[i, 1] + step * (2.0 * u[i, 1] - 1.0)
-        z = r[i, 2] + step * (2.0 * u[i, 2] - 1.0) if u.shape[1] == 3 else r[i, 2]
-        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
-        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
-        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
-        if x >= box[0] or y >= box[1] or z >= box[2]:
+        x, y, z = _trial(r, i, step, key, dim, box)
+        if x >= box[0]:
             if old > 0.0:
                 overlapping += 1
             continue
@@ -282,3 +323,166 @@ def distinct(values, m, seen, out):
     for k in range(u):
         seen[out[k]] = False
     return u
+
+
+@jit
+def sort_by_cell(r, radius, ids, box, ncell, start, cell_of, r_tmp, f_tmp, i_tmp):
+    """Stable counting sort of the particles by cell (row by row along x): r (N, 3),
+    radius (N,) and ids (N,) permuted in place; start (n_cells + 1,) receives the
+    first index of each cell (start[-1] = N). cell_of (N,) int, r_tmp, f_tmp and
+    i_tmp (like r, radius, ids) are scratch."""
+    n = r.shape[0]
+    nc = ncell[0] * ncell[1] * ncell[2]
+    start[: nc + 1] = 0
+    for k in range(n):
+        c = cell_index(r[k, 0], r[k, 1], r[k, 2], box, ncell)
+        cell_of[k] = c
+        start[c + 1] += 1
+    for c in range(1, nc + 1):
+        start[c] += start[c - 1]
+    for k in range(n):
+        c = cell_of[k]
+        dest = start[c]
+        start[c] = dest + 1
+        r_tmp[dest, 0] = r[k, 0]
+        r_tmp[dest, 1] = r[k, 1]
+        r_tmp[dest, 2] = r[k, 2]
+        f_tmp[dest] = radius[k]
+        i_tmp[dest] = ids[k]
+    for c in range(nc, 0, -1):
+        start[c] = start[c - 1]
+    start[0] = 0
+    r[:] = r_tmp
+    radius[:] = f_tmp
+    ids[:] = i_tmp
+
+
+@jit(inline="always")
+def _row_overlaps(k, x, y, z, rk, a, b, r, radius, same):
+    if same:  # equal radii: one contact distance
+        s2 = 4.0 * rk * rk
+        for j in range(a, b):
+            dx = x - r[j, 0]
+            dy = y - r[j, 1]
+            dz = z - r[j, 2]
+            if dx * dx + dy * dy + dz * dz < s2 and j != k:
+                return True
+        return False
+    for j in range(a, b):
+        dx = x - r[j, 0]
+        dy = y - r[j, 1]
+        dz = z - r[j, 2]
+        s = rk + radius[j]
+        if dx * dx + dy * dy + dz * dz < s * s and j != k:
+            return True
+    return False
+
+
+@jit
+def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
+    """True if particle k at (x, y, z) overlaps another one, for particles sorted by cell
+    (:func:`sort_by_cell`) on a grid whose y and z cells (3D) are >= 2 ``reach`` wide
+    and with ncell[0] cells along x: scans the two rows in y and z nearest the point,
+    along x the cells within ``reach``. Every particle within reach of the point is
+    scanned, whatever cell it is filed under."""
+    nx = ncell[0]
+    ny = ncell[1]
+    nz = ncell[2]
+    fy = y * (ny / box[1])
+    cy = min(int(fy), ny - 1)
+    ly = cy - 1 if fy - cy < 0.5 else cy
+    if nz > 1:
+        fz = z * (nz / box[2])
+        cz = min(int(fz), nz - 1)
+        lz = cz - 1 if fz - cz < 0.5 else cz
+        mz = 2
+    else:
+        lz = 0
+        mz = 1
+    xl = int(math.floor((x - reach) * (nx / box[0])))
+    xh = min(int(math.floor((x + reach) * (nx / box[0]))), xl + nx - 1)
+    # x cells [xl, xh] as up to two runs of the row: [a1, b1) unshifted, [a2, b2) shifted by sx2
+    a1 = xl
+    b1 = xh + 1
+    a2 = 0
+    b2 = 0
+    sx2 = 0.0
+    if xl < 0:
+        a1 = 0
+        a2 = xl + nx
+        b2 = nx
+        sx2 = -box[0]
+    elif xh >= nx:
+        b1 = nx
+        b2 = xh + 1 - nx
+        sx2 = box[0]
+    rk = radius[k]
+    for oz in range(mz):
+        kz = lz + oz
+        zz = z
+        if kz < 0:
+            kz += nz
+            zz = z + box[2]
+        elif kz >= nz:
+            kz -= nz
+            zz = z - box[2]
+        for oy in range(2):
+            ky = ly + oy
+            yy = y
+            if ky < 0:
+                ky += ny
+                yy = y + box[1]
+            elif ky >= ny:
+                ky -= ny
+                yy = y - box[1]
+            row = nx * (ky + ny * kz)
+            if _row_overlaps(k, x, yy, zz, rk, start[row + a1], start[row + b1], r, radius, same):
+                return True
+            if _row_overlaps(k, x - sx2, yy, zz, rk, start[row + a2], start[row + b2], r, radius, same):
+                return True
+    return False
+
+
+@jit(inline="always")
+def _wrapped(x, length):
+    return x - length if x >= length else (x + length if x < 0.0 else x)
+
+
+@jit
+def sorted_sweep(r, radius, box, ncell, start, step, key, dim):
+    """One sweep of displacement moves r_k += step (2 u_k - 1) (as :func:`sweep`) over
+    particles sorted by cell, in their sorted order, on a grid (:func:`sorted_overlaps`)
+    with reach = 2 R_max + step: the particles already moved in this sweep are less
+    than ``step`` from where they were filed, so they are still found. Until the end
+    of the sweep a moved particle keeps its coordinates unwrapped (next to its cell,
+    possibly outside the box), so that the periodic shift of its cell applies to it.
+    Returns the accepted count."""
+    reach = 0.0
+    rmin = math.inf
+    for k in range(radius.shape[0]):
+        reach = max(reach, radius[k])
+        rmin = min(rmin, radius[k])
+    same = rmin == reach
+    reach = (2.0 * reach + step) * (1.0 + 1e-9)  # (+ rounding margin)
+    accepted = 0
+    for k in range(r.shape[0]):
+        n = np.uint64(dim * k)
+        xu = r[k, 0] + step * (2.0 * splitmix_uniform(key, n) - 1.0)
+        yu = r[k, 1] + step * (2.0 * splitmix_uniform(key, n + np.uint64(1)) - 1.0)
+        zu = r[k, 2] + step * (2.0 * splitmix_uniform(key, n + np.uint64(2)) - 1.0) if dim == 3 else r[k, 2]
+        x = _wrapped(xu, box[0])
+        y = _wrapped(yu, box[1])
+        z = _wrapped(zu, box[2])
+        if x >= box[0] or y >= box[1] or z >= box[2]:
+            continue  # -tiny + L rounded to L: skip this move
+        if sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
+            continue
+        r[k, 0] = xu
+        r[k, 1] = yu
+        r[k, 2] = zu
+        accepted += 1
+    for k in range(r.shape[0]):  # (the same wrap as at the move)
+        r[k, 0] = _wrapped(r[k, 0], box[0])
+        r[k, 1] = _wrapped(r[k, 1], box[1])
+        r[k, 2] = _wrapped(r[k, 2], box[2])
+    return accepted

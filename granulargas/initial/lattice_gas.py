@@ -166,6 +166,20 @@ def _spread_out(m_keep, order, rng):
     return np.sort(order[keep])
 
 
+def _sorted_grid(box, dmax, step):
+    """Cell counts (3,) for a sweep over cell-sorted particles (:func:`_montecarlo.sorted_sweep`):
+    cells ~dmax wide along x, >= 2 (dmax + step) along y and z; None where that
+    needs fewer than two cells on an axis (small boxes) or the step is longer than a
+    diameter (dilute: a wide reach would scan many particles), where cell lists serve better."""
+    reach = dmax + step
+    if step > dmax or float(box.min()) < 4.0 * reach:
+        return None
+    grid = np.ones(3, dtype=np.int64)
+    grid[0] = max(1, int(box[0] / dmax))
+    grid[1 : len(box)] = (box[1:] / (2.0 * reach) * (1.0 - 1e-9)).astype(np.int64)
+    return grid
+
+
 def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     """Random non-overlapping positions (N, d) in [0, L) for spheres/disks of ``radii``,
     with the long-wavelength density fluctuations of the equilibrium fluid (module docstring).
@@ -218,13 +232,33 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     melt = MELT_SWEEPS if sweeps is None else sweeps
     if sweeps is None:
         sweeps = MELT_SWEEPS if n <= 100_000 else 6
-    u = np.empty((n, d))  # uniform random numbers of a sweep
-    state = {"step": 0.1 * dmax}
+    state = {"step": 0.1 * dmax, "stale": False}
+    sorting = {"start": np.empty(0, dtype=np.int64), "cell_of": np.empty(n, dtype=np.int64),
+               "r": np.empty_like(r3), "f": np.empty(n), "i": np.empty(n, dtype=ids.dtype)}
 
-    def do_sweep(rad):
-        rng.random(out=u)
-        acc = mc.sweep(r3, rad, box3, ncell, head, nxt, prv, cof, state["step"], u) / n
-        state["step"] = min(0.5 * float(box.min()), state["step"] * min(2.0, max(0.5, acc / 0.4)))
+    def sweep_key():  # the 64-bit key of a sweep's random numbers (_montecarlo docstring)
+        return np.uint64(rng.integers(0, 2**63, dtype=np.int64))
+
+    def lists():  # the cell lists of the pushes, after sweeps over sorted particles
+        if state["stale"]:
+            mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
+            state["stale"] = False
+
+    def do_sweep(scale):
+        step = state["step"]
+        grid = _sorted_grid(box, dmax * scale, step)
+        if grid is None:  # small box or long moves: cell lists
+            lists()
+            acc = mc.sweep(r3, radii * scale, box3, ncell, head, nxt, prv, cof, step, sweep_key(), d)
+        else:
+            if len(sorting["start"]) <= int(np.prod(grid)):
+                sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int64)
+            mc.sort_by_cell(r3, radii, ids, box3, grid, sorting["start"], sorting["cell_of"], sorting["r"],
+                            sorting["f"], sorting["i"])
+            acc = mc.sorted_sweep(r3, radii * scale, box3, grid, sorting["start"], step, sweep_key(), d)
+            state["stale"] = True
+        acc /= n
+        state["step"] = min(0.5 * float(box.min()), step * min(2.0, max(0.5, acc / 0.4)))
 
     # Dense systems (and lattices too tight for the largest particles) start
     # diluted, radii scaled by lam so that the packing is <= 0.25 and the sweeps
@@ -236,7 +270,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         sweeps = max(int(melt), int(sweeps))
     if lam < 1.0:
         for _ in range(int(melt)):
-            do_sweep(radii * lam)
+            do_sweep(lam)
     buf = np.empty(max(64, 40 * n), dtype=np.int64)
     near = np.empty(256, dtype=np.int64)
     uniq = np.empty(n, dtype=np.int64)
@@ -246,6 +280,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         if grow < 1e-4:
             raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
                               f"radii (reached {lam:.4f} of the target size)")
+        lists()
         saved = r3.copy()
         trial = min(1.0, lam * (1.0 + grow))
         rad = radii * trial
@@ -254,8 +289,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             if len(idx) == 0:
                 break
             if it % 100 == 99:  # jammed spots: let the hard-sphere surroundings make room
-                rng.random(out=u)
-                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, u)
+                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, sweep_key(), d)
                 idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
                 continue
             kick = rng.uniform(0.5, 1.5, size=len(idx))
@@ -270,10 +304,9 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             continue
         grow = min(0.05, grow * 1.5)
         lam = trial
-        rad = radii * lam
-        do_sweep(rad)
+        do_sweep(lam)
     for _ in range(int(sweeps)):
-        do_sweep(radii)
+        do_sweep(1.0)
     out = np.empty((n, d))
     out[ids] = r3[:, :d]
     return out
