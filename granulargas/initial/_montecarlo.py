@@ -14,6 +14,7 @@ per sweep), and the result is reproducible everywhere.
 
 import math
 
+import numba
 import numpy as np
 
 from granulargas._numba import jit
@@ -448,15 +449,43 @@ def _wrapped(x, length):
     return x - length if x >= length else (x + length if x < 0.0 else x)
 
 
-@jit
+@jit(inline="always")
+def _sorted_move(k, r, radius, box, ncell, start, step, key, dim, reach, same):
+    """Move k of a sweep over cell-sorted particles; True if accepted."""
+    n = np.uint64(dim * k)
+    xu = r[k, 0] + step * (2.0 * splitmix_uniform(key, n) - 1.0)
+    yu = r[k, 1] + step * (2.0 * splitmix_uniform(key, n + np.uint64(1)) - 1.0)
+    zu = r[k, 2] + step * (2.0 * splitmix_uniform(key, n + np.uint64(2)) - 1.0) if dim == 3 else r[k, 2]
+    x = _wrapped(xu, box[0])
+    y = _wrapped(yu, box[1])
+    z = _wrapped(zu, box[2])
+    if x >= box[0] or y >= box[1] or z >= box[2]:
+        return False  # -tiny + L rounded to L: skip this move
+    if sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
+        return False
+    r[k, 0] = xu
+    r[k, 1] = yu
+    r[k, 2] = zu
+    return True
+
+
+@jit(parallel=True)
 def sorted_sweep(r, radius, box, ncell, start, step, key, dim):
     """One sweep of displacement moves r_k += step (2 u_k - 1) (as :func:`sweep`) over
-    particles sorted by cell, in their sorted order, on a grid (:func:`sorted_overlaps`)
-    with reach = 2 R_max + step: the particles already moved in this sweep are less
-    than ``step`` from where they were filed, so they are still found. Until the end
-    of the sweep a moved particle keeps its coordinates unwrapped (next to its cell,
-    possibly outside the box), so that the periodic shift of its cell applies to it.
-    Returns the accepted count."""
+    particles sorted by cell, on a grid (:func:`sorted_overlaps`) with reach = 2 R_max
+    + step: the particles already moved in this sweep are less than ``step`` from
+    where they were filed, so they are still found. Until the end of the sweep a
+    moved particle keeps its coordinates unwrapped (next to its cell, possibly
+    outside the box), so that the periodic shift of its cell applies to it.
+
+    Order: the slabs of cells (z layers in 3D, y rows in 2D; an even number of
+    them, each >= 2 reach thick) of even index first, then those of odd index; in
+    each slab the particles in their sorted order. The moves in one slab neither
+    read nor write what the moves in another slab of the same parity do (a scan
+    reaches into the two neighbouring slabs only, which do not move meanwhile),
+    so the slabs of a parity run in parallel threads and the result is the same
+    for any number of threads. Returns the accepted count.
+    """
     reach = 0.0
     rmin = math.inf
     for k in range(radius.shape[0]):
@@ -464,23 +493,19 @@ def sorted_sweep(r, radius, box, ncell, start, step, key, dim):
         rmin = min(rmin, radius[k])
     same = rmin == reach
     reach = (2.0 * reach + step) * (1.0 + 1e-9)  # (+ rounding margin)
+    if ncell[2] > 1:
+        slabs = ncell[2]
+        per_slab = ncell[0] * ncell[1]
+    else:
+        slabs = ncell[1]
+        per_slab = ncell[0]
     accepted = 0
-    for k in range(r.shape[0]):
-        n = np.uint64(dim * k)
-        xu = r[k, 0] + step * (2.0 * splitmix_uniform(key, n) - 1.0)
-        yu = r[k, 1] + step * (2.0 * splitmix_uniform(key, n + np.uint64(1)) - 1.0)
-        zu = r[k, 2] + step * (2.0 * splitmix_uniform(key, n + np.uint64(2)) - 1.0) if dim == 3 else r[k, 2]
-        x = _wrapped(xu, box[0])
-        y = _wrapped(yu, box[1])
-        z = _wrapped(zu, box[2])
-        if x >= box[0] or y >= box[1] or z >= box[2]:
-            continue  # -tiny + L rounded to L: skip this move
-        if sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
-            continue
-        r[k, 0] = xu
-        r[k, 1] = yu
-        r[k, 2] = zu
-        accepted += 1
+    for parity in range(2):
+        for h in numba.prange(slabs // 2):
+            slab = 2 * h + parity
+            for k in range(start[slab * per_slab], start[(slab + 1) * per_slab]):
+                if _sorted_move(k, r, radius, box, ncell, start, step, key, dim, reach, same):
+                    accepted += 1
     for k in range(r.shape[0]):  # (the same wrap as at the move)
         r[k, 0] = _wrapped(r[k, 0], box[0])
         r[k, 1] = _wrapped(r[k, 1], box[1])

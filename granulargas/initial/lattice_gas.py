@@ -177,6 +177,7 @@ def _sorted_grid(box, dmax, step):
     grid = np.ones(3, dtype=np.int64)
     grid[0] = max(1, int(box[0] / dmax))
     grid[1 : len(box)] = (box[1:] / (2.0 * reach) * (1.0 - 1e-9)).astype(np.int64)
+    grid[len(box) - 1] -= grid[len(box) - 1] % 2  # an even number of slabs
     return grid
 
 
