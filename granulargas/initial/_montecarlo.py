@@ -511,3 +511,24 @@ def sorted_sweep(r, radius, box, ncell, start, step, key, dim):
         r[k, 1] = _wrapped(r[k, 1], box[1])
         r[k, 2] = _wrapped(r[k, 2], box[2])
     return accepted
+
+
+@jit(parallel=True)
+def sorted_overlapping(r, radius, box, ncell, start, flags):
+    """flags[k] = particle k overlaps some other one, for particles sorted by cell
+    (:func:`sort_by_cell`, positions as filed) on a grid of :func:`sorted_overlaps`
+    with reach 2 R_max; returns the number of overlapping particles."""
+    reach = 0.0
+    rmin = math.inf
+    for k in range(radius.shape[0]):
+        reach = max(reach, radius[k])
+        rmin = min(rmin, radius[k])
+    same = rmin == reach
+    reach = 2.0 * reach * (1.0 + 1e-9)  # (+ rounding margin)
+    count = 0
+    for k in numba.prange(r.shape[0]):
+        hit = sorted_overlaps(k, r[k, 0], r[k, 1], r[k, 2], r, radius, box, ncell, start, reach, same)
+        flags[k] = hit
+        if hit:
+            count += 1
+    return count

@@ -245,6 +245,13 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
             state["stale"] = False
 
+    def sort(grid):  # particles (and their radii and ids) sorted by the cells of grid
+        if len(sorting["start"]) <= int(np.prod(grid)):
+            sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int64)
+        mc.sort_by_cell(r3, radii, ids, box3, grid, sorting["start"], sorting["cell_of"], sorting["r"],
+                        sorting["f"], sorting["i"])
+        state["stale"] = True
+
     def do_sweep(scale):
         step = state["step"]
         grid = _sorted_grid(box, dmax * scale, step)
@@ -252,12 +259,8 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             lists()
             acc = mc.sweep(r3, radii * scale, box3, ncell, head, nxt, prv, cof, step, sweep_key(), d)
         else:
-            if len(sorting["start"]) <= int(np.prod(grid)):
-                sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int64)
-            mc.sort_by_cell(r3, radii, ids, box3, grid, sorting["start"], sorting["cell_of"], sorting["r"],
-                            sorting["f"], sorting["i"])
+            sort(grid)
             acc = mc.sorted_sweep(r3, radii * scale, box3, grid, sorting["start"], step, sweep_key(), d)
-            state["stale"] = True
         acc /= n
         state["step"] = min(0.5 * float(box.min()), step * min(2.0, max(0.5, acc / 0.4)))
 
@@ -281,11 +284,18 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         if grow < 1e-4:
             raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
                               f"radii (reached {lam:.4f} of the target size)")
+        trial = min(1.0, lam * (1.0 + grow))
+        grid = _sorted_grid(box, dmax * trial, 0.0)
+        if grid is not None:  # census over sorted particles
+            sort(grid)
+            mc.sorted_overlapping(r3, radii * trial, box3, grid, sorting["start"], seen)
+            idx = np.flatnonzero(seen)
+            seen[:] = False
         lists()
         saved = r3.copy()
-        trial = min(1.0, lam * (1.0 + grow))
         rad = radii * trial
-        idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
+        if grid is None:
+            idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
         for it in range(600):
             if len(idx) == 0:
                 break
