@@ -1,8 +1,19 @@
 """Compiled hard-sphere Monte Carlo sweeps for initial states (numba leaf module).
 
-Random single-particle displacements, rejected on overlap; candidates come
-from a cell grid of width >= 2 R_max (doubly linked cell lists, reused from
-:mod:`granulargas.engine._cells`).
+Random single-particle displacements, rejected on overlap. Two ways to find
+the candidates:
+
+* particles sorted by cell before each sweep (:func:`sort_by_cell`,
+  :func:`sorted_sweep`): the cells of a row are contiguous in memory, so a scan
+  reads a few contiguous runs of positions instead of following a linked list
+  per cell (each list of ~1 particle costs a mispredicted loop exit and a
+  dependent load); cells are left stale during the sweep and the scan reaches
+  2 R_max + step, which finds every particle moved since the sort. The sweep
+  runs slab by slab, so that the slabs of one parity run in parallel threads
+  with a result independent of the thread count;
+* doubly linked cell lists on a grid of width >= 2 R_max (reused from
+  :mod:`granulargas.engine._cells`), kept up to date by every move: for small
+  boxes, long moves (dilute gases) and the overlap pushes of the growth steps.
 
 Random numbers of a sweep: the displacement of particle i along axis a uses
 the (d i + a)-th output of the SplitMix64 generator (Steele, Lea & Flood 2014)

@@ -17,7 +17,10 @@ stuck for some seeds and raises ConfigError):
    overlaps pushed apart, every push overshooting by ``PUSH_MARGIN`` times the
    step, so that a dense step settles in tens of passes rather than hundreds);
 3. hard-sphere Monte Carlo sweeps (random displacements rejected on overlap,
-   step adapted to ~40 % acceptance) destroy the lattice order.
+   step adapted to ~40 % acceptance) destroy the lattice order. A sweep moves
+   the particles sorted by cell, slab by slab (:mod:`._montecarlo`): the slabs of
+   one parity run in parallel threads, with the same result for any number of
+   threads (``NUMBA_NUM_THREADS``).
 
 Long-wavelength density fluctuations. The sweeps move each particle by a
 fraction of a diameter: they relax the structure at short range, but a density
