@@ -146,14 +146,19 @@ def test_sonine_a2_of_the_hcs_matches_van_noije_ernst(tmp_path):
 
 
 def test_viscoelastic_cooling_at_damping_0_1_follows_the_kinetic_theory(tmp_path):
-    # damping 0.1 (beta ~ 0.1 at thermal speed): the leading-order law is 20 % off by
-    # t = 60, the kinetic theory with the exact eps(g) and a2(t) within 3 % (it agrees with
-    # DSMC of the Enskog-Boltzmann equation to 0.15 %; N = 1000 seeds 5-10 give T/T_theory
-    # 1.018 +- 0.018 over the last decade with neighbour lists, 1.020 +- 0.014 with cell
-    # crossings: velocity correlations of the small periodic box; this seed with lists: 1.022)
-    a = _run(tmp_path, 3, 1000, 0.1, 5, 'model = "viscoelastic"\ndamping = 0.1', 60.0, 0.5, "lists")
-    eps_eff = math.sqrt(1 - th.effective_inelasticity(0.1, 1.0))
-    _check_homogeneous_box(a, eps_eff)
-    assert abs(a.T_ratio_last_decade - 1) < 0.03, a.T_ratio_last_decade
-    closed = a.history.temperature[-1] / a.prediction.temperature(a.time[-1])
-    assert closed > 1.1, closed
+    # damping 0.1 (beta ~ 0.1 at thermal speed): the leading-order law is 10-20 % off by
+    # the end, the kinetic theory with the exact eps(g) and a2(t) within 3 % (it agrees with
+    # DSMC of the Enskog-Boltzmann equation to 0.15 %). Packing 0.05, N = 1000, four seeds:
+    # single seeds scatter by 1.1 % (seeds 1-12: T/T_theory 0.998 +- 0.003 over the last
+    # decade). At packing 0.1 the simulated gas cools 2 % slower than Enskog's theory at
+    # every N (1000: 1.018 +- 0.004, 4000: 1.021 +- 0.002), the velocity correlations
+    # that the Enskog closure leaves out.
+    ratios, closed = [], []
+    for seed in (1, 2, 3, 4):
+        a = _run(tmp_path, 3, 1000, 0.05, seed, 'model = "viscoelastic"\ndamping = 0.1', 120.0, 1.0)
+        eps_eff = math.sqrt(1 - th.effective_inelasticity(0.1, 1.0))
+        _check_homogeneous_box(a, eps_eff)
+        ratios.append(a.T_ratio_last_decade)
+        closed.append(a.history.temperature[-1] / a.prediction.temperature(a.time[-1]))
+    assert abs(np.mean(ratios) - 1) < 0.03, ratios
+    assert min(closed) > 1.1, closed
