@@ -159,9 +159,10 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
 def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, dim):
     """Sweep of moves accepted when the moved particle's overlap depth does not grow.
 
-    Moves r_i += step (2 u_i - 1) as in :func:`sweep`. Non-overlapping particles therefore move as hard spheres while overlapping
-    ones are pushed apart (zero-temperature overlap relaxation). Returns the
-    number of particles still overlapping after their move.
+    Moves r_i += step (2 u_i - 1) as in :func:`sweep`. Non-overlapping particles
+    therefore move as hard spheres while overlapping ones are pushed apart
+    (zero-temperature overlap relaxation). Returns the number of particles still
+    overlapping after their move.
     """
     overlapping = 0
     for i in range(r.shape[0]):
