@@ -69,7 +69,7 @@ import math
 
 import numpy as np
 
-from granulargas._numba import jit, kernel
+from granulargas._numba import inlined, jit, kernel
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._state import CALENDAR_STATE, Calendar
 
@@ -119,7 +119,7 @@ def allocate_calendar(n, capacity=None, pool=None) -> Calendar:
 
 
 # ----------------------------------------------------------------- small heap
-@kernel(inline="always")
+@inlined
 def _sift_up(small, where, k):
     t = small[k, 0]
     p = small[k, 1]
@@ -138,7 +138,7 @@ def _sift_up(small, where, k):
     where[int(p)] = -k - 1
 
 
-@kernel(inline="always")
+@inlined
 def _sift_down(small, where, k, n):
     t = small[k, 0]
     p = small[k, 1]
@@ -166,7 +166,7 @@ def _sift_down(small, where, k, n):
     where[int(p)] = -k - 1
 
 
-@kernel(inline="always")
+@inlined
 def _small_push(i, t, small, where, cs):
     k = cs.size
     if k >= small.shape[0]:
@@ -178,7 +178,7 @@ def _small_push(i, t, small, where, cs):
     return True
 
 
-@kernel(inline="always")
+@inlined
 def _small_remove(k, small, where, cs):
     last = cs.size - 1
     cs.size = last
@@ -194,7 +194,7 @@ def _small_remove(k, small, where, cs):
 
 
 # -------------------------------------------------------------------- buckets
-@kernel(inline="always")
+@inlined
 def _append(i, b, chunks, buckets, where, cs):
     """Put id i into bucket b; False if the chunk pool is empty."""
     c = buckets[b, 0]
@@ -214,7 +214,7 @@ def _append(i, b, chunks, buckets, where, cs):
     return True
 
 
-@kernel(inline="always")
+@inlined
 def _release(c, chunks, cs):
     chunks[c, 0] = cs.free
     cs.free = c
@@ -224,7 +224,8 @@ def _release(c, chunks, cs):
 _OK, _HEAP_FULL, _POOL_EMPTY = 0, 1, 2
 
 
-def _insert_impl(i, t, cal, cs):
+@inlined
+def _insert(i, t, cal, cs):
     """Place the event of particle i at time t; returns _OK, _HEAP_FULL or _POOL_EMPTY."""
     cal.qt[i] = t
     x = (t - cs.t0) / cs.width
@@ -244,13 +245,14 @@ def _insert_impl(i, t, cal, cs):
     return _OK
 
 
-# the hot path inlines it; the cold paths (rebuilds, overflow) share one compiled copy,
-# which keeps the first compile short
-_insert = kernel(inline="always")(_insert_impl)
-_insert_call = kernel(_insert_impl)
+@kernel(python=False)
+def _insert_call(i, t, cal, cs):
+    """:func:`_insert` for the cold paths (rebuilds, overflow): one compiled copy that they
+    share, which keeps the first compile short (the hot path inlines :func:`_insert`)."""
+    return _insert(i, t, cal, cs)
 
 
-@kernel
+@kernel(python=False)
 def _place_all(t0, w, cal):
     """Empty the calendar and insert every event ``qt`` (windows from t0, width w).
 
@@ -281,7 +283,7 @@ def _place_all(t0, w, cal):
     return True
 
 
-@kernel
+@kernel(python=False)
 def _replace(failure, cal):
     """Place all events anew from ``qt`` (which always holds every event time).
 
@@ -328,7 +330,7 @@ def cal_update(i, t, cal):
     return True
 
 
-@kernel
+@kernel(python=False)
 def _redistribute_overflow(cal):
     """Place the live overflow events anew; returns an insert status (_OK or the failure)."""
     cs = cal.state[0]
@@ -357,7 +359,7 @@ def _redistribute_overflow(cal):
     return _OK
 
 
-@kernel(inline="always")
+@inlined
 def _open_bucket(slot, cal, cs):
     """Move the live events of ring bucket ``slot`` into the small heap; False if it fills."""
     chunks = cal.chunks
@@ -388,7 +390,7 @@ def _open_bucket(slot, cal, cs):
     return True
 
 
-@kernel(inline="always")
+@inlined
 def cal_look_ahead(cal):
     """Prefetch hints for one chunk of the next bucket (no effect on results).
 
@@ -413,7 +415,7 @@ def cal_look_ahead(cal):
         cs.look = nx
 
 
-@kernel(inline="always")
+@inlined
 def cal_after_next(cal, skip):
     """Best guess of the particle whose event follows the earliest one, or -1.
 
@@ -443,7 +445,7 @@ def cal_after_next(cal, skip):
     return int(small[c2, 1]) if c2 > 0 else -1
 
 
-@kernel(inline="always")
+@inlined
 def cal_next_time(cal):
     """Time of the earliest event after :func:`cal_peek` returned its particle."""
     return cal.small[0, 0]

@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from granulargas._numba import kernel
+from granulargas._numba import inlined, kernel
 from granulargas.engine._geometry import min_image
 from granulargas.engine._prefetch import prefetch
 
@@ -36,7 +36,7 @@ OVERFLOW = 10
 CELL_OVERFLOW = 11
 
 
-@kernel(inline="always")
+@inlined(python=True)  # tests call it from Python
 def cell_coord(x, length, n):
     c = int(x * (n / length))
     if c >= n:
@@ -46,7 +46,7 @@ def cell_coord(x, length, n):
     return c
 
 
-@kernel(inline="always")
+@inlined
 def cell_index(x, y, z, box, ncell):
     cx = cell_coord(x, box[0], ncell[0])
     cy = cell_coord(y, box[1], ncell[1])
@@ -54,13 +54,13 @@ def cell_index(x, y, z, box, ncell):
     return cx + ncell[0] * (cy + ncell[1] * cz)
 
 
-@kernel(inline="always")
+@inlined
 def stencil_size(ncell):
     """Cells around a point: 27 in 3D, 9 with a single layer in z (2D)."""
     return 27 if ncell[2] >= 3 else 9
 
 
-@kernel(inline="always")
+@inlined
 def stencil_cell(cx, cy, cz, k, ncell):
     """Flat index of the k-th cell around cell (cx, cy, cz), periodic.
 
@@ -75,7 +75,7 @@ def stencil_cell(cx, cy, cz, k, ncell):
     return kx + ncell[0] * (ky + ncell[1] * kz)
 
 
-@kernel(inline="always")
+@inlined
 def cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of):
     h = cell_head[c]
     cell_next[i] = h
@@ -86,7 +86,7 @@ def cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of):
     cell_of[i] = c
 
 
-@kernel(inline="always")
+@inlined
 def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
     p = cell_prev[i]
     n = cell_next[i]
@@ -98,7 +98,7 @@ def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
         cell_prev[n] = p
 
 
-@kernel(inline="always")
+@inlined
 def slot_insert(i, c, cell_ids, cell_n, cell_of):
     """Append particle i to cell c (the caller has checked the capacity)."""
     q = cell_n[c]
@@ -107,7 +107,7 @@ def slot_insert(i, c, cell_ids, cell_n, cell_of):
     cell_of[i] = c
 
 
-@kernel(inline="always")
+@inlined
 def slot_remove(i, cell_ids, cell_n, cell_of):
     """Remove particle i from its cell (the cell's last entry takes its slot).
 
@@ -124,7 +124,7 @@ def slot_remove(i, cell_ids, cell_n, cell_of):
     cell_n[c] = last
 
 
-@kernel(inline="always")
+@inlined
 def _gaps2(x, c, length, n):
     """Squared distances from x to the lower and upper faces of its cell c (0 if outside)."""
     w = length / n
@@ -135,7 +135,7 @@ def _gaps2(x, c, length, n):
     return lo * lo, hi * hi
 
 
-@kernel(inline="always")
+@inlined
 def _pick(o, lo2, hi2):
     if o < 0:
         return lo2
@@ -198,7 +198,7 @@ def _reach(x, y, z, cut, space, stencil):
     return ns
 
 
-@kernel(inline="always")
+@inlined
 def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     """Particles j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
 
@@ -269,7 +269,7 @@ def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     return found
 
 
-@kernel
+@kernel(python=False)
 def prefetch_cells(x, y, z, cut, space, cells, stencil):
     """Prefetch hints for the cell rows a list rebuild around (x, y, z) will read.
 
@@ -283,7 +283,7 @@ def prefetch_cells(x, y, z, cut, space, cells, stencil):
         prefetch(cells.n, c)
 
 
-@kernel(inline="always")
+@inlined
 def _wrap(c, n):
     if c < 0:
         return c + n
@@ -292,7 +292,7 @@ def _wrap(c, n):
     return c
 
 
-@kernel(inline="always")
+@inlined
 def _shift(c, n, length):
     """Periodic offset of unwrapped cell coordinate c: the cell's contents sit at x + shift."""
     if c < 0:

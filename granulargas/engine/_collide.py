@@ -31,7 +31,7 @@ Everything here works on plain floats, so that other collision-driven methods
     v_i -= fi * n;  v_j += fj * n          # loss = energy lost, impulse = (1 + eps) m_eff u_n
 """
 
-from granulargas._numba import kernel
+from granulargas._numba import inlined
 from granulargas.contact.lookup import table_lookup
 
 ELASTIC = 0
@@ -39,7 +39,7 @@ CONSTANT = 1
 VISCOELASTIC = 2
 
 
-@kernel(inline="always")
+@inlined
 def restitution(kind, eps_const, prefactor, inv_h, coeffs, gn, r_eff, m_eff):
     """Coefficient of restitution of one collision (-1.0 if beyond the table).
 
@@ -64,7 +64,7 @@ def restitution(kind, eps_const, prefactor, inv_h, coeffs, gn, r_eff, m_eff):
     return table_lookup(beta, inv_h, coeffs)
 
 
-@kernel(inline="always")
+@inlined
 def pair_collision(un, mi, mj, eps):
     """Velocity changes, energy loss and impulse of a pair collision, eq. (2).
 
@@ -93,7 +93,7 @@ def pair_collision(un, mi, mj, eps):
     return f * mj, f * mi, 0.5 * (1.0 - eps * eps) * m_eff * un * un, (1.0 + eps) * m_eff * un
 
 
-@kernel(inline="always")
+@inlined
 def wall_collision(vn, mi, eps):
     """Sphere-wall collision: (new normal velocity, energy lost, momentum given to the wall).
 

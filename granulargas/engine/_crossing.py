@@ -44,7 +44,7 @@ than 2 R_max by a relative margin of :data:`MARGIN` that covers it.
 
 import math
 
-from granulargas._numba import kernel
+from granulargas._numba import inlined, kernel
 from granulargas.engine._geometry import min_image, pair_delay
 from granulargas.engine._prefetch import prefetch
 
@@ -52,7 +52,7 @@ from granulargas.engine._prefetch import prefetch
 MARGIN = 1e-6
 
 
-@kernel(inline="always")
+@inlined
 def face_gap(x, v, c, width, n, period):
     """Distance along one axis from coordinate x (in cell c of width ``width``, n cells),
     moving at v, to the face it moves to, and that face's side (0 lower, 1 upper).
@@ -70,7 +70,7 @@ def face_gap(x, v, c, width, n, period):
     return (gap if gap > 0.0 else 0.0), speed, 0
 
 
-@kernel(inline="always")
+@inlined
 def predict_crossing(i, t, rec, grid, space):
     """Earliest cell crossing of particle i (streamed to t): (time, face 2 a + side).
 
@@ -95,7 +95,7 @@ def predict_crossing(i, t, rec, grid, space):
     return t + gap / speed, face
 
 
-@kernel(inline="always")
+@inlined
 def _neighbour(c, o, n, period):
     """Cell coordinate c + o, wrapped on a periodic axis; -1 beyond a wall."""
     k = c + o
@@ -106,7 +106,7 @@ def _neighbour(c, o, n, period):
     return k
 
 
-@kernel(inline="always")
+@inlined
 def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     """Earliest collision of particle i (streamed to t) with the particles of the cells at
     offsets [x0, x1] x [y0, y1] x [z0, z1] from its cell, before ``before``: (time,
@@ -155,7 +155,7 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     return best, p
 
 
-@kernel(inline="always")
+@inlined
 def predict_pair_cells(i, t, before, rec, count, grid, space):
     """Earliest collision of particle i (streamed to t) before ``before``: (time, partner
     slot) or (``before``, -1).
@@ -179,7 +179,7 @@ def predict_pair_cells(i, t, before, rec, count, grid, space):
     return before, -1
 
 
-@kernel(inline="always")
+@inlined
 def scan_new_layer(i, t, face, rec, count, grid, space):
     """After i crossed ``face`` into its present cell: keep the better of the stored pair
     and the particles of the layer of cells that became adjacent, and mark the stored
@@ -205,7 +205,7 @@ def scan_new_layer(i, t, face, rec, count, grid, space):
     grid.fresh[0] = i
 
 
-@kernel(inline="always")
+@inlined
 def grid_insert(i, c, grid):
     """Put particle i at the head of cell c's list."""
     head = grid.head
@@ -218,7 +218,7 @@ def grid_insert(i, c, grid):
     grid.cell[i, 3] = c
 
 
-@kernel(inline="always")
+@inlined
 def grid_remove(i, grid):
     """Take particle i out of its cell's list."""
     q = grid.prev[i]
@@ -231,7 +231,7 @@ def grid_remove(i, grid):
         grid.prev[n] = q
 
 
-@kernel(inline="always")
+@inlined
 def cross(i, face, grid, space):
     """Move particle i (at the face ``face`` of its cell) into the cell beyond that face."""
     a = face >> 1
@@ -260,7 +260,7 @@ def build_grid(rec, grid, space):
         grid_insert(i, grid.cell[i, 0] + ncell[0] * (grid.cell[i, 1] + ncell[1] * grid.cell[i, 2]), grid)
 
 
-@kernel(inline="always")
+@inlined
 def prefetch_around(i, grid, space):
     """Prefetch hints for the cell heads around particle i's cell (no effect on results)."""
     ncell = space.ncell

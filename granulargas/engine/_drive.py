@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from granulargas._numba import kernel
+from granulargas._numba import inlined, kernel
 
 _GAMMA = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -50,7 +50,7 @@ _S2 = np.uint64(2)
 _TWO53 = 1.0 / 9007199254740992.0
 
 
-@kernel(inline="always")
+@inlined
 def mix64(z):
     """SplitMix64 finaliser of a 64-bit word (a bijection with full avalanche)."""
     z = (z ^ (z >> _S30)) * _M1
@@ -58,13 +58,13 @@ def mix64(z):
     return z ^ (z >> _S31)
 
 
-@kernel(inline="always")
+@inlined
 def _uniform(key, counter):
     """Uniform number in [0, 1) for a counter under a key (53 random bits)."""
     return np.float64(mix64(key + counter * _GAMMA) >> _S11) * _TWO53
 
 
-@kernel(inline="always")
+@inlined(python=True)  # tests call it from Python
 def kick_normals(seed, step, ident):
     """Three independent standard normal numbers for (seed, step k, particle id).
 

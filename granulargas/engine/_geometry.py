@@ -22,10 +22,10 @@ that overlaps and recedes is left alone: it separates.
 
 import math
 
-from granulargas._numba import kernel
+from granulargas._numba import inlined
 
 
-@kernel(inline="always")
+@inlined
 def min_image(dx, length):
     """Nearest periodic image of a coordinate difference with |dx| < 1.5 L."""
     half = 0.5 * length
@@ -36,7 +36,7 @@ def min_image(dx, length):
     return dx
 
 
-@kernel(inline="always")
+@inlined
 def collision_delay(dx, dy, dz, ux, uy, uz, sigma):
     """Time until contact of a pair, or inf.
 
@@ -71,7 +71,7 @@ def collision_delay(dx, dy, dz, ux, uy, uz, sigma):
     return s if hit else math.inf
 
 
-@kernel(inline="always")
+@inlined
 def pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period):
     """Time from t until particle i (centre (xi, yi, zi) at t, velocity v, radius ri)
     touches particle j, streamed from its own clock: (1) with the record of j
@@ -83,7 +83,7 @@ def pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period):
                            vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
 
 
-@kernel(inline="always")
+@inlined
 def exit_delay(dx, dy, dz, vx, vy, vz, radius):
     """Time until a particle at offset d from its list centre is at distance ``radius``.
 
@@ -103,7 +103,7 @@ def exit_delay(dx, dy, dz, vx, vy, vz, radius):
     return (q - b) / v2
 
 
-@kernel(inline="always")
+@inlined
 def wall_delay(x, v, radius, length):
     """Time until a sphere at coordinate x, moving at v along a wall axis, touches a wall.
 

@@ -81,7 +81,7 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
-from granulargas._numba import kernel
+from granulargas._numba import inlined, kernel
 from granulargas.engine._calendar import (
     cal_after_next,
     cal_build,
@@ -136,7 +136,7 @@ STALE = -4
 CROSS = -5
 
 
-@kernel(inline="always")
+@inlined
 def stream(i, t, rec, img, period):
     """Move particle i on its straight line to time t, wrapping on periodic axes."""
     dt = t - rec[i, 6]
@@ -153,7 +153,7 @@ def stream(i, t, rec, img, period):
 
 
 # --------------------------------------------------------------------- predict
-@kernel(inline="always")
+@inlined
 def predict_expiry(i, t, rec, centre, period, half_shell):
     """Time at which particle i (streamed to t) is ``half_shell`` from its list centre."""
     return t + exit_delay(min_image(rec[i, 0] - centre[i, 0], period[0]),
@@ -162,7 +162,7 @@ def predict_expiry(i, t, rec, centre, period, half_shell):
                           rec[i, 3], rec[i, 4], rec[i, 5], half_shell)
 
 
-@kernel(inline="always")
+@inlined
 def predict_pair(i, t, before, rec, nbl, nbn, period):
     """Earliest collision of particle i (streamed to t) with its neighbours before ``before``.
 
@@ -187,7 +187,7 @@ def predict_pair(i, t, before, rec, nbl, nbn, period):
     return best, p
 
 
-@kernel
+@kernel(python=False)
 def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts):
     """:func:`predict_pair` for a particle whose contact is under way (resolved rule,
     :mod:`granulargas.engine._resolved`).
@@ -269,7 +269,7 @@ def _collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
         i, j, te, dx, dy, dz, p, contacts, c, rule, period)
 
 
-@kernel(inline="always")
+@inlined
 def predict_wall(i, t, rec, space):
     """Earliest wall collision of particle i (streamed to t): (time, wall index 2 a + side).
 
@@ -287,7 +287,7 @@ def predict_wall(i, t, rec, space):
     return t + best, wall
 
 
-@kernel(inline="always")
+@inlined
 def predict_kick(c, prm):
     """Time of the next driving step, (k + 1/2) dt_k (inf without driving)."""
     return (c.kick_step + 0.5) * prm.kick_interval if prm.kick_interval < math.inf else math.inf
@@ -299,7 +299,7 @@ def mode_flags(cells):
     return (1, None) if cells is not None else (None, 1)
 
 
-@kernel
+@kernel(python=False)
 def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
 
@@ -351,7 +351,7 @@ def predict_all(t, rec, count, events, lists, onlists, oncells, space, half_shel
 
 
 # --------------------------------------------------------------------- execute
-@kernel(inline="always")
+@inlined
 def _collapse_watch(i, te, p, prm):
     """Count runs of ever faster re-collisions of particle i; note the collision time."""
     if te - p.lastcoll[i] < prm.collapse_dt:
@@ -361,7 +361,7 @@ def _collapse_watch(i, te, p, prm):
     p.lastcoll[i] = te
 
 
-@kernel(inline="always")
+@inlined
 def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
@@ -435,7 +435,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     return DONE
 
 
-@kernel(inline="always")
+@inlined
 def execute_expiry(i, te, p, lists, cells, c, prm):
     """List expiry of i at te: a new list centre and neighbour list (OVERFLOW/CELL_OVERFLOW
     if a list or a cell is full: nothing changed, the driver enlarges and calls again)."""
@@ -449,7 +449,7 @@ def execute_expiry(i, te, p, lists, cells, c, prm):
     return DONE
 
 
-@kernel(inline="always")
+@inlined
 def execute_crossing(i, face, te, p, grid, c, prm):
     """Cell crossing of i at te through face ``face`` (2 a + side): into the next cell
     (:func:`granulargas.engine._crossing.cross`) and its best pair updated with the
@@ -462,7 +462,7 @@ def execute_crossing(i, face, te, p, grid, c, prm):
     return DONE
 
 
-@kernel(inline="always")
+@inlined
 def execute_wall(i, wall, te, p, c, walls, prm):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
     m_eff = m_i. Returns DONE or TABLE_RANGE."""
@@ -498,7 +498,7 @@ def execute_wall(i, wall, te, p, c, walls, prm):
     return DONE
 
 
-@kernel
+@kernel(python=False)
 def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
     """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1);
     every event predicted anew and the calendar rebuilt (O(N))."""
@@ -519,7 +519,7 @@ def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
 
 
 # -------------------------------------------------------------------- prefetch
-@kernel(inline="always")
+@inlined
 def _prefetch_particle(i, p, ev, lists, cal):
     """Prefetch hints for the per-particle rows an event of particle i touches (not
     ``img``, which only a wrap through the box writes)."""
@@ -537,7 +537,7 @@ def _prefetch_particle(i, p, ev, lists, cal):
     prefetch(cal.where, i)
 
 
-@kernel(inline="always")
+@inlined
 def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     """Prefetch hints for the next event of the cell-crossing mode: the rows of particle
     i1, its partner and the cell heads around them, and the rows of the likely event
@@ -573,7 +573,7 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     return i2
 
 
-@kernel(inline="always")
+@inlined
 def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
     """Prefetch hints for the next event, particle i1 (no effect on results).
 

@@ -46,7 +46,7 @@ whose rebuild moves it to its new cell.
 
 import math
 
-from granulargas._numba import kernel
+from granulargas._numba import inlined, kernel
 from granulargas.contact.oblique_lookup import LOOKUP_BETA_RANGE, LOOKUP_OK, resolve_collision
 
 #: Status codes (the loop passes them on): the impact lies beyond the oblique-contact
@@ -55,7 +55,7 @@ OBLIQUE_BETA_RANGE = 22
 OBLIQUE_DELTA_RANGE = 23
 
 
-@kernel(inline="always")
+@inlined
 def _wrap(i, a, x, rec, img, period):
     """Store coordinate a of slot i, wrapped into [0, period) (images counted)."""
     if x >= period:
@@ -70,7 +70,7 @@ def _wrap(i, a, x, rec, img, period):
     rec[i, a] = x
 
 
-@kernel
+@kernel(python=False)
 def resolved_pair(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
     """Collision that takes time of slots i, j (streamed to te, touching, approaching).
 
