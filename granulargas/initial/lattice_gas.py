@@ -237,7 +237,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     if sweeps is None:
         sweeps = MELT_SWEEPS if n <= 100_000 else 6
     state = {"step": 0.1 * dmax, "stale": False}
-    sorting = {"start": np.empty(0, dtype=np.int64), "cell_of": np.empty(n, dtype=np.int64),
+    sorting = {"start": np.empty(0, dtype=np.int32), "cell_of": np.empty(n, dtype=np.int32),
                "r": np.empty_like(r3), "f": np.empty(n), "i": np.empty(n, dtype=ids.dtype)}
 
     def sweep_key():  # the 64-bit key of a sweep's random numbers (_montecarlo docstring)
@@ -250,7 +250,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
 
     def sort(grid):  # particles (and their radii and ids) sorted by the cells of grid
         if len(sorting["start"]) <= int(np.prod(grid)):
-            sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int64)
+            sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int32)
         mc.sort_by_cell(r3, radii, ids, box3, grid, sorting["start"], sorting["cell_of"], sorting["r"],
                         sorting["f"], sorting["i"])
         state["stale"] = True

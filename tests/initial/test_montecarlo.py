@@ -48,8 +48,8 @@ def test_sorted_sweeps_create_no_overlap(d, eta, step):
     radius, ids = st.radii.copy(), np.arange(n)
     grid = _sorted_grid(st.box, 1.0, step)
     assert grid is not None
-    start = np.empty(int(np.prod(grid)) + 1, dtype=np.int64)
-    scratch = (np.empty(n, dtype=np.int64), np.empty_like(r), np.empty(n), np.empty(n, dtype=np.int64))
+    start = np.empty(int(np.prod(grid)) + 1, dtype=np.int32)
+    scratch = (np.empty(n, dtype=np.int32), np.empty_like(r), np.empty(n), np.empty(n, dtype=np.int64))
     moved = 0
     for sweep in range(30):
         mc.sort_by_cell(r, radius, ids, box, grid, start, *scratch)
