@@ -56,6 +56,11 @@ events, from the mean event delay (:func:`cal_width`); at the start of a
 N = 10^6) only when w is off from that by more than a factor 2, which keeps w
 matched to a cooling gas. Ties are broken by heap node order, deterministically.
 
+The loop inlines the common cases (:func:`cal_first`, :func:`cal_update_root`,
+:func:`cal_update_ring`) and calls :func:`cal_peek` / :func:`cal_update` for the rest:
+a call passes every array of the calendar as separate arguments, which costs more
+than most updates do.
+
 State: :class:`granulargas.engine._state.Calendar` -- ``qt`` (N,) event times,
 ``chunks`` (pool, CHUNK) i4, ``where`` (N,) i4, ``small`` (capacity, 2) f8 nodes
 (time, id), ``buckets`` (nb + 1, 2) i4 (newest chunk, ids in it), and ``state``,
@@ -330,6 +335,62 @@ def cal_update(i, t, cal):
     return True
 
 
+@inlined
+def cal_update_root(i, t, cal):
+    """:func:`cal_update` of the particle whose event is the earliest (the root of the small
+    heap), small enough for the loop to inline: the common case -- its next event falls
+    into a ring bucket whose newest chunk has room -- here (the root node removed, the id
+    appended), the rest by the call. Same result as :func:`cal_update` in every case."""
+    cs = cal.state[0]
+    where = cal.where
+    x = (t - cs.t0) / cs.width
+    cur = cs.cur
+    nb = cs.nb
+    if where[i] == -1 and x >= cur + 1 and x < cur + nb:
+        b = int(x) & (nb - 1)
+        c = cal.buckets[b, 0]
+        f = cal.buckets[b, 1]
+        if c >= 0 and f < CHUNK - 1:
+            small = cal.small
+            last = cs.size - 1
+            cs.size = last
+            if last > 0:
+                small[0, 0] = small[last, 0]
+                small[0, 1] = small[last, 1]
+                _sift_down(small, where, 0, last)
+            cal.qt[i] = t
+            cal.chunks[c, 1 + f] = i
+            cal.buckets[b, 1] = f + 1
+            where[i] = b
+            cs.nring += 1
+            return True
+    return cal_update(i, t, cal)
+
+
+@inlined
+def cal_update_ring(i, t, cal):
+    """:func:`cal_update` small enough for the loop to inline, for a particle whose event
+    is in the ring (the partner of a collision, mostly): when its next event falls into a
+    ring bucket whose newest chunk has room, the id is appended there (the old entry goes
+    stale), the rest by the call. Same result as :func:`cal_update` in every case."""
+    cs = cal.state[0]
+    wi = cal.where[i]
+    x = (t - cs.t0) / cs.width
+    cur = cs.cur
+    nb = cs.nb
+    if wi >= 0 and wi < nb and x >= cur + 1 and x < cur + nb:
+        b = int(x) & (nb - 1)
+        c = cal.buckets[b, 0]
+        f = cal.buckets[b, 1]
+        if c >= 0 and f < CHUNK - 1:
+            cal.qt[i] = t
+            cal.chunks[c, 1 + f] = i
+            cal.buckets[b, 1] = f + 1
+            cal.where[i] = b
+            return True
+    return cal_update(i, t, cal)
+
+
 @kernel(python=False)
 def _redistribute_overflow(cal):
     """Place the live overflow events anew; returns an insert status (_OK or the failure)."""
@@ -443,6 +504,13 @@ def cal_after_next(cal, skip):
                 t2 = small[q, 0]
                 c2 = q
     return int(small[c2, 1]) if c2 > 0 else -1
+
+
+@inlined
+def cal_first(cal):
+    """:func:`cal_peek` inlined where the window is usually open: the root of the small heap,
+    or the call when the heap is empty."""
+    return int(cal.small[0, 1]) if cal.state[0].size > 0 else cal_peek(cal)
 
 
 @inlined

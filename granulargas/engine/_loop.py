@@ -87,8 +87,11 @@ from granulargas.engine._calendar import (
     cal_build,
     cal_look_ahead,
     cal_next_time,
+    cal_first,
     cal_peek,
     cal_update,
+    cal_update_ring,
+    cal_update_root,
 )
 from granulargas.engine._cells import prefetch_cells, rebuild_list
 from granulargas.engine._collide import pair_collision, restitution, wall_collision
@@ -343,6 +346,29 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
     return best
 
 
+@inlined
+def predict_fresh(i, t, rec, count, events, grid, space):
+    """:func:`predict` in the cell-crossing mode right after a crossing of i (``grid.fresh[0] == i``):
+    the same result, without the full scan's code (the loop inlines it; ``predict`` itself is a call)."""
+    best, face = predict_crossing(i, t, rec, grid, space)
+    tag = np.int64(face)
+    p = np.int64(CROSS)
+    grid.fresh[0] = -1
+    pt = grid.pair_t[i]
+    if pt < best:
+        best = pt
+        p = np.int64(grid.pair_j[i])
+        tag = np.int64(count[p])
+    tw, wall = predict_wall(i, t, rec, space)
+    if tw < best:
+        best = tw
+        p = WALL
+        tag = wall
+    events.partner[i] = p
+    events.tag[i] = tag
+    return best
+
+
 @kernel
 def predict_all(t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
@@ -423,8 +449,12 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
     tj = predict(j, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
-    if not cal_update(j, tj, cal):
-        return CALENDAR
+    if onlists is not None:
+        if not cal_update(j, tj, cal):
+            return CALENDAR
+    if oncells is not None:
+        if not cal_update_ring(j, tj, cal):
+            return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
         ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
@@ -665,8 +695,11 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         if c.events >= events_end:
             status = BUDGET
             break
-        # ---- pop
-        i = cal_peek(cal)
+        # ---- pop (cell mode: the peek after the previous event has opened the window)
+        if onlists is not None:
+            i = cal_peek(cal)
+        if oncells is not None:
+            i = cal_first(cal)
         if i < 0:
             if i == -2:
                 status = CALENDAR
@@ -727,15 +760,30 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             c.stale += 1
             clock = tick(probe, P_STALE, clock)
         # ---- re-predict the particle of the event
-        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
+        if onlists is not None:
+            ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
+        if oncells is not None:
+            if lists.fresh[0] == i:  # after a crossing: the stored best pair is current
+                ti = predict_fresh(i, te, rec, p.count, ev, lists, prm.space)
+            else:
+                ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
+                             contacts)
         clock = tick(probe, PREDICT, clock)
-        if not cal_update(i, ti, cal):
-            status = CALENDAR
-            break
+        if onlists is not None:
+            if not cal_update(i, ti, cal):
+                status = CALENDAR
+                break
+        if oncells is not None:
+            if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
+                status = CALENDAR
+                break
         c.events += 1
         clock = tick(probe, UPDATE, clock)
         # ---- prefetch hints for the next events (no effect on results)
-        i1 = cal_peek(cal)
+        if onlists is not None:
+            i1 = cal_peek(cal)
+        if oncells is not None:
+            i1 = cal_first(cal)
         clock = tick(probe, PEEK, clock)
         if i1 == -2:
             status = CALENDAR
