@@ -158,8 +158,7 @@ def figure_snapshot(snap, info, cells, k_max, path, theory_law):
     if info.dimension == 3:
         w = np.nanmean(w, axis=2)  # omega_z averaged over z
     wmax = float(np.nanpercentile(np.abs(w), 99)) or 1.0
-    cmap = plt.get_cmap("RdBu_r").copy()
-    cmap.set_bad("0.85")
+    cmap = plt.get_cmap("RdBu_r").with_extremes(bad="0.85")
     im = ax[2].imshow(w.T, origin="lower", extent=(0, box[0], 0, box[1]), cmap=cmap, vmin=-wmax, vmax=wmax)
     fig.colorbar(im, ax=ax[2], fraction=0.046,
                  label="vorticity" + (" $\\omega_z$" if info.dimension == 3 else "") + " [$\\sqrt{T}/\\sigma$]")

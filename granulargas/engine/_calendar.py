@@ -336,58 +336,56 @@ def cal_update(i, t, cal):
 
 
 @inlined
+def _ring_append(i, t, cal, cs):
+    """The common case of an update: when t falls into the ring (beyond the window) and
+    that bucket's newest chunk has room, append i there and return True; else change
+    nothing and return False."""
+    x = (t - cs.t0) / cs.width
+    if not (x >= cs.cur + 1 and x < cs.cur + cs.nb):  # written so that a NaN fails too
+        return False
+    b = int(x) & (cs.nb - 1)
+    c = cal.buckets[b, 0]
+    f = cal.buckets[b, 1]
+    if c < 0 or f >= CHUNK - 1:
+        return False
+    cal.qt[i] = t
+    cal.chunks[c, 1 + f] = i
+    cal.buckets[b, 1] = f + 1
+    cal.where[i] = b
+    return True
+
+
+@inlined
 def cal_update_root(i, t, cal):
     """:func:`cal_update` of the particle whose event is the earliest (the root of the small
-    heap), small enough for the loop to inline: the common case -- its next event falls
-    into a ring bucket whose newest chunk has room -- here (the root node removed, the id
-    appended), the rest by the call. Same result as :func:`cal_update` in every case."""
+    heap), small enough for the loop to inline: the common case (:func:`_ring_append`,
+    then the root node removed; :func:`_small_remove` less its sift-up, which the root
+    never needs) here, the rest by the call. Same result as
+    :func:`cal_update` in every case."""
     cs = cal.state[0]
-    where = cal.where
-    x = (t - cs.t0) / cs.width
-    cur = cs.cur
-    nb = cs.nb
-    if where[i] == -1 and x >= cur + 1 and x < cur + nb:
-        b = int(x) & (nb - 1)
-        c = cal.buckets[b, 0]
-        f = cal.buckets[b, 1]
-        if c >= 0 and f < CHUNK - 1:
-            small = cal.small
-            last = cs.size - 1
-            cs.size = last
-            if last > 0:
-                small[0, 0] = small[last, 0]
-                small[0, 1] = small[last, 1]
-                _sift_down(small, where, 0, last)
-            cal.qt[i] = t
-            cal.chunks[c, 1 + f] = i
-            cal.buckets[b, 1] = f + 1
-            where[i] = b
-            cs.nring += 1
-            return True
+    if cal.where[i] == -1 and _ring_append(i, t, cal, cs):
+        small = cal.small
+        last = cs.size - 1  # the root node removed: the last one sifted down from the top
+        cs.size = last
+        if last > 0:
+            small[0, 0] = small[last, 0]
+            small[0, 1] = small[last, 1]
+            _sift_down(small, cal.where, 0, last)
+        cs.nring += 1
+        return True
     return cal_update(i, t, cal)
 
 
 @inlined
 def cal_update_ring(i, t, cal):
     """:func:`cal_update` small enough for the loop to inline, for a particle whose event
-    is in the ring (the partner of a collision, mostly): when its next event falls into a
-    ring bucket whose newest chunk has room, the id is appended there (the old entry goes
-    stale), the rest by the call. Same result as :func:`cal_update` in every case."""
+    is in the ring (the partner of a collision, mostly): the common case
+    (:func:`_ring_append`; the old entry goes stale) here, the rest by the call. Same
+    result as :func:`cal_update` in every case."""
     cs = cal.state[0]
     wi = cal.where[i]
-    x = (t - cs.t0) / cs.width
-    cur = cs.cur
-    nb = cs.nb
-    if wi >= 0 and wi < nb and x >= cur + 1 and x < cur + nb:
-        b = int(x) & (nb - 1)
-        c = cal.buckets[b, 0]
-        f = cal.buckets[b, 1]
-        if c >= 0 and f < CHUNK - 1:
-            cal.qt[i] = t
-            cal.chunks[c, 1 + f] = i
-            cal.buckets[b, 1] = f + 1
-            cal.where[i] = b
-            return True
+    if wi >= 0 and wi < cs.nb and _ring_append(i, t, cal, cs):
+        return True
     return cal_update(i, t, cal)
 
 

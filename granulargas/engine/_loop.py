@@ -88,7 +88,6 @@ from granulargas.engine._calendar import (
     cal_look_ahead,
     cal_next_time,
     cal_first,
-    cal_peek,
     cal_update,
     cal_update_ring,
     cal_update_root,
@@ -302,6 +301,20 @@ def mode_flags(cells):
     return (1, None) if cells is not None else (None, 1)
 
 
+@inlined
+def settle_event(i, t, best, p, tag, rec, events, space):
+    """The earlier of i's predicted event (time ``best``, partner or kind ``p``, ``tag``) and
+    its next wall impact into i's event slot; returns that event's time."""
+    tw, wall = predict_wall(i, t, rec, space)
+    if tw < best:
+        best = tw
+        p = WALL
+        tag = wall
+    events.partner[i] = p
+    events.tag[i] = tag
+    return best
+
+
 @kernel(python=False)
 def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
@@ -336,14 +349,7 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
         tag = np.int64(count[p])
     else:
         p = kind
-    tw, wall = predict_wall(i, t, rec, space)
-    if tw < best:
-        best = tw
-        p = WALL
-        tag = wall
-    events.partner[i] = p
-    events.tag[i] = tag
-    return best
+    return settle_event(i, t, best, p, tag, rec, events, space)
 
 
 @inlined
@@ -359,14 +365,7 @@ def predict_fresh(i, t, rec, count, events, grid, space):
         best = pt
         p = np.int64(grid.pair_j[i])
         tag = np.int64(count[p])
-    tw, wall = predict_wall(i, t, rec, space)
-    if tw < best:
-        best = tw
-        p = WALL
-        tag = wall
-    events.partner[i] = p
-    events.tag[i] = tag
-    return best
+    return settle_event(i, t, best, p, tag, rec, events, space)
 
 
 @kernel
@@ -695,11 +694,8 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         if c.events >= events_end:
             status = BUDGET
             break
-        # ---- pop (cell mode: the peek after the previous event has opened the window)
-        if onlists is not None:
-            i = cal_peek(cal)
-        if oncells is not None:
-            i = cal_first(cal)
+        # ---- pop (the peek after the previous event has opened the window)
+        i = cal_first(cal)
         if i < 0:
             if i == -2:
                 status = CALENDAR
@@ -769,21 +765,13 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
                 ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
                              contacts)
         clock = tick(probe, PREDICT, clock)
-        if onlists is not None:
-            if not cal_update(i, ti, cal):
-                status = CALENDAR
-                break
-        if oncells is not None:
-            if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
-                status = CALENDAR
-                break
+        if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
+            status = CALENDAR
+            break
         c.events += 1
         clock = tick(probe, UPDATE, clock)
         # ---- prefetch hints for the next events (no effect on results)
-        if onlists is not None:
-            i1 = cal_peek(cal)
-        if oncells is not None:
-            i1 = cal_first(cal)
+        i1 = cal_first(cal)
         clock = tick(probe, PEEK, clock)
         if i1 == -2:
             status = CALENDAR

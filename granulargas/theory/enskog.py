@@ -304,8 +304,9 @@ def enskog_cooling_rate(eps, n, T, dim=3, sigma=1.0, m=1.0, chi=None, a2=None):
 
 
 def haff_tau0(eps, n, T0=1.0, dim=3, sigma=1.0, m=1.0, chi=None, a2=None):
-    """Haff time ``tau0 = 2 / zeta(T0)`` of ``T = T0 / (1 + t/tau0)^2``."""
-    return 2.0 / enskog_cooling_rate(eps, n, T0, dim, sigma, m, chi, a2)
+    """Haff time ``tau0 = 2 / zeta(T0)`` of ``T = T0 / (1 + t/tau0)^2`` (inf for an elastic gas)."""
+    with np.errstate(divide="ignore", over="ignore"):
+        return 2.0 / np.float64(enskog_cooling_rate(eps, n, T0, dim, sigma, m, chi, a2))
 
 
 def haff_temperature(t, T0, tau0):
