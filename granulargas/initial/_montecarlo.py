@@ -13,14 +13,17 @@ the candidates:
   with a result independent of the thread count;
 * doubly linked cell lists on a grid of width >= 2 R_max (reused from
   :mod:`granulargas.engine._cells`), kept up to date by every move: for small
-  boxes, long moves (dilute gases) and the overlap pushes of the growth steps.
+  systems, small boxes, long moves (dilute gases) and the overlap pushes of the
+  growth steps.
 
-Random numbers of a sweep: the displacement of particle i along axis a uses
-the (d i + a)-th output of the SplitMix64 generator (Steele, Lea & Flood 2014)
-started from a 64-bit ``key`` that Python draws per sweep from the seeded numpy
-Generator; SplitMix64's n-th output is a closed function of (key, n), so each
-is computed where it is used (no array of N d random numbers to fill and read
-per sweep), and the result is reproducible everywhere.
+Random numbers of a sweep: either an (N, d) array ``u`` of uniforms that Python
+fills from the seeded numpy Generator (small systems), or, for the sorted
+sweeps of large ones, a 64-bit ``key`` that Python draws per sweep from the
+Generator: the displacement of particle i along axis a then uses the
+(d i + a)-th output of the SplitMix64 generator (Steele, Lea & Flood 2014)
+started from the key. SplitMix64's n-th output is a closed function of
+(key, n), so each is computed where it is used (no array of N d random numbers
+to fill and read per sweep). Either way the result is reproducible everywhere.
 """
 
 import math
@@ -28,7 +31,7 @@ import math
 import numba
 import numpy as np
 
-from granulargas._numba import jit
+from granulargas._numba import inlined, jit
 from granulargas.engine._cells import _wrap, cell_coord, cell_index, cell_insert, cell_remove
 from granulargas.engine._geometry import min_image
 
@@ -38,7 +41,7 @@ _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
 _MIX2 = np.uint64(0x94D049BB133111EB)
 
 
-@jit(inline="always")
+@inlined
 def splitmix_uniform(key, n):
     """The n-th (n >= 0) output of SplitMix64 started from ``key``, as a double in [0, 1)
     (its top 53 bits); key and n uint64."""
@@ -49,14 +52,21 @@ def splitmix_uniform(key, n):
     return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@jit(inline="always")
-def _trial(r, i, step, key, dim, box):
-    """Trial position r_i + step (2 u - 1) (u of particle i from the sweep's key), wrapped
+@inlined
+def _uniform(key, u, i, a, dim):
+    """Uniform a (axis) of particle i: u[i, a] if u holds a sweep's numbers, else from the key."""
+    if u.shape[0] > 0:
+        return u[i, a]
+    return splitmix_uniform(key, np.uint64(dim * i + a))
+
+
+@inlined
+def _trial(r, i, step, key, u, dim, box):
+    """Trial position r_i + step (2 u - 1) (u of particle i: :func:`_uniform`), wrapped
     into the box; x = box[0] flags a move to skip (-tiny + L rounded to L)."""
-    n = np.uint64(dim * i)
-    x = r[i, 0] + step * (2.0 * splitmix_uniform(key, n) - 1.0)
-    y = r[i, 1] + step * (2.0 * splitmix_uniform(key, n + np.uint64(1)) - 1.0)
-    z = r[i, 2] + step * (2.0 * splitmix_uniform(key, n + np.uint64(2)) - 1.0) if dim == 3 else r[i, 2]
+    x = r[i, 0] + step * (2.0 * _uniform(key, u, i, 0, dim) - 1.0)
+    y = r[i, 1] + step * (2.0 * _uniform(key, u, i, 1, dim) - 1.0)
+    z = r[i, 2] + step * (2.0 * _uniform(key, u, i, 2, dim) - 1.0) if dim == 3 else r[i, 2]
     x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
     y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
     z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
@@ -108,12 +118,13 @@ def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
 
 
 @jit
-def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, dim):
-    """One sweep of displacement moves r_i += step (2 u_i - 1), u_i the sweep's uniforms
-    (key uint64, dim = 2 or 3; module docstring); returns the accepted count."""
+def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, u, dim):
+    """One sweep of displacement moves r_i += step (2 u_i - 1), u_i the sweep's uniforms:
+    the rows of ``u`` (N, dim), or if u is empty those of ``key`` (uint64; module
+    docstring); dim = 2 or 3. Returns the accepted count."""
     accepted = 0
     for i in range(r.shape[0]):
-        x, y, z = _trial(r, i, step, key, dim, box)
+        x, y, z = _trial(r, i, step, key, u, dim, box)
         if x >= box[0]:
             continue
         if overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
@@ -156,7 +167,7 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
 
 
 @jit
-def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, dim):
+def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, u, dim):
     """Sweep of moves accepted when the moved particle's overlap depth does not grow.
 
     Moves r_i += step (2 u_i - 1) as in :func:`sweep`. Non-overlapping particles
@@ -168,7 +179,7 @@ def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of,
     for i in range(r.shape[0]):
         old = overlap_depth(i, r[i, 0], r[i, 1], r[i, 2], r, radius, box, ncell, cell_head,
                             cell_next)
-        x, y, z = _trial(r, i, step, key, dim, box)
+        x, y, z = _trial(r, i, step, key, u, dim, box)
         if x >= box[0]:
             if old > 0.0:
                 overlapping += 1
@@ -370,7 +381,7 @@ def sort_by_cell(r, radius, ids, box, ncell, start, cell_of, r_tmp, f_tmp, i_tmp
     ids[:] = i_tmp
 
 
-@jit(inline="always")
+@inlined
 def _row_overlaps(k, x, y, z, rk, a, b, r, radius, same):
     if same:  # equal radii: one contact distance
         s2 = 4.0 * rk * rk
@@ -456,12 +467,12 @@ def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
     return False
 
 
-@jit(inline="always")
+@inlined
 def _wrapped(x, length):
     return x - length if x >= length else (x + length if x < 0.0 else x)
 
 
-@jit(inline="always")
+@inlined
 def _sorted_move(k, r, radius, box, ncell, start, step, key, dim, reach, same):
     """Move k of a sweep over cell-sorted particles; True if accepted."""
     n = np.uint64(dim * k)

@@ -6,6 +6,7 @@ import pytest
 
 from granulargas.initial import _montecarlo as mc
 from granulargas.initial import random_state
+from granulargas.initial import lattice_gas
 from granulargas.initial.lattice_gas import _sorted_grid
 
 
@@ -64,7 +65,8 @@ def test_sorted_sweeps_create_no_overlap(d, eta, step):
 
 
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 numba threads")
-def test_state_does_not_depend_on_the_thread_count():
+def test_state_does_not_depend_on_the_thread_count(monkeypatch):
+    monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)  # the sorted, parallel sweeps
     states = []
     for threads in (1, 2):
         numba.set_num_threads(threads)
