@@ -141,6 +141,15 @@ def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step,
 
 
 @jit
+def wrap_positions(r, box):
+    """Positions wrapped into the box (a coordinate that rounds to L becomes 0)."""
+    for k in range(r.shape[0]):
+        r[k, 0] = _in_box(r[k, 0], box[0])
+        r[k, 1] = _in_box(r[k, 1], box[1])
+        r[k, 2] = _in_box(r[k, 2], box[2])
+
+
+@jit
 def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     """Sum over j != i of max(0, R_i + R_j - |r_ij|) for particle i placed at (x, y, z)."""
     cx = cell_coord(x, box[0], ncell[0])
@@ -350,15 +359,19 @@ def distinct(values, m, seen, out):
 
 
 @jit
-def sort_by_cell(r, radius, ids, box, ncell, start, cell_of, r_tmp, f_tmp, i_tmp):
+def sort_by_cell(r, radius, ids, box, ncell, start, cell_of, r_tmp, f_tmp, i_tmp, dest):
     """Stable counting sort of the particles by cell (row by row along x): r (N, 3),
-    radius (N,) and ids (N,) permuted in place; start (n_cells + 1,) receives the
-    first index of each cell (start[-1] = N). cell_of (N,) int, r_tmp, f_tmp and
-    i_tmp (like r, radius, ids) are scratch."""
+    radius (N,) and ids (N,) permuted in place, positions wrapped into the box;
+    start (n_cells + 1,) receives the first index of each cell (start[-1] = N),
+    cell_of (N,) int the cell of each particle (sorted order), dest (N,) int the new
+    index of each old one. r_tmp, f_tmp and i_tmp (like r, radius, ids) are scratch."""
     n = r.shape[0]
     nc = ncell[0] * ncell[1] * ncell[2]
     start[: nc + 1] = 0
     for k in range(n):
+        r[k, 0] = _in_box(r[k, 0], box[0])
+        r[k, 1] = _in_box(r[k, 1], box[1])
+        r[k, 2] = _in_box(r[k, 2], box[2])
         c = cell_index(r[k, 0], r[k, 1], r[k, 2], box, ncell)
         cell_of[k] = c
         start[c + 1] += 1
@@ -366,19 +379,30 @@ def sort_by_cell(r, radius, ids, box, ncell, start, cell_of, r_tmp, f_tmp, i_tmp
         start[c] += start[c - 1]
     for k in range(n):
         c = cell_of[k]
-        dest = start[c]
-        start[c] = dest + 1
-        r_tmp[dest, 0] = r[k, 0]
-        r_tmp[dest, 1] = r[k, 1]
-        r_tmp[dest, 2] = r[k, 2]
-        f_tmp[dest] = radius[k]
-        i_tmp[dest] = ids[k]
+        d = start[c]
+        start[c] = d + 1
+        dest[k] = d
+        r_tmp[d, 0] = r[k, 0]
+        r_tmp[d, 1] = r[k, 1]
+        r_tmp[d, 2] = r[k, 2]
+        f_tmp[d] = radius[k]
+        i_tmp[d] = ids[k]
     for c in range(nc, 0, -1):
         start[c] = start[c - 1]
     start[0] = 0
+    for c in range(nc):
+        for k in range(start[c], start[c + 1]):
+            cell_of[k] = c
     r[:] = r_tmp
     radius[:] = f_tmp
     ids[:] = i_tmp
+
+
+@inlined
+def _in_box(x, length):
+    """x wrapped into [0, length) (a value that rounds to length becomes 0)."""
+    x = x - length if x >= length else (x + length if x < 0.0 else x)
+    return 0.0 if x >= length else x
 
 
 @inlined
@@ -555,3 +579,264 @@ def sorted_overlapping(r, radius, box, ncell, start, flags):
         if hit:
             count += 1
     return count
+
+
+@inlined
+def _row_push(k, x, y, z, rk, a, b, r, radius, margin, far, near, nn, px, py, pz, same):
+    cap = near.shape[0]
+    s = 2.0 * rk
+    for j in range(a, b):
+        dx = x - r[j, 0]
+        dy = y - r[j, 1]
+        dz = z - r[j, 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        if not same:
+            s = rk + radius[j]
+        if d2 < s * s and d2 > 0.0 and j != k:
+            dd = d2**0.5
+            f = (0.5 * (s - dd) + margin * s) / dd
+            px += f * dx
+            py += f * dy
+            pz += f * dz
+        if nn < cap:  # stored unconditionally, kept if within s + far (no branch)
+            near[nn] = j
+        nn += (d2 < (s + far) * (s + far)) & (j != k)
+    return nn, px, py, pz
+
+
+@jit
+def sorted_scan(k, x, y, z, r, radius, box, ncell, start, reach, margin, far, near, same):
+    """Overlap push of particle k at (x, y, z) (in the box) and its neighbours, for
+    particles sorted by cell (:func:`sort_by_cell`; scan as :func:`sorted_overlaps`,
+    over every particle filed within ``reach`` of the point).
+
+    Returns (nn, px, py, pz): the push sum_j [(R_k + R_j - d)/2 + margin (R_k + R_j)]
+    n_kj over the overlaps, and the number nn of particles j within R_k + R_j +
+    ``far``, whose indices go to near[:nn] (entries beyond the buffer are counted,
+    not stored). ``same``: all radii equal.
+    """
+    nx = ncell[0]
+    ny = ncell[1]
+    nz = ncell[2]
+    fy = y * (ny / box[1])
+    cy = min(int(fy), ny - 1)
+    ly = cy - 1 if fy - cy < 0.5 else cy
+    if nz > 1:
+        fz = z * (nz / box[2])
+        cz = min(int(fz), nz - 1)
+        lz = cz - 1 if fz - cz < 0.5 else cz
+        mz = 2
+    else:
+        lz = 0
+        mz = 1
+    xl = int(math.floor((x - reach) * (nx / box[0])))
+    xh = min(int(math.floor((x + reach) * (nx / box[0]))), xl + nx - 1)
+    a1 = xl
+    b1 = xh + 1
+    a2 = 0
+    b2 = 0
+    sx2 = 0.0
+    if xl < 0:
+        a1 = 0
+        a2 = xl + nx
+        b2 = nx
+        sx2 = -box[0]
+    elif xh >= nx:
+        b1 = nx
+        b2 = xh + 1 - nx
+        sx2 = box[0]
+    rk = radius[k]
+    nn = 0
+    px = 0.0
+    py = 0.0
+    pz = 0.0
+    for oz in range(mz):
+        kz = lz + oz
+        zz = z
+        if kz < 0:
+            kz += nz
+            zz = z + box[2]
+        elif kz >= nz:
+            kz -= nz
+            zz = z - box[2]
+        for oy in range(2):
+            ky = ly + oy
+            yy = y
+            if ky < 0:
+                ky += ny
+                yy = y + box[1]
+            elif ky >= ny:
+                ky -= ny
+                yy = y - box[1]
+            row = nx * (ky + ny * kz)
+            nn, px, py, pz = _row_push(k, x, yy, zz, rk, start[row + a1], start[row + b1], r, radius, margin,
+                                       far, near, nn, px, py, pz, same)
+            nn, px, py, pz = _row_push(k, x - sx2, yy, zz, rk, start[row + a2], start[row + b2], r, radius,
+                                       margin, far, near, nn, px, py, pz, same)
+    return nn, px, py, pz
+
+
+@jit
+def group_by_slab(idx, filed, ncell, grouped, slab_start):
+    """The entries of idx grouped by the slab of their cell (z layers in 3D, y rows in
+    2D; stable counting sort) into grouped; slab_start (slabs + 1,) the offsets."""
+    per_slab = ncell[0] * ncell[1] if ncell[2] > 1 else ncell[0]
+    slab_start[:] = 0
+    for q in range(idx.shape[0]):
+        slab_start[filed[idx[q]] // per_slab + 1] += 1
+    for h in range(1, slab_start.shape[0]):
+        slab_start[h] += slab_start[h - 1]
+    for q in range(idx.shape[0]):
+        h = filed[idx[q]] // per_slab
+        grouped[slab_start[h]] = idx[q]
+        slab_start[h] += 1
+    for h in range(slab_start.shape[0] - 1, 0, -1):
+        slab_start[h] = slab_start[h - 1]
+    slab_start[0] = 0
+
+
+@jit(parallel=True)
+def sorted_push(idx, slab_start, r, radius, box, ncell, start, filed, cap, kick, margin, out, out_n):
+    """Push each particle of ``idx`` out of its overlaps (as :func:`push_some`), for
+    particles sorted by cell (:func:`sort_by_cell`, which files particle k in cell
+    filed[k]) on a grid of :func:`sorted_overlaps` with reach 2 R_max + cap.
+
+    A pushed particle keeps its coordinates unwrapped (next to the cell it is filed
+    in) and stays within ``cap`` of that cell on every axis: a push that would take
+    it further is shortened (same direction) to end there. Every particle thus lies
+    within cap of its cell, and every particle within 2 R_max of a point within the
+    box is among those a scan with reach 2 R_max + cap reads. New overlaps after
+    the push are looked up among the particles the first scan found within
+    R_k + R_j + R_k when the push is shorter than R_k, else by a second scan.
+
+    ``idx`` is grouped by slab (:func:`group_by_slab`, offsets slab_start): the
+    slabs of even index are pushed first, then those of odd index, each slab in
+    its order in idx, the slabs of one parity in parallel threads (as
+    :func:`sorted_sweep`: a particle stays within cap of its slab, so its scan
+    reads its own slab and the two next to it, which do not move meanwhile); the
+    result is the same for any number of threads. The particles still involved in
+    overlaps after the pushes of slab h (with repetitions) are written to
+    out[40 a:], a = slab_start[h], their number to out_n[h]. Returns the number of
+    shortened pushes.
+    """
+    rmax = 0.0
+    rmin = math.inf
+    for k in range(radius.shape[0]):
+        rmax = max(rmax, radius[k])
+        rmin = min(rmin, radius[k])
+    same = rmin == rmax
+    reach = (2.0 * rmax + cap) * (1.0 + 1e-9)  # (+ rounding margin)
+    slabs = slab_start.shape[0] - 1
+    clamped = 0
+    for parity in range(2):
+        for h in numba.prange(slabs // 2):
+            slab = 2 * h + parity
+            a = slab_start[slab]
+            b = slab_start[slab + 1]
+            if b > a:
+                near = np.empty(256, dtype=np.int64)
+                m, c = _push_run(idx, a, b, r, radius, box, ncell, start, filed, cap, kick, margin, near, out,
+                                 40 * a, 40 * b, same, reach)
+                out_n[slab] = m - 40 * a
+                clamped += c
+            else:
+                out_n[slab] = 0
+    return clamped
+
+
+@jit
+def _push_run(idx, qa, qb, r, radius, box, ncell, start, filed, cap, kick, margin, near, out, m, mend, same,
+              reach):
+    """Pushes of idx[qa:qb] (:func:`sorted_push`), writing to out[m:mend]; returns (the
+    new end of out, the number of shortened pushes)."""
+    nx = ncell[0]
+    ny = ncell[1]
+    wx = box[0] / nx
+    wy = box[1] / ny
+    wz = box[2] / ncell[2]
+    cap_near = near.shape[0]
+    clamped = 0
+    for q in range(qa, qb):
+        k = idx[q]
+        x = _in_box(r[k, 0], box[0])
+        y = _in_box(r[k, 1], box[1])
+        z = _in_box(r[k, 2], box[2])
+        rk = radius[k]
+        nn, px, py, pz = sorted_scan(k, x, y, z, r, radius, box, ncell, start, reach, margin, rk, near, same)
+        if px == 0.0 and py == 0.0 and pz == 0.0:
+            continue
+        px *= kick[q]
+        py *= kick[q]
+        pz *= kick[q]
+        c = filed[k]
+        cx = c % nx
+        cy = (c // nx) % ny
+        cz = c // (nx * ny)
+        t = 1.0
+        t = _clamp(t, r[k, 0], px, cx * wx - cap, (cx + 1) * wx + cap)
+        t = _clamp(t, r[k, 1], py, cy * wy - cap, (cy + 1) * wy + cap)
+        if ncell[2] > 1:
+            t = _clamp(t, r[k, 2], pz, cz * wz - cap, (cz + 1) * wz + cap)
+        if t < 1.0:
+            clamped += 1
+            px *= t
+            py *= t
+            pz *= t
+        r[k, 0] += px
+        r[k, 1] += py
+        r[k, 2] += pz
+        m0 = m
+        if nn <= cap_near and px * px + py * py + pz * pz < rk * rk:
+            for e in range(nn):
+                j = near[e]
+                dx = min_image(r[k, 0] - r[j, 0], box[0])
+                dy = min_image(r[k, 1] - r[j, 1], box[1])
+                dz = min_image(r[k, 2] - r[j, 2], box[2])
+                s = rk + radius[j]
+                if dx * dx + dy * dy + dz * dz < s * s and m < mend:
+                    out[m] = j
+                    m += 1
+        else:
+            x = _in_box(r[k, 0], box[0])
+            y = _in_box(r[k, 1], box[1])
+            z = _in_box(r[k, 2], box[2])
+            nn, px, py, pz = sorted_scan(k, x, y, z, r, radius, box, ncell, start, reach, 0.0, 0.0, near, same)
+            for e in range(min(nn, cap_near)):
+                if m < mend:
+                    out[m] = near[e]
+                    m += 1
+            if nn > cap_near and m == m0 and m < mend:  # partners not all stored: list k
+                out[m] = k
+                m += 1
+                continue
+        if m > m0 and m < mend:
+            out[m] = k
+            m += 1
+    return m, clamped
+
+
+@jit
+def distinct_runs(values, bases, counts, seen, out):
+    """Distinct entries of the runs values[bases[h]:bases[h] + counts[h]] (in order) into
+    out (first-occurrence order); returns their number. ``seen`` as in :func:`distinct`."""
+    u = 0
+    for h in range(counts.shape[0]):
+        for k in range(bases[h], bases[h] + counts[h]):
+            v = values[k]
+            if not seen[v]:
+                seen[v] = True
+                out[u] = v
+                u += 1
+    for k in range(u):
+        seen[out[k]] = False
+    return u
+
+
+@inlined
+def _clamp(t, x, p, lo, hi):
+    """Largest t' <= t with x + t' p within [lo, hi] (x within it)."""
+    if x + t * p > hi:
+        return (hi - x) / p
+    if x + t * p < lo:
+        return (lo - x) / p
+    return t

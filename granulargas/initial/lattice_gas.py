@@ -106,6 +106,9 @@ PUSH_MARGIN = 0.4
 #: under a second) the saving would not repay the compile.
 SORTED_MIN_PARTICLES = 100_000
 
+# pushes over sorted particles stay within this fraction of a diameter of their cell
+PUSH_CAP = 0.1
+
 # lowest occupancy N/M of the lattice: M <= 8 N (memory at very low packing)
 _MIN_OCCUPANCY = 1.0 / 8.0
 
@@ -257,19 +260,21 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         rng.random(out=u)
         return np.uint64(0)
 
-    def lists():  # the cell lists of the pushes, after sweeps over sorted particles
+    def lists():  # the cell lists, after sweeps or pushes over sorted particles
         if state["stale"]:
+            mc.wrap_positions(r3, box3)
             mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
             state["stale"] = False
 
     def sort(grid):  # particles (and their radii and ids) sorted by the cells of grid
         if not sorting:
             sorting.update(start=np.empty(0, dtype=np.int32), cell_of=np.empty(n, dtype=np.int32),
-                           r=np.empty_like(r3), f=np.empty(n), i=np.empty(n, dtype=ids.dtype))
+                           r=np.empty_like(r3), f=np.empty(n), i=np.empty(n, dtype=ids.dtype),
+                           dest=np.empty(n, dtype=np.int32))
         if len(sorting["start"]) <= int(np.prod(grid)):
             sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int32)
         mc.sort_by_cell(r3, radii, ids, box3, grid, sorting["start"], sorting["cell_of"], sorting["r"],
-                        sorting["f"], sorting["i"])
+                        sorting["f"], sorting["i"], sorting["dest"])
         state["stale"] = True
 
     def do_sweep(scale):
@@ -299,23 +304,9 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     near = np.empty(256, dtype=np.int64)
     uniq = np.empty(n, dtype=np.int64)
     seen = np.zeros(n, dtype=np.bool_)
-    grow = 0.05
-    while lam < 1.0:
-        if grow < 1e-4:
-            raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
-                              f"radii (reached {lam:.4f} of the target size)")
-        trial = min(1.0, lam * (1.0 + grow))
-        grid = _sorted_grid(box, dmax * trial, 0.0) if large else None
-        if grid is not None:  # census over sorted particles
-            sort(grid)
-            mc.sorted_overlapping(r3, radii * trial, box3, grid, sorting["start"], seen)
-            idx = np.flatnonzero(seen)
-            seen[:] = False
-        lists()
-        saved = r3.copy()
-        rad = radii * trial
-        if grid is None:
-            idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
+
+    def pushes(rad, grow):  # a growth step's pushes over cell lists; returns the overlapping left
+        idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
         for it in range(600):
             if len(idx) == 0:
                 break
@@ -329,9 +320,68 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
                              near, buf)
             # in order of first appearance (a pushed particle's new partners, then itself)
             idx = uniq[: mc.distinct(buf, m, seen, uniq)].copy()
-        if len(idx):  # stuck: undo, grow more gently
-            r3[:] = saved
-            mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
+        return idx
+
+
+    def sorted_pushes(idx, grid, scale, grow, cap):  # the same over sorted particles (large systems)
+        start = sorting["start"]
+        slabs = int(grid[2] if d == 3 else grid[1])
+        slab_start = np.empty(slabs + 1, dtype=np.int64)
+        out_n = np.empty(slabs, dtype=np.int64)
+        rad = radii * scale
+        for it in range(600):
+            if len(idx) == 0:
+                break
+            if it % 100 == 99:  # jammed spots: as in pushes(), then sorted again
+                lists()
+                key = sweep_key()
+                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, key, u, d)
+                sort(grid)
+                rad = radii * scale
+                mc.sorted_overlapping(r3, rad, box3, grid, start, seen)
+                idx = np.flatnonzero(seen)
+                seen[:] = False
+                continue
+            mc.group_by_slab(idx, sorting["cell_of"], grid, uniq[: len(idx)], slab_start)
+            idx = uniq[: len(idx)].copy()
+            kick = rng.uniform(0.5, 1.5, size=len(idx))
+            clamped = mc.sorted_push(idx, slab_start, r3, rad, box3, grid, start, sorting["cell_of"], cap,
+                                     kick, PUSH_MARGIN * grow, buf, out_n)
+            state["stale"] = True
+            # in order of first appearance (a pushed particle's new partners, then itself)
+            idx = uniq[: mc.distinct_runs(buf, 40 * slab_start[:-1], out_n, seen, uniq)].copy()
+            if clamped:  # pushes held back at the cap: sort again
+
+                sort(grid)
+                rad = radii * scale
+                idx = sorting["dest"][idx].astype(np.int64)
+        return idx
+    grow = 0.05
+    while lam < 1.0:
+        if grow < 1e-4:
+            raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
+                              f"radii (reached {lam:.4f} of the target size)")
+        trial = min(1.0, lam * (1.0 + grow))
+        cap = PUSH_CAP * dmax * trial
+        grid = _sorted_grid(box, dmax * trial, cap) if large else None
+        if grid is not None:  # large systems: census and pushes over sorted particles
+            sort(grid)
+            mc.sorted_overlapping(r3, radii * trial, box3, grid, sorting["start"], seen)
+            idx = np.flatnonzero(seen)
+            seen[:] = False
+            saved = (r3.copy(), radii.copy(), ids.copy())
+            idx = sorted_pushes(idx, grid, trial, grow, cap)
+            if len(idx):
+                r3[:], radii[:], ids[:] = saved
+                state["stale"] = True
+        else:
+            lists()
+            saved = r3.copy()
+            idx = pushes(radii * trial, grow)
+            if len(idx):
+                r3[:] = saved
+                mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
+        if len(idx):  # stuck: undone, grow more gently
             grow *= 0.5
             continue
         grow = min(0.05, grow * 1.5)
@@ -339,6 +389,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         do_sweep(lam)
     for _ in range(int(sweeps)):
         do_sweep(1.0)
+    mc.wrap_positions(r3, box3)
     out = np.empty((n, d))
     out[ids] = r3[:, :d]
     return out

@@ -50,7 +50,8 @@ def test_sorted_sweeps_create_no_overlap(d, eta, step):
     grid = _sorted_grid(st.box, 1.0, step)
     assert grid is not None
     start = np.empty(int(np.prod(grid)) + 1, dtype=np.int32)
-    scratch = (np.empty(n, dtype=np.int32), np.empty_like(r), np.empty(n), np.empty(n, dtype=np.int64))
+    scratch = (np.empty(n, dtype=np.int32), np.empty_like(r), np.empty(n), np.empty(n, dtype=np.int64),
+               np.empty(n, dtype=np.int32))
     moved = 0
     for sweep in range(30):
         mc.sort_by_cell(r, radius, ids, box, grid, start, *scratch)
@@ -64,6 +65,32 @@ def test_sorted_sweeps_create_no_overlap(d, eta, step):
     np.testing.assert_array_equal(np.sort(ids), np.arange(n))
 
 
+def _overlapping_pairs(st):
+    """Pairs closer than R_i + R_j, by brute force over all pairs (minimum image)."""
+    d = st.positions.shape[1]
+    dr = st.positions[:, None, :] - st.positions[None, :, :]
+    dr -= st.box[:d] * np.round(dr / st.box[:d])
+    dist = np.linalg.norm(dr, axis=2) + 10 * np.eye(len(st.radii))
+    return int(np.sum(np.triu(dist < st.radii[:, None] + st.radii[None, :], 1)))
+
+
+@pytest.mark.parametrize("d, eta, seed", [(3, 0.54, 0), (3, 0.54, 1), (3, 0.5, 2), (2, 0.76, 0), (2, 0.76, 1)])
+def test_dense_states_over_sorted_particles_have_no_overlap(monkeypatch, d, eta, seed):
+    """The growth steps of large systems (census and pushes over cell-sorted particles,
+    forced here for 600 particles) leave no overlap, at the densest packings allowed."""
+    monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)
+    st = random_state(600, eta, d, seed=seed, sweeps=0)
+    assert _overlapping_pairs(st) == 0
+    assert np.all(st.positions >= 0) and np.all(st.positions < st.box)
+
+
+def test_polydisperse_dense_state_over_sorted_particles_has_no_overlap(monkeypatch):
+    monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)
+    radii = np.random.default_rng(5).uniform(0.35, 0.5, 800)
+    st = random_state(800, 0.5, 3, seed=4, radii=radii, sweeps=0)
+    assert _overlapping_pairs(st) == 0
+
+
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 numba threads")
 def test_state_does_not_depend_on_the_thread_count(monkeypatch):
     monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)  # the sorted, parallel sweeps
@@ -71,7 +98,7 @@ def test_state_does_not_depend_on_the_thread_count(monkeypatch):
     for threads in (1, 2):
         numba.set_num_threads(threads)
         try:
-            states.append(random_state(3000, 0.45, 3, seed=2).positions)
+            states.append(random_state(3000, 0.5, 3, seed=2).positions)
         finally:
             numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     np.testing.assert_array_equal(states[0], states[1])
