@@ -745,6 +745,32 @@ def sorted_push(idx, slab_start, r, radius, box, ncell, start, filed, cap, kick,
 
 
 @jit
+def sorted_push_serial(idx, slab_start, r, radius, box, ncell, start, filed, cap, kick, margin, out, out_n):
+    """:func:`sorted_push` on one thread, in the same order (the same result): for passes
+    over a few particles, where starting threads would cost more than it saves."""
+    rmax = 0.0
+    rmin = math.inf
+    for k in range(radius.shape[0]):
+        rmax = max(rmax, radius[k])
+        rmin = min(rmin, radius[k])
+    same = rmin == rmax
+    reach = (2.0 * rmax + cap) * (1.0 + 1e-9)  # (+ rounding margin)
+    slabs = slab_start.shape[0] - 1
+    near = np.empty(256, dtype=np.int64)
+    clamped = 0
+    for parity in range(2):
+        for h in range(slabs // 2):
+            slab = 2 * h + parity
+            a = slab_start[slab]
+            b = slab_start[slab + 1]
+            m, c = _push_run(idx, a, b, r, radius, box, ncell, start, filed, cap, kick, margin, near, out,
+                             40 * a, 40 * b, same, reach)
+            out_n[slab] = m - 40 * a
+            clamped += c
+    return clamped
+
+
+@jit
 def _push_run(idx, qa, qb, r, radius, box, ncell, start, filed, cap, kick, margin, near, out, m, mend, same,
               reach):
     """Pushes of idx[qa:qb] (:func:`sorted_push`), writing to out[m:mend]; returns (the

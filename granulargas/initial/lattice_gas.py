@@ -17,10 +17,16 @@ stuck for some seeds and raises ConfigError):
    overlaps pushed apart, every push overshooting by ``PUSH_MARGIN`` times the
    step, so that a dense step settles in tens of passes rather than hundreds);
 3. hard-sphere Monte Carlo sweeps (random displacements rejected on overlap,
-   step adapted to ~40 % acceptance) destroy the lattice order. A sweep moves
-   the particles sorted by cell, slab by slab (:mod:`._montecarlo`): the slabs of
-   one parity run in parallel threads, with the same result for any number of
-   threads (``NUMBA_NUM_THREADS``).
+   step adapted to ~40 % acceptance) destroy the lattice order.
+
+Large systems (N >= :data:`SORTED_MIN_PARTICLES`) run the sweeps, the overlap
+census and the pushes of step 2 over particles sorted by cell, slab by slab
+(:mod:`._montecarlo`): the slabs of one parity run in parallel threads, with the
+same result for any number of threads (``NUMBA_NUM_THREADS``). A push there may
+carry a particle at most ``PUSH_CAP`` diameters beyond its cell (so that scans of
+reach 2 R_max + cap find it without re-sorting); a push that would go further is
+shortened, and the particles are sorted again before the next pass. Small
+systems use cell lists and the generator's random numbers throughout.
 
 Long-wavelength density fluctuations. The sweeps move each particle by a
 fraction of a diameter: they relax the structure at short range, but a density
@@ -106,8 +112,13 @@ PUSH_MARGIN = 0.4
 #: under a second) the saving would not repay the compile.
 SORTED_MIN_PARTICLES = 100_000
 
-# pushes over sorted particles stay within this fraction of a diameter of their cell
+# pushes over sorted particles (large systems) stay within this fraction of a diameter of
+# their cell: the scans reach (1 + PUSH_CAP) diameters
 PUSH_CAP = 0.1
+
+# passes over fewer particles push on one thread (same order, same result): starting the
+# threads would cost more than they save
+PARALLEL_MIN_PUSHES = 20_000
 
 # lowest occupancy N/M of the lattice: M <= 8 N (memory at very low packing)
 _MIN_OCCUPANCY = 1.0 / 8.0
@@ -345,7 +356,8 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             mc.group_by_slab(idx, sorting["cell_of"], grid, uniq[: len(idx)], slab_start)
             idx = uniq[: len(idx)].copy()
             kick = rng.uniform(0.5, 1.5, size=len(idx))
-            clamped = mc.sorted_push(idx, slab_start, r3, rad, box3, grid, start, sorting["cell_of"], cap,
+            push = mc.sorted_push if len(idx) >= PARALLEL_MIN_PUSHES else mc.sorted_push_serial
+            clamped = push(idx, slab_start, r3, rad, box3, grid, start, sorting["cell_of"], cap,
                                      kick, PUSH_MARGIN * grow, buf, out_n)
             state["stale"] = True
             # in order of first appearance (a pushed particle's new partners, then itself)

@@ -94,6 +94,7 @@ def test_polydisperse_dense_state_over_sorted_particles_has_no_overlap(monkeypat
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 numba threads")
 def test_state_does_not_depend_on_the_thread_count(monkeypatch):
     monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)  # the sorted, parallel sweeps
+    monkeypatch.setattr(lattice_gas, "PARALLEL_MIN_PUSHES", 0)  # and pushes
     states = []
     for threads in (1, 2):
         numba.set_num_threads(threads)
@@ -101,4 +102,7 @@ def test_state_does_not_depend_on_the_thread_count(monkeypatch):
             states.append(random_state(3000, 0.5, 3, seed=2).positions)
         finally:
             numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    monkeypatch.setattr(lattice_gas, "PARALLEL_MIN_PUSHES", 10**9)  # pushes on one thread
+    states.append(random_state(3000, 0.5, 3, seed=2).positions)
     np.testing.assert_array_equal(states[0], states[1])
+    np.testing.assert_array_equal(states[0], states[2])
