@@ -311,7 +311,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     if lam < 1.0:
         for _ in range(int(melt)):
             do_sweep(lam)
-    buf = np.empty(max(64, 40 * n), dtype=np.int64)
+    buf = np.empty(0 if large else max(64, 40 * n), dtype=np.int64)  # pushed particles' partners
     near = np.empty(256, dtype=np.int64)
     uniq = np.empty(n, dtype=np.int64)
     seen = np.zeros(n, dtype=np.bool_)
@@ -356,14 +356,15 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             mc.group_by_slab(idx, sorting["cell_of"], grid, uniq[: len(idx)], slab_start)
             idx = uniq[: len(idx)].copy()
             kick = rng.uniform(0.5, 1.5, size=len(idx))
+            out = np.empty(40 * len(idx), dtype=np.int64)  # slab h writes from 40 slab_start[h] on
             push = mc.sorted_push if len(idx) >= PARALLEL_MIN_PUSHES else mc.sorted_push_serial
-            clamped = push(idx, slab_start, r3, rad, box3, grid, start, sorting["cell_of"], cap,
-                                     kick, PUSH_MARGIN * grow, buf, out_n)
+            clamped = push(idx, slab_start, r3, rad, box3, grid, start, sorting["cell_of"], cap, kick,
+                           PUSH_MARGIN * grow, out, out_n)
             state["stale"] = True
             # in order of first appearance (a pushed particle's new partners, then itself)
-            idx = uniq[: mc.distinct_runs(buf, 40 * slab_start[:-1], out_n, seen, uniq)].copy()
+            idx = uniq[: mc.distinct_runs(out, 40 * slab_start[:-1], out_n, seen, uniq)].copy()
+            del out  # (a buffer per pass: its untouched pages are never mapped)
             if clamped:  # pushes held back at the cap: sort again
-
                 sort(grid)
                 rad = radii * scale
                 idx = sorting["dest"][idx].astype(np.int64)
