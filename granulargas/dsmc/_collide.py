@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from granulargas._numba import jit
+from granulargas._numba import inlined
 from granulargas.dsmc._random import next_u64
 
 _MASK32 = np.uint64(0xFFFFFFFF)
@@ -44,7 +44,7 @@ _S32 = np.uint64(32)
 _INV31 = 1.0 / 2147483648.0  # 2^-31
 
 
-@jit(inline="always")
+@inlined
 def normal_part_3d(state, gx, gy, gz, g2):
     """(p_x, p_y, p_z, g_n^2) for a 3D pair with relative velocity g (|g|^2 = g2 > 0)."""
     while True:
@@ -66,7 +66,7 @@ def normal_part_3d(state, gx, gy, gz, g2):
     return px, py, pz, gn2
 
 
-@jit(inline="always")
+@inlined
 def normal_part_2d(state, gx, gy, g2):
     """(p_x, p_y, g_n^2) for a 2D pair with relative velocity g (|g|^2 = g2 > 0)."""
     sn = np.float64(next_u64(state) >> np.uint64(11)) * (2.0 / 9007199254740992.0) - 1.0
@@ -77,7 +77,7 @@ def normal_part_2d(state, gx, gy, g2):
     return px, py, c2 * g2
 
 
-@jit(inline="always")
+@inlined
 def apply_pair_update(rec, i, j, dim, px, py, pz, eps, mi, mj):
     """Smooth-sphere velocity update of the pair (i, j) from the normal part p of their
     relative velocity; momentum is conserved exactly up to rounding."""

@@ -38,7 +38,7 @@ pairs come from the counter-based pair stream, so the rows of the pairs
 
 import math
 
-from granulargas._numba import jit
+from granulargas._numba import inlined, jit
 from granulargas.dsmc._collide import apply_pair_update, normal_part_2d, normal_part_3d
 from granulargas.dsmc._majorant import build_histogram, class_edge, speed_class, top_classes
 from granulargas.dsmc._random import pair_of, uniform
@@ -80,7 +80,7 @@ N_FPAR = 6
 RING = 16  # candidates prefetched ahead (power of two)
 
 
-@jit(inline="always")
+@inlined
 def _class_of(rec, i, dim):
     """Speed class of particle i."""
     w2 = rec[i, 0] * rec[i, 0] + rec[i, 1] * rec[i, 1]

@@ -27,7 +27,7 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 
-from granulargas._numba import jit
+from granulargas._numba import inlined, jit
 
 N_CLASSES = 8192
 _SHIFT = 50
@@ -60,13 +60,13 @@ def _bits_f64(typingctx, b):
     return sig, codegen
 
 
-@jit(inline="always")
+@inlined(python=True)
 def speed_class(w2):
     """Class of a squared speed w2 >= 0 (finite): monotone in w2, 0 <= class < 8192."""
     return _f64_bits(w2) >> _SHIFT
 
 
-@jit(inline="always")
+@inlined(python=True)
 def class_edge(k):
     """Upper speed edge of class k: every w with speed_class(w*w) <= k has w < class_edge(k)
     (the square root of the next class's first w^2, which lies above every w^2 of
@@ -91,7 +91,7 @@ def build_histogram(rec, dim, hist):
     return top
 
 
-@jit(inline="always")
+@inlined(python=True)
 def top_classes(hist, top):
     """(k1, k2): the highest occupied class at or below ``top`` and the class of the
     second-fastest particle (k1 again if it holds two or more)."""

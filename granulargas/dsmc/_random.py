@@ -22,7 +22,7 @@ Uniform doubles are 53-bit multiples of 2^-53.
 
 import numpy as np
 
-from granulargas._numba import jit
+from granulargas._numba import inlined
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -46,7 +46,7 @@ _INV53 = 1.0 / 9007199254740992.0  # 2^-53
 STATE_WORDS = 5  # xoshiro256** (4) + pair-stream key (1)
 
 
-@jit(inline="always")
+@inlined
 def mix64(z):
     """SplitMix64 output function (a bijection of uint64)."""
     z = (z ^ (z >> _S30)) * _M1
@@ -54,12 +54,12 @@ def mix64(z):
     return z ^ (z >> _S31)
 
 
-@jit(inline="always")
+@inlined
 def _rotl(x, k):
     return (x << k) | (x >> (np.uint64(64) - k))
 
 
-@jit(inline="always")
+@inlined
 def next_u64(state):
     """Next xoshiro256** output; advances ``state[0:4]`` in place."""
     s0 = state[0]
@@ -81,13 +81,13 @@ def next_u64(state):
     return result
 
 
-@jit(inline="always")
+@inlined
 def uniform(state):
     """Uniform double in [0, 1) (53 bits) from the sequential stream."""
     return np.float64(next_u64(state) >> _S11) * _INV53
 
 
-@jit(inline="always")
+@inlined
 def _bounded32(x, n, seed):
     """Uniform integer in [0, n) from the 32-bit value x (Lemire), re-drawing from
     ``mix64(seed + ...)`` in the rare rejected case; returns (value, seed)."""
@@ -103,7 +103,7 @@ def _bounded32(x, n, seed):
     return np.int64(m >> _S32), seed
 
 
-@jit(inline="always")
+@inlined
 def pair_of(key, k, n):
     """Candidate pair number ``k`` of the pair stream: (i, j), i != j, uniform over
     the n (n - 1) ordered pairs; a pure function of (key, k, n), n < 2^31."""
