@@ -860,9 +860,10 @@ def distinct_runs(values, bases, counts, seen, out):
 
 @inlined
 def _clamp(t, x, p, lo, hi):
-    """Largest t' <= t with x + t' p within [lo, hi] (x within it)."""
-    if x + t * p > hi:
-        return (hi - x) / p
-    if x + t * p < lo:
-        return (lo - x) / p
+    """Largest t' in [0, t] with x + t' p within [lo, hi] (x within it; 0 if x lies
+    beyond by rounding and p points further out)."""
+    if p > 0.0 and x + t * p > hi:
+        return max(0.0, (hi - x) / p)
+    if p < 0.0 and x + t * p < lo:
+        return max(0.0, (lo - x) / p)
     return t
