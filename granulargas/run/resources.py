@@ -11,7 +11,7 @@ Memory of a run (bytes; N particles, d dimensions; measured with
 above the measured peak and within a factor 2 of it):
 
 * initial placement (:func:`granulargas.initial.random_state`): about 900 B per
-  particle (lattice sites, Monte Carlo work arrays) plus 4.5 B per cell of its
+  particle (lattice sites, Monte Carlo work arrays) plus 5 B per cell of its
   grid (box volume / largest diameter^d cells);
 * engine (:class:`granulargas.engine.Simulation` after its first build): 420 B
   per particle plus 6 B per neighbour-list slot (the engine's initial list width,
@@ -47,7 +47,7 @@ from granulargas.io.config import RunConfig
 #: the engine stores cell ids as int32
 MAX_CELLS = 2**31 - 1
 PLACEMENT_BYTES_PER_PARTICLE = 900.0
-PLACEMENT_BYTES_PER_CELL = 4.5
+PLACEMENT_BYTES_PER_CELL = 5.0
 ENGINE_BYTES_PER_PARTICLE = 420.0
 ENGINE_BYTES_PER_LIST_SLOT = 6.0
 ENGINE_BYTES_PER_CELL = 72.0

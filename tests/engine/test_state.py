@@ -98,19 +98,22 @@ def test_neighbour_lists_grow_when_full():
     """Lists cut to their current fullest length overflow during the run, grow, and
     the trajectory is bit-identical to an undisturbed run."""
     # whether a list outgrows the fullest initial one by t = 2 depends on the state:
-    # about half of the seeds do (11 of seeds 0-19); seed 1 does
-    ref = make_sim(n=300, packing=0.45, seed=1, shell=1.0)
-    sim = make_sim(n=300, packing=0.45, seed=1, shell=1.0)
-    sim._nb_width = 4  # overflow in the first build
-    sim._build()
-    lists = sim._engine.lists
-    w = int(lists.nbn.max())
-    sim._nb_width = w
-    sim._engine = sim._engine._replace(lists=lists._replace(
-        nbl=np.ascontiguousarray(lists.nbl[:, :w]), scratch=sim._new_scratch()))
-    sim.run(2.0)
+    # about half of the seeds do; the test takes the first of seeds 0-9 that does
+    for seed in range(10):
+        sim = make_sim(n=300, packing=0.45, seed=seed, shell=1.0)
+        sim._nb_width = 4  # overflow in the first build
+        sim._build()
+        lists = sim._engine.lists
+        w = int(lists.nbn.max())
+        sim._nb_width = w
+        sim._engine = sim._engine._replace(lists=lists._replace(
+            nbl=np.ascontiguousarray(lists.nbl[:, :w]), scratch=sim._new_scratch()))
+        sim.run(2.0)
+        if sim._nb_width > w:
+            break
+    assert sim._nb_width > w, "no list outgrew its initial width in seeds 0-9"
+    ref = make_sim(n=300, packing=0.45, seed=seed, shell=1.0)
     ref.run(2.0)
-    assert sim._nb_width > w
     assert check(sim) == []
     np.testing.assert_array_equal(sim.positions, ref.positions)
 

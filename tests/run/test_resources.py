@@ -9,7 +9,7 @@ import pytest
 
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.errors import ConfigError
-from granulargas.initial import random_state
+from granulargas.initial import lattice_gas, random_state
 from granulargas.io.config import parse_config
 from granulargas.run import resources
 from granulargas.run.schedule import check_output_size, output_counts, output_schedule, pacing_stops
@@ -51,8 +51,13 @@ def _measure(n, d, eta):
     return placement, engine
 
 
-@pytest.mark.parametrize("n, d, eta", [(4000, 3, 0.1), (4000, 3, 0.002), (3000, 2, 0.005), (3000, 2, 0.5)])
-def test_memory_estimate_bounds_the_measured_peak(n, d, eta):
+@pytest.mark.parametrize("n, d, eta, large", [(4000, 3, 0.1, False), (4000, 3, 0.002, False), (3000, 2, 0.005, False),
+                                              (3000, 2, 0.5, False), (4000, 3, 0.5, True), (4000, 3, 0.3, True),
+                                              (3000, 2, 0.7, True)])
+def test_memory_estimate_bounds_the_measured_peak(monkeypatch, n, d, eta, large):
+    """large: the placement of large systems (sorted particles; forced for n particles)."""
+    if large:
+        monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)
     placement, engine = _measure(n, d, eta)
     est = resources.run_memory(n, d, eta)
     assert est["placement"] >= placement, (est["placement"] / n, placement / n)
