@@ -311,12 +311,17 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     if lam < 1.0:
         for _ in range(int(melt)):
             do_sweep(lam)
-    buf = np.empty(0 if large else max(64, 40 * n), dtype=np.int64)  # pushed particles' partners
+    # pushed particles' partners (pushes over cell lists: small systems, and large ones in
+    # boxes too small for the sorted scans); allocated on first use
+    buf = np.empty(0, dtype=np.int64)
     near = np.empty(256, dtype=np.int64)
     uniq = np.empty(n, dtype=np.int64)
     seen = np.zeros(n, dtype=np.bool_)
 
     def pushes(rad, grow):  # a growth step's pushes over cell lists; returns the overlapping left
+        nonlocal buf
+        if len(buf) == 0:
+            buf = np.empty(max(64, 40 * n), dtype=np.int64)
         idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
         for it in range(600):
             if len(idx) == 0:

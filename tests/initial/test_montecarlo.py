@@ -91,6 +91,17 @@ def test_polydisperse_dense_state_over_sorted_particles_has_no_overlap(monkeypat
     assert _overlapping_pairs(st) == 0
 
 
+@pytest.mark.parametrize("n, d, eta", [(64, 3, 0.5), (12, 2, 0.7)])
+def test_dense_states_of_large_systems_in_small_boxes_have_no_overlap(monkeypatch, n, d, eta):
+    """A box too small for the scans over sorted particles (fewer than two rows of cells):
+    the growth steps of a large system push over cell lists there, and leave no overlap."""
+    monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)
+    for seed in range(4):
+        st = random_state(n, eta, d, seed=seed, sweeps=0)
+        assert _sorted_grid(st.box, 1.0, lattice_gas.PUSH_CAP) is None
+        assert _overlapping_pairs(st) == 0
+
+
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 numba threads")
 def test_state_does_not_depend_on_the_thread_count(monkeypatch):
     monkeypatch.setattr(lattice_gas, "SORTED_MIN_PARTICLES", 0)  # the sorted, parallel sweeps
