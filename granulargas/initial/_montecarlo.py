@@ -426,13 +426,12 @@ def _row_overlaps(k, x, y, z, rk, a, b, r, radius, same):
     return False
 
 
-@jit
-def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
-    """True if particle k at (x, y, z) overlaps another one, for particles sorted by cell
-    (:func:`sort_by_cell`) on a grid whose y and z cells (3D) are >= 2 ``reach`` wide
-    and with ncell[0] cells along x: scans the two rows in y and z nearest the point,
-    along x the cells within ``reach``. Every particle within reach of the point is
-    scanned, whatever cell it is filed under."""
+@inlined
+def _scan_window(x, y, z, box, ncell, reach):
+    """The cells a scan of particles sorted by cell visits around (x, y, z) (in the box):
+    the two rows in y and in z (3D) nearest the point, from (ly, lz), mz rows in z; along x
+    the cells within ``reach`` as up to two runs of a row, [a1, b1) unshifted and [a2, b2)
+    across the periodic boundary, whose particles are seen shifted by sx2."""
     nx = ncell[0]
     ny = ncell[1]
     nz = ncell[2]
@@ -449,7 +448,6 @@ def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
         mz = 1
     xl = int(math.floor((x - reach) * (nx / box[0])))
     xh = min(int(math.floor((x + reach) * (nx / box[0]))), xl + nx - 1)
-    # x cells [xl, xh] as up to two runs of the row: [a1, b1) unshifted, [a2, b2) shifted by sx2
     a1 = xl
     b1 = xh + 1
     a2 = 0
@@ -464,6 +462,20 @@ def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
         b1 = nx
         b2 = xh + 1 - nx
         sx2 = box[0]
+    return ly, lz, mz, a1, b1, a2, b2, sx2
+
+
+@jit
+def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
+    """True if particle k at (x, y, z) overlaps another one, for particles sorted by cell
+    (:func:`sort_by_cell`) on a grid whose y and z cells (3D) are >= 2 ``reach`` wide
+    and with ncell[0] cells along x: scans the two rows in y and z nearest the point,
+    along x the cells within ``reach``. Every particle within reach of the point is
+    scanned, whatever cell it is filed under."""
+    nx = ncell[0]
+    ny = ncell[1]
+    nz = ncell[2]
+    ly, lz, mz, a1, b1, a2, b2, sx2 = _scan_window(x, y, z, box, ncell, reach)
     rk = radius[k]
     for oz in range(mz):
         kz = lz + oz
@@ -618,33 +630,7 @@ def sorted_scan(k, x, y, z, r, radius, box, ncell, start, reach, margin, far, ne
     nx = ncell[0]
     ny = ncell[1]
     nz = ncell[2]
-    fy = y * (ny / box[1])
-    cy = min(int(fy), ny - 1)
-    ly = cy - 1 if fy - cy < 0.5 else cy
-    if nz > 1:
-        fz = z * (nz / box[2])
-        cz = min(int(fz), nz - 1)
-        lz = cz - 1 if fz - cz < 0.5 else cz
-        mz = 2
-    else:
-        lz = 0
-        mz = 1
-    xl = int(math.floor((x - reach) * (nx / box[0])))
-    xh = min(int(math.floor((x + reach) * (nx / box[0]))), xl + nx - 1)
-    a1 = xl
-    b1 = xh + 1
-    a2 = 0
-    b2 = 0
-    sx2 = 0.0
-    if xl < 0:
-        a1 = 0
-        a2 = xl + nx
-        b2 = nx
-        sx2 = -box[0]
-    elif xh >= nx:
-        b1 = nx
-        b2 = xh + 1 - nx
-        sx2 = box[0]
+    ly, lz, mz, a1, b1, a2, b2, sx2 = _scan_window(x, y, z, box, ncell, reach)
     rk = radius[k]
     nn = 0
     px = 0.0
