@@ -97,14 +97,15 @@ def pool_size(n, nb, stale=True):
     return live + nb + 1 + (live if stale else 0)
 
 
-def allocate_calendar(n, capacity=None, pool=None) -> Calendar:
+def allocate_calendar(n, capacity=None, pool=None, qt=None, where=None) -> Calendar:
     """An empty calendar for n particles (fill ``qt``, then :func:`cal_build`).
 
     ``capacity`` of the small heap: default max(1024, n / 16), some 10^3 times
     what a window holds; when a window would overflow it, the calendar halves
     its width and places all events anew (O(N), self-correcting). ``pool``:
     number of chunks (default :func:`pool_size`; never below what n live
-    entries need, so that placing all events anew always succeeds).
+    entries need, so that placing all events anew always succeeds). ``qt``, ``where``:
+    arrays of n to use (views into per-particle rows), else new ones.
     """
     nb = ring_size(n)
     cap = max(1024, n // 16) if capacity is None else int(capacity)
@@ -114,9 +115,9 @@ def allocate_calendar(n, capacity=None, pool=None) -> Calendar:
     state = np.zeros(1, dtype=CALENDAR_STATE)
     state[0] = (0, 0, nb, 0, -1, -1, 1.0, 0.0, np.inf)
     return Calendar(
-        qt=np.full(n, np.inf),
+        qt=np.full(n, np.inf) if qt is None else qt,
         chunks=buf[offset : offset + chunks * CHUNK].reshape(chunks, CHUNK),
-        where=np.zeros(n, dtype=np.int32),
+        where=np.zeros(n, dtype=np.int32) if where is None else where,
         small=np.zeros((min(n, cap), 2)),
         buckets=np.zeros((nb + 1, 2), dtype=np.int32),
         state=state,

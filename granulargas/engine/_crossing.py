@@ -62,14 +62,22 @@ PAIR_J = 6
 PAIR_TAG = 7
 
 
-def grid_rows(n):
-    """``Grid.cell`` for n particles: (n, 8) int32 rows on 32-byte boundaries (each row in one
-    cache line), partners -1."""
-    buf = np.zeros(n * 8 + 8, dtype=np.int32)
-    offset = (-buf.ctypes.data % 32) // 4
-    rows = buf[offset : offset + n * 8].reshape(n, 8)
-    rows[:, PAIR_J] = -1
-    return rows
+def particle_rows(n):
+    """The per-particle data of a cell crossing in one 64-byte row per particle (one cache
+    line; the C code's particle record does the same): views of one buffer of n rows, as
+    int32 columns 0-7 ``cell`` (``Grid.cell``, partners -1), 8 ``partner``, 9 ``tag``
+    (``Events``), 10 ``where`` (``Calendar``), and float64 columns 6 ``qt`` (``Calendar``,
+    inf) and 7 ``pair_t`` (``Grid``, inf). Returns (cell, partner, tag, where, qt, pair_t)."""
+    buf = np.zeros(n * 8 + 8)
+    offset = (-buf.ctypes.data % 64) // 8
+    f8 = buf[offset : offset + n * 8].reshape(n, 8)
+    i4 = f8.view(np.int32)
+    cell = i4[:, :8]
+    cell[:, PAIR_J] = -1
+    partner = i4[:, 8]
+    partner[:] = -1
+    f8[:, 6:] = np.inf
+    return cell, partner, i4[:, 9], i4[:, 10], f8[:, 6], f8[:, 7]
 
 
 @inlined

@@ -585,13 +585,12 @@ def _prefetch_particle(i, p, ev, lists, cal):
 @inlined
 def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     """Prefetch hints for the next event of the cell-crossing mode: the rows of particle
-    i1 and its partner, the cell heads around i1 (for a crossing also those of the layer
-    it makes adjacent), and the rows of the likely event after it. Returns that event's
-    guessed particle (-1: none)."""
+    i1 and its partner, the cell heads around i1, and the rows of the likely event after
+    it. Returns that event's guessed particle (-1: none). (A particle's cell, event and
+    calendar data share one row of ``grid.cell``: :func:`~granulargas.engine._crossing.particle_rows`.)"""
     rec = p.rec
     p1 = ev.partner[i1]
     prefetch(grid.cell, i1)
-    prefetch(grid.pair_t, i1)
     prefetch_around(i1, grid, prm.space)
     if p1 >= 0:
         prefetch(rec, p1)
@@ -600,22 +599,14 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm):
         prefetch(p.count, p1)
         prefetch(p.lastcoll, p1)
         prefetch(p.rapid, p1)
-        prefetch(ev.partner, p1)
-        prefetch(ev.tag, p1)
-        prefetch(cal.qt, p1)
-        prefetch(cal.where, p1)
         prefetch(p.mass, i1)
         prefetch(p.lastcoll, i1)
         prefetch(p.rapid, i1)
         prefetch(p.count, i1)
-    prefetch(cal.where, i1)
     i2 = cal_after_next(cal, p1)
     if i2 >= 0:
         prefetch(rec, i2)
         prefetch(grid.cell, i2)
-        prefetch(grid.pair_t, i2)
-        prefetch(ev.partner, i2)
-        prefetch(ev.tag, i2)
     return i2
 
 

@@ -36,13 +36,16 @@ Record layout
   ``of`` (N,) i4 cell of each list centre.
 * In the cell-crossing mode (:mod:`granulargas.engine._crossing`) ``lists`` is a
   :class:`Grid` instead and ``cells`` is None: ``head`` (C,) i4 the first
-  particle of each cell (-1: empty); ``cell`` (N, 8) i4 one 32-byte row per
-  particle (the int32 data of a crossing in one cache line; columns named in
+  particle of each cell (-1: empty); ``cell`` (N, 8) i4 one int32 row per
+  particle (the int32 data of a crossing; columns named in
   :mod:`~granulargas.engine._crossing`): its cell coordinates, flat cell index,
   next and previous particle of its cell's doubly linked list, its best pair's
   partner (-1: none) and that partner's count then; ``pair_t`` f8 the time of
   that best pair; ``width`` (3,) f8 the cell side per axis; ``fresh`` (1,) i8
   the slot whose stored pair a crossing has just brought up to date (-1: none).
+  In this mode ``cell``, ``pair_t``, ``events.partner``, ``events.tag``,
+  ``calendar.qt`` and ``calendar.where`` are strided views into one 64-byte row
+  per particle (:func:`granulargas.engine._crossing.particle_rows`).
   The loop is compiled for one of the two modes (the flags ``onlists`` and
   ``oncells`` of :func:`granulargas.engine._loop.predict`), so each mode's build
   carries none of the other's code.

@@ -26,7 +26,7 @@ from granulargas.engine import _loop, _state
 from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
-from granulargas.engine._crossing import MARGIN, build_grid, grid_rows
+from granulargas.engine._crossing import MARGIN, build_grid, particle_rows
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
@@ -400,16 +400,18 @@ class Simulation:
             count=np.zeros(n, dtype=np.int32),
             lastcoll=np.ascontiguousarray(self._last_collision[order]),
             rapid=np.zeros(n, dtype=np.int32), ident=order.astype(np.int32))
-        events = _state.Events(partner=np.full(n, -1, dtype=np.int32),
-                               tag=np.zeros(n, dtype=np.int32))
         ncells = int(np.prod(spc.ncell))
         if self.neighbours == "cells":
-            lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), cell=grid_rows(n),
-                                width=spc.box / spc.ncell, pair_t=np.full(n, np.inf),
+            cell, partner, tag, where, qt, pair_t = particle_rows(n)
+            events = _state.Events(partner=partner, tag=tag)
+            lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), cell=cell,
+                                width=spc.box / spc.ncell, pair_t=pair_t,
                                 fresh=np.full(1, -1, dtype=np.int64))
             build_grid(rec, lists, spc)
-            self._finish_build(particles, events, lists, None, order)
+            self._finish_build(particles, events, lists, None, order, qt=qt, where=where)
             return
+        events = _state.Events(partner=np.full(n, -1, dtype=np.int32),
+                               tag=np.zeros(n, dtype=np.int32))
         centre = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
         pos = np.ascontiguousarray(rec[:, :3])
         stencil = np.empty(27, dtype=np.int64)
@@ -436,12 +438,13 @@ class Simulation:
         lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
         self._finish_build(particles, events, lists, cells, order)
 
-    def _finish_build(self, particles, events, lists, cells, order):
-        """Contacts, every particle's event, counters and the calendar (after the neighbour search)."""
+    def _finish_build(self, particles, events, lists, cells, order, qt=None, where=None):
+        """Contacts, every particle's event, counters and the calendar (after the neighbour search;
+        ``qt``, ``where``: the calendar's per-particle arrays, if the mode keeps them elsewhere)."""
         n = self.n
         spc = self._space
         rec = particles.rec
-        calendar = allocate_calendar(n)
+        calendar = allocate_calendar(n, qt=qt, where=where)
         slot = np.empty(n, dtype=np.int64)
         slot[order] = np.arange(n)
         cp = self._contact_partner[order]
