@@ -465,6 +465,17 @@ def _scan_window(x, y, z, box, ncell, reach):
     return ly, lz, mz, a1, b1, a2, b2, sx2
 
 
+@inlined
+def _periodic_row(c, n, x, length):
+    """Row index c (at most one period outside [0, n)) wrapped into it, and the query
+    coordinate x shifted so that the row's particles are seen at their periodic image."""
+    if c < 0:
+        return c + n, x + length
+    if c >= n:
+        return c - n, x - length
+    return c, x
+
+
 @jit
 def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
     """True if particle k at (x, y, z) overlaps another one, for particles sorted by cell
@@ -478,23 +489,9 @@ def sorted_overlaps(k, x, y, z, r, radius, box, ncell, start, reach, same):
     ly, lz, mz, a1, b1, a2, b2, sx2 = _scan_window(x, y, z, box, ncell, reach)
     rk = radius[k]
     for oz in range(mz):
-        kz = lz + oz
-        zz = z
-        if kz < 0:
-            kz += nz
-            zz = z + box[2]
-        elif kz >= nz:
-            kz -= nz
-            zz = z - box[2]
+        kz, zz = _periodic_row(lz + oz, nz, z, box[2])
         for oy in range(2):
-            ky = ly + oy
-            yy = y
-            if ky < 0:
-                ky += ny
-                yy = y + box[1]
-            elif ky >= ny:
-                ky -= ny
-                yy = y - box[1]
+            ky, yy = _periodic_row(ly + oy, ny, y, box[1])
             row = nx * (ky + ny * kz)
             if _row_overlaps(k, x, yy, zz, rk, start[row + a1], start[row + b1], r, radius, same):
                 return True
@@ -637,23 +634,9 @@ def sorted_scan(k, x, y, z, r, radius, box, ncell, start, reach, margin, far, ne
     py = 0.0
     pz = 0.0
     for oz in range(mz):
-        kz = lz + oz
-        zz = z
-        if kz < 0:
-            kz += nz
-            zz = z + box[2]
-        elif kz >= nz:
-            kz -= nz
-            zz = z - box[2]
+        kz, zz = _periodic_row(lz + oz, nz, z, box[2])
         for oy in range(2):
-            ky = ly + oy
-            yy = y
-            if ky < 0:
-                ky += ny
-                yy = y + box[1]
-            elif ky >= ny:
-                ky -= ny
-                yy = y - box[1]
+            ky, yy = _periodic_row(ly + oy, ny, y, box[1])
             row = nx * (ky + ny * kz)
             nn, px, py, pz = _row_push(k, x, yy, zz, rk, start[row + a1], start[row + b1], r, radius, margin,
                                        far, near, nn, px, py, pz, same)
