@@ -346,13 +346,25 @@ def distinct(values, m, seen, out):
 
     ``seen`` (bool, N) must be all False on entry and is all False again on return.
     """
-    u = 0
-    for k in range(m):
+    return _unmark(seen, out, _first_seen(values, 0, m, seen, out, 0))
+
+
+@inlined
+def _first_seen(values, a, b, seen, out, u):
+    """Append the entries of values[a:b] not yet seen to out[u:] (marking them in seen);
+    returns the new count."""
+    for k in range(a, b):
         v = values[k]
         if not seen[v]:
             seen[v] = True
             out[u] = v
             u += 1
+    return u
+
+
+@inlined
+def _unmark(seen, out, u):
+    """seen all False again after out[:u] were marked; returns u."""
     for k in range(u):
         seen[out[k]] = False
     return u
@@ -816,15 +828,8 @@ def distinct_runs(values, bases, counts, seen, out):
     out (first-occurrence order); returns their number. ``seen`` as in :func:`distinct`."""
     u = 0
     for h in range(counts.shape[0]):
-        for k in range(bases[h], bases[h] + counts[h]):
-            v = values[k]
-            if not seen[v]:
-                seen[v] = True
-                out[u] = v
-                u += 1
-    for k in range(u):
-        seen[out[k]] = False
-    return u
+        u = _first_seen(values, bases[h], bases[h] + counts[h], seen, out, u)
+    return _unmark(seen, out, u)
 
 
 @inlined
