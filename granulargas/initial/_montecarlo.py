@@ -439,6 +439,17 @@ def _row_overlaps(k, x, y, z, rk, a, b, r, radius, same):
 
 
 @inlined
+def _radius_range(radius):
+    """Smallest and largest radius."""
+    rmin = math.inf
+    rmax = 0.0
+    for k in range(radius.shape[0]):
+        rmin = min(rmin, radius[k])
+        rmax = max(rmax, radius[k])
+    return rmin, rmax
+
+
+@inlined
 def _scan_window(x, y, z, box, ncell, reach):
     """The cells a scan of particles sorted by cell visits around (x, y, z) (in the box):
     the two rows in y and in z (3D) nearest the point, from (ly, lz), mz rows in z; along x
@@ -554,11 +565,7 @@ def sorted_sweep(r, radius, box, ncell, start, step, key, dim):
     so the slabs of a parity run in parallel threads and the result is the same
     for any number of threads. Returns the accepted count.
     """
-    reach = 0.0
-    rmin = math.inf
-    for k in range(radius.shape[0]):
-        reach = max(reach, radius[k])
-        rmin = min(rmin, radius[k])
+    rmin, reach = _radius_range(radius)
     same = rmin == reach
     reach = (2.0 * reach + step) * (1.0 + 1e-9)  # (+ rounding margin)
     if ncell[2] > 1:
@@ -586,11 +593,7 @@ def sorted_overlapping(r, radius, box, ncell, start, flags):
     """flags[k] = particle k overlaps some other one, for particles sorted by cell
     (:func:`sort_by_cell`, positions as filed) on a grid of :func:`sorted_overlaps`
     with reach 2 R_max; returns the number of overlapping particles."""
-    reach = 0.0
-    rmin = math.inf
-    for k in range(radius.shape[0]):
-        reach = max(reach, radius[k])
-        rmin = min(rmin, radius[k])
+    rmin, reach = _radius_range(radius)
     same = rmin == reach
     reach = 2.0 * reach * (1.0 + 1e-9)  # (+ rounding margin)
     count = 0
@@ -700,11 +703,7 @@ def sorted_push(idx, slab_start, r, radius, box, ncell, start, filed, cap, kick,
     out[40 a:], a = slab_start[h], their number to out_n[h]. Returns the number of
     shortened pushes.
     """
-    rmax = 0.0
-    rmin = math.inf
-    for k in range(radius.shape[0]):
-        rmax = max(rmax, radius[k])
-        rmin = min(rmin, radius[k])
+    rmin, rmax = _radius_range(radius)
     same = rmin == rmax
     reach = (2.0 * rmax + cap) * (1.0 + 1e-9)  # (+ rounding margin)
     slabs = slab_start.shape[0] - 1
@@ -729,11 +728,7 @@ def sorted_push(idx, slab_start, r, radius, box, ncell, start, filed, cap, kick,
 def sorted_push_serial(idx, slab_start, r, radius, box, ncell, start, filed, cap, kick, margin, out, out_n):
     """:func:`sorted_push` on one thread, in the same order (the same result): for passes
     over a few particles, where starting threads would cost more than it saves."""
-    rmax = 0.0
-    rmin = math.inf
-    for k in range(radius.shape[0]):
-        rmax = max(rmax, radius[k])
-        rmin = min(rmin, radius[k])
+    rmin, rmax = _radius_range(radius)
     same = rmin == rmax
     reach = (2.0 * rmax + cap) * (1.0 + 1e-9)  # (+ rounding margin)
     slabs = slab_start.shape[0] - 1
