@@ -39,8 +39,8 @@ def _run_caller(root, cache_dir):
     """(result, whether it came from numba's on-disk cache) in a fresh interpreter."""
     code = ("from cachedpkg.caller import caller; r = caller(); "
             "print(r, sum(caller.stats.cache_hits.values()))")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root), os.getcwd()]),
-               NUMBA_CACHE_DIR=str(cache_dir))
+    path = [str(root)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(cache_dir))
     env.pop("GRANULARGAS_NO_CACHE", None)
     out = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True,
                          text=True, check=True).stdout.split()
