@@ -47,7 +47,7 @@ import math
 import numpy as np
 
 from granulargas._numba import inlined, kernel
-from granulargas.engine._geometry import min_image, pair_delay, pair_delay_near
+from granulargas.engine._geometry import min_image, pair_delay
 from granulargas.engine._prefetch import prefetch
 
 #: cells are at least (1 + MARGIN) times the largest contact distance wide
@@ -202,24 +202,23 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
 
 @inlined
 def _interior(i, grid, space):
-    """Whether particle i's cell and all its neighbours lie inside the grid (3D; no wrap) and
-    the grid is at least 5 cells wide on every axis: then a particle of a neighbouring cell
-    (or of the layer beyond it after a crossing) is less than 2/5 of the period away on each
-    axis, so that the coordinate differences are their own nearest images."""
+    """Whether particle i's cell and all its neighbours lie inside the grid (3D; no wrap)."""
     ncell = space.ncell
     cell = grid.cell
     return (cell[i, 0] >= 1 and cell[i, 0] <= ncell[0] - 2 and cell[i, 1] >= 1 and cell[i, 1] <= ncell[1] - 2
-            and cell[i, 2] >= 1 and cell[i, 2] <= ncell[2] - 2
-            and ncell[0] >= 5 and ncell[1] >= 5 and ncell[2] >= 5)
+            and cell[i, 2] >= 1 and cell[i, 2] <= ncell[2] - 2)
 
 
 @inlined
 def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
     """:func:`scan_cells` over cells of flat index c0 + u s1 + w s2 + v (w, u in 0..2,
-    v in 0..n0-1, in this order) -- the cells around an interior cell (:func:`_interior`),
-    without wraps and without nearest-image tests; the same two passes."""
+    v in 0..n0-1, in this order) -- the cells around an interior cell, without wraps; the
+    same two passes. (The coordinate differences keep their nearest-image tests: a particle
+    that has just crossed a periodic face may sit a round-off distance on the far side of
+    the box from its new cell.)"""
     head = grid.head
     row_of = grid.cell
+    period = space.period
     xi = rec[i, 0]
     yi = rec[i, 1]
     zi = rec[i, 2]
@@ -241,7 +240,7 @@ def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
     for q in range(1, k):
         j = first[q]
         while j >= 0:
-            tc = t + pair_delay_near(j, t, xi, yi, zi, vx, vy, vz, ri, rec)
+            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
             better = tc < best
             best = tc if better else best
             p = j if better else p

@@ -84,16 +84,6 @@ def pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period):
 
 
 @inlined
-def pair_delay_near(j, t, xi, yi, zi, vx, vy, vz, ri, rec):
-    """:func:`pair_delay` for a pair known to be nearer than half the period on every
-    axis, where the nearest image is the difference itself (same result, no wrap tests)."""
-    dtj = t - rec[j, 6]
-    return collision_delay(xi - (rec[j, 0] + rec[j, 3] * dtj), yi - (rec[j, 1] + rec[j, 4] * dtj),
-                           zi - (rec[j, 2] + rec[j, 5] * dtj),
-                           vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
-
-
-@inlined
 def exit_delay(dx, dy, dz, vx, vy, vz, radius):
     """Time until a particle at offset d from its list centre is at distance ``radius``.
 
