@@ -19,13 +19,22 @@ stuck for some seeds and raises ConfigError):
 3. hard-sphere Monte Carlo sweeps (random displacements rejected on overlap,
    step adapted to ~40 % acceptance) destroy the lattice order.
 
-Large systems (N >= :data:`SORTED_MIN_PARTICLES`) run the sweeps, the overlap
-census and the pushes of step 2 over particles sorted by cell, slab by slab
-(:mod:`._montecarlo`): the slabs of one parity run in parallel threads, with the
-same result for any number of threads (``NUMBA_NUM_THREADS``). A push there may
-carry a particle at most ``PUSH_CAP`` diameters beyond its cell (so that scans of
-reach 2 R_max + cap find it without re-sorting); a push that would go further is
-shortened, and the particles are sorted again before the next pass. Small
+Large systems (N >= :data:`SORTED_MIN_PARTICLES`) run the sweeps over
+particles sorted by cell, slab by slab (:mod:`._montecarlo`): the slabs of one
+parity run in parallel threads, with the same result for any number of threads
+(``NUMBA_NUM_THREADS``). Their growth of step 2 is one compression instead of
+steps and pushes (:mod:`._compression`): after the sweeps at reduced radii, all
+radii are set to full size at once and the overlaps are removed by the energy
+minimiser FIRE (Bitzek et al. 2006) on harmonic overlaps of contact distances
+swollen by ``SWELL`` (4 %; less where the swollen packing would exceed
+``SWELL_PACKING_MAX``, well below soft-sphere jamming), until no pair is closer
+than contact. All particles relax at once, so that the ~60 minimiser steps cost
+less than the pushes' dozens of passes over the last growth steps (where nearly
+every particle overlaps and each push opens one gap by closing another), and the
+swelling leaves gaps around the contacts: the contact value of g(r) after the
+final sweeps is close to the equilibrium fluid's (N = 2e5 at packing 0.5: ~6.9
+with Carnahan-Starling 6.0, the pushes ~10.9). Where the box is too small for
+the sorted scans, the growth steps with pushes over cell lists serve; small
 systems use cell lists and the generator's random numbers throughout.
 
 Long-wavelength density fluctuations. The sweeps move each particle by a
@@ -79,6 +88,7 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.errors import ConfigError
+from granulargas.initial import _compression as fire
 from granulargas.initial import _montecarlo as mc
 from granulargas.initial.state import InitialState
 
@@ -119,6 +129,29 @@ PUSH_CAP = 0.1
 # passes over fewer particles push on one thread (same order, same result): starting the
 # threads would cost more than they save
 PARALLEL_MIN_PUSHES = 20_000
+
+#: large systems grow to full size in one compression (:mod:`._compression`): contact
+#: distances swollen by this fraction, so that every gap ends >= SWELL/2 of a contact distance
+SWELL = 0.04
+
+# the swollen packing stays below this (3D, 2D; jamming of soft spheres: ~0.64, ~0.84),
+# where the compression converges in ~100 steps
+SWELL_PACKING_MAX = {3: 0.58, 2: 0.80}
+
+# neighbour lists of the compression: pairs within the swollen contact distance + this
+# fraction of the largest diameter (rebuilt when a particle has moved half as far)
+FIRE_SKIN = 0.25
+
+# FIRE: initial time step (unit masses, unit stiffness), its largest value, steps before giving up
+FIRE_DT = 0.2
+FIRE_DT_MAX = 0.5
+FIRE_MAX_STEPS = 5000
+
+# particles per block of the compression's parallel moves
+FIRE_BLOCK = 4096
+
+# room for this many more pairs than a particle had in the last neighbour list
+NEIGHBOUR_SLACK = 12
 
 # lowest occupancy N/M of the lattice: M <= 8 N (memory at very low packing)
 _MIN_OCCUPANCY = 1.0 / 8.0
@@ -374,6 +407,63 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
                 rad = radii * scale
                 idx = sorting["dest"][idx].astype(np.int64)
         return idx
+    def compress(grid, swell):  # growth to full size in one FIRE minimisation (large systems)
+        skin = FIRE_SKIN * dmax
+        v = np.zeros((n, 3))
+        f = np.empty((n, 3))
+        r0 = np.empty((n, 3))
+        moved = np.empty(-(-n // FIRE_BLOCK))
+        counts = np.empty(n, dtype=np.int64)
+        offsets = np.zeros(n + 1, dtype=np.int64)
+
+        def rebuild(pairs):  # sorted again (v with the particles), neighbour lists from the sort
+            sort(grid)
+            dest = sorting["dest"]
+            f[dest] = v
+            v[:] = f
+            start = sorting["start"]
+            if len(pairs) == 0:
+                fire.neighbour_counts(r3, radii, box3, grid, start, swell, skin, counts)
+            else:  # room for as many pairs as the particle had neighbours, + NEIGHBOUR_SLACK
+                room[dest] = counts
+                counts[:] = room
+            while True:
+                np.cumsum(counts + NEIGHBOUR_SLACK, out=offsets[1:])
+                if len(pairs) < offsets[-1]:
+                    pairs = np.empty(int(1.1 * offsets[-1]), dtype=np.int32)
+                if fire.neighbour_rows(r3, radii, box3, grid, start, swell, skin, offsets, pairs, counts) == 0:
+                    break
+            r0[:] = r3
+            return pairs
+
+        room = np.empty(n, dtype=np.int64)
+        pairs = rebuild(np.empty(0, dtype=np.int32))
+        dt, alpha, downhill = FIRE_DT, 0.1, 0
+        for _ in range(FIRE_MAX_STEPS):
+            power, vv, ff, hard, _worst = fire.fire_forces(r3, radii, box3, offsets, counts, pairs, swell, v, f)
+            if hard == 0:  # no pair closer than contact
+                state["stale"] = True
+                return
+            if power >= 0.0:  # FIRE (Bitzek et al. 2006): N_min 5, f_inc 1.1, f_alpha 0.99, f_dec 0.5
+                downhill += 1
+                if downhill > 5:
+                    dt, alpha = min(1.1 * dt, FIRE_DT_MAX), 0.99 * alpha
+                keep, mix = 1.0 - alpha, alpha * math.sqrt(vv / ff) if ff > 0.0 else 0.0
+            else:
+                downhill, dt, alpha, keep, mix = 0, 0.5 * dt, 0.1, 0.0, 0.0
+            fire.fire_move(r3, v, f, r0, keep, mix, dt, FIRE_BLOCK, moved)
+            state["stale"] = True
+            if float(moved.max()) > (0.5 * skin) ** 2:
+                pairs = rebuild(pairs)
+        raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these radii "
+                          f"(the compression to full size did not converge in {FIRE_MAX_STEPS} steps)")
+
+    if lam < 1.0 and large:  # large systems: one compression to full size where the box allows
+        swell = min(SWELL, (SWELL_PACKING_MAX[d] / eta) ** (1.0 / d) - 1.0)
+        grid = _sorted_grid(box, dmax * (1.0 + swell), FIRE_SKIN * dmax)
+        if grid is not None:
+            compress(grid, swell)
+            lam = 1.0
     grow = 0.05
     while lam < 1.0:
         if grow < 1e-4:
