@@ -153,14 +153,44 @@ def fire_forces(r, radius, box, offsets, counts, pairs, swell, v, f):
     return p, vv, ff, hard, worst
 
 
+@jit
+def separate_pairs(r, radius, box, offsets, counts, pairs, swell):
+    """Each listed pair closer than R_i + R_j pushed apart along its axis to (1 + swell/2)
+    (R_i + R_j), both particles by half (in list order, Gauss-Seidel: for the last few
+    overlaps of a compression, which FIRE resolves slowly). Returns the number of pairs
+    pushed."""
+    pushed = 0
+    for k in range(r.shape[0]):
+        for e in range(offsets[k], offsets[k] + counts[k]):
+            j = pairs[e]
+            dx = min_image(r[k, 0] - r[j, 0], box[0])
+            dy = min_image(r[k, 1] - r[j, 1], box[1])
+            dz = min_image(r[k, 2] - r[j, 2], box[2])
+            s = radius[k] + radius[j]
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if d < s and d > 0.0:
+                c = 0.5 * ((1.0 + 0.5 * swell) * s - d) / d
+                r[k, 0] += c * dx
+                r[k, 1] += c * dy
+                r[k, 2] += c * dz
+                r[j, 0] -= c * dx
+                r[j, 1] -= c * dy
+                r[j, 2] -= c * dz
+                pushed += 1
+    return pushed
+
+
 @jit(parallel=True)
 def fire_move(r, v, f, r0, keep, mix, dt, block, moved):
     """One FIRE step: v = keep v + mix f (the velocity mixing; keep = 0 and mix = 0 stop
     the particles), then v += dt f, r += dt v (semi-implicit Euler, unit masses).
-    moved[b] = the largest squared distance from r0 of a particle of block b."""
+    moved[b] = the largest and the second largest distance from r0 of the particles of
+    block b (a pair has come closer by at most the sum of the two largest over all
+    blocks)."""
     n = r.shape[0]
     for b in numba.prange(moved.shape[0]):
-        worst = 0.0
+        first = 0.0
+        second = 0.0
         for k in range(b * block, min(n, (b + 1) * block)):
             dist2 = 0.0
             for a in range(3):
@@ -168,5 +198,11 @@ def fire_move(r, v, f, r0, keep, mix, dt, block, moved):
                 v[k, a] = w
                 r[k, a] += dt * w
                 dist2 += (r[k, a] - r0[k, a]) ** 2
-            worst = max(worst, dist2)
-        moved[b] = worst
+            if dist2 > second:
+                if dist2 > first:
+                    second = first
+                    first = dist2
+                else:
+                    second = dist2
+        moved[b, 0] = math.sqrt(first)
+        moved[b, 1] = math.sqrt(second)

@@ -101,12 +101,13 @@ def test_fire_move_is_a_fire_step():
     r0 = r - 0.01
     want_v = 0.9 * v + 0.3 * f + 0.2 * f
     want_r = r + 0.2 * want_v
-    moved = np.empty(3)
+    moved = np.empty((3, 2))
     fire.fire_move(r, v, f, r0, 0.9, 0.3, 0.2, 4, moved)
     np.testing.assert_allclose(v, want_v, rtol=1e-14)
     np.testing.assert_allclose(r, want_r, rtol=1e-14)
-    dist2 = np.sum((want_r - r0) ** 2, axis=1)
-    np.testing.assert_allclose(moved, [dist2[0:4].max(), dist2[4:8].max(), dist2[8]], rtol=1e-14)
+    dist = np.linalg.norm(want_r - r0, axis=1)
+    top = [np.sort(dist[0:4])[::-1][:2], np.sort(dist[4:8])[::-1][:2], [dist[8], 0.0]]
+    np.testing.assert_allclose(moved, top, rtol=1e-14)
 
 
 def test_large_dense_states_are_compressed_without_pushes(monkeypatch):
@@ -124,3 +125,17 @@ def test_large_dense_states_are_compressed_without_pushes(monkeypatch):
     dr -= st.box * np.round(dr / st.box)
     dist = np.linalg.norm(dr, axis=2) + 10 * np.eye(1500)
     assert dist.min() >= 1.0
+
+
+def test_separate_pairs_pushes_overlapping_pairs_to_the_swollen_distance():
+    box = np.array([10.0, 10.0, 10.0])
+    r = np.array([[0.2, 5.0, 5.0], [9.5, 5.0, 5.0], [3.0, 3.0, 3.0], [4.05, 3.0, 3.0]])  # pair 0-1 across x = 0
+    radius = np.array([0.5, 0.5, 0.4, 0.6])
+    offsets = np.array([0, 2, 3, 4, 4])
+    counts = np.array([2, 0, 1, 0])
+    pairs = np.array([1, 2, 3, -1], dtype=np.int32)  # 0-1 (overlap 0.3), 0-2 (apart), 2-3 (apart)
+    assert fire.separate_pairs(r, radius, box, offsets, counts, pairs, 0.04) == 1
+    gap = r[0, 0] + 10.0 - r[1, 0]
+    assert gap == pytest.approx(1.02, rel=1e-14)
+    assert r[0, 0] + r[1, 0] - 10.0 == pytest.approx(0.2 + 9.5 - 10.0, abs=1e-14)  # centre kept
+    np.testing.assert_array_equal(r[2:], [[3.0, 3.0, 3.0], [4.05, 3.0, 3.0]])
