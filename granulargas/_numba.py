@@ -29,20 +29,97 @@ Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function
 whose compilation triggered the callee's, so that a kernel first compiled from
 within an inlined kernel would be inlined into all its callers.
+
+The on-disk cache. Numba stores a compiled function with a stamp of its own
+source file and reuses it while that file is unchanged. But the machine code
+of a function holds the code of every jit function it calls (inlined or linked
+in) and the module constants it reads, from other files too: after an edit of
+``_geometry.py`` alone, the cached event loop of ``_loop.py`` would still run
+the old geometry. The functions compiled here are therefore cached with a
+stamp that adds :func:`source_stamp`, a hash of every Python source file of
+the package (and of the package that holds the function, if another one): any
+change to the package's sources recompiles everything once.
+An installed package never changes, so its cache stays valid.
 """
 
+import functools
+import hashlib
 import os
 
 import numba
+from numba.core import caching
 
 _CACHE = os.environ.get("GRANULARGAS_NO_CACHE", "") not in ("1", "true", "yes")
 
+_PACKAGE = os.path.dirname(os.path.abspath(__file__))
+
+
+@functools.lru_cache(maxsize=None)
+def source_stamp(root=_PACKAGE):
+    """SHA-256 (hex) of the relative paths and contents of the ``.py`` files under ``root``."""
+    digest = hashlib.sha256()
+    for folder, subfolders, files in os.walk(root):
+        subfolders[:] = sorted(d for d in subfolders if d != "__pycache__")
+        for name in sorted(files):
+            if name.endswith(".py"):
+                path = os.path.join(folder, name)
+                digest.update(os.path.relpath(path, root).encode() + b"\0")
+                with open(path, "rb") as f:
+                    digest.update(f.read())
+                digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def _top_package(path):
+    """Directory of the top-level package that holds the file ``path`` (None: not in a package)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.exists(os.path.join(folder, "__init__.py")):
+        return None
+    while os.path.exists(os.path.join(os.path.dirname(folder), "__init__.py")):
+        folder = os.path.dirname(folder)
+    return folder
+
+
+def _package_stamped(locator):
+    """Subclass of numba cache locator ``locator`` whose source stamp adds :func:`source_stamp`
+    of this package and of the package holding the function (test helpers, user code)."""
+
+    class PackageStamped(locator):
+        def get_source_stamp(self):
+            own = getattr(self, "_py_file", None)
+            own = _top_package(own) if own else None
+            extra = source_stamp(own) if own and own != _PACKAGE else None
+            return (super().get_source_stamp(), source_stamp(), extra)
+
+    PackageStamped.__name__ = PackageStamped.__qualname__ = f"PackageStamped{locator.__name__}"
+    return PackageStamped
+
+
+class _CacheImpl(caching.CompileResultCacheImpl):
+    _locator_classes = [_package_stamped(c) for c in caching.CompileResultCacheImpl._locator_classes]
+
+
+class _FunctionCache(caching.FunctionCache):
+    """numba's per-function cache, with the package-wide source stamp (module docstring)."""
+
+    _impl_class = _CacheImpl
+
 
 def jit(*args, **kwargs):
-    """``numba.njit`` with the package defaults (cache=True, no fastmath)."""
-    kwargs.setdefault("cache", _CACHE)
+    """``numba.njit`` with the package defaults (cached with the package's stamp, no fastmath)."""
+    cache = kwargs.pop("cache", _CACHE)
     kwargs.setdefault("forceinline", False)
-    return numba.njit(*args, **kwargs)
+
+    def decorate(func):
+        dispatcher = numba.njit(**kwargs)(func)
+        if cache and hasattr(dispatcher, "enable_caching"):  # not with NUMBA_DISABLE_JIT
+            dispatcher._cache = _FunctionCache(dispatcher.py_func)
+        return dispatcher
+
+    if args:
+        (func,) = args
+        return decorate(func)
+    return decorate
 
 
 def kernel(*args, python=True, **kwargs):

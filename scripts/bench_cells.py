@@ -3,8 +3,8 @@
 For each N and packing fraction the same random state (3D, or 2D with
 ``--dimension 2``) runs with each
 neighbour search (``--modes``: ``lists`` with the default shell, ``cells`` with
-cells one diameter wide, ``cells:X`` with cells (1 + X) diameters wide) in this
-process: a warm-up of 5 collisions per particle, then ``--rounds`` alternated
+cells one diameter wide, ``cells:X`` with cells (1 + X) diameters wide, ``lists:X`` with a list shell
+of X diameters) in this process: a warm-up of 5 collisions per particle, then ``--rounds`` alternated
 timed runs of max(2e5, N) collisions each. Printed per case: events per
 collision (list expiries or cell crossings, stale events), and the median rate
 in million collisions per second of CPU time (and of the wall clock). The
@@ -25,6 +25,11 @@ Usage::
     taskset -c 1 python scripts/bench_cells.py --n 10976 --packings 0.05 0.1
     taskset -c 1 python scripts/bench_cells.py --rule viscoelastic --modes lists cells cells:0.5
     taskset -c 1 python scripts/bench_cells.py --c-cell /path/Cell/md --c-single /path/Single/md
+
+``--plot FILE`` draws the rate against the events per collision, one panel per
+N and packing, one point per mode (the C codes' rates as horizontal lines):
+the trade-off between fewer, dearer events (wider cells, wider list shells) and
+more, cheaper ones.
 """
 
 import argparse
@@ -59,8 +64,9 @@ def mode_kwargs(mode):
     if mode == "cells":
         return dict(neighbours="cells")
     name, extra = mode.split(":")
-    assert name == "cells", mode
-    return dict(neighbours="cells", shell=float(extra))
+    if name not in ("lists", "cells"):
+        raise SystemExit(f"--modes: {mode!r}: expected lists, cells, lists:SHELL or cells:SHELL")
+    return dict(neighbours=name, shell=float(extra))
 
 
 def compile_seconds(rule, modes):
@@ -106,7 +112,9 @@ def main(argv=None):
     p.add_argument("--c-single", help="binary of the C code's Single variant")
     p.add_argument("--c-collisions", type=float, default=5e5)
     p.add_argument("--core", type=int, default=1)
+    p.add_argument("--plot", help="PNG file: rate against events per collision")
     args = p.parse_args(argv)
+    results = []
     rule = make_rule(args.rule)
     for mode, s in compile_seconds(rule, args.modes).items():
         print(f"first run (JIT compile, 0 when cached) {mode}: {s:.1f} s", flush=True)
@@ -143,10 +151,52 @@ def main(argv=None):
                       f"{statistics.median(cpu) / 1e6:.4f} M collisions/s CPU "
                       f"({statistics.median(wall) / 1e6:.4f} wall; rounds "
                       f"{' '.join(f'{x / 1e6:.4f}' for x in cpu)})", flush=True)
+                results.append(dict(n=n, packing=eta, mode=mode, shell=sim.shell,
+                                    events=per["events"], rate=statistics.median(cpu) / 1e6))
             for name, rates in c_rates.items():
                 if rates:
                     print(f"N={n} packing {eta} elastic {name}: {statistics.median(rates):.4f} M collisions/s "
                           f"CPU (rounds {' '.join(f'{x:.4f}' for x in rates)})", flush=True)
+                    results.append(dict(n=n, packing=eta, mode=name, rate=statistics.median(rates)))
+    if args.plot:
+        plot(results, args.plot, f"{args.dimension}D, {args.rule}")
+
+
+def plot(results, path, title):
+    """Rate against events per collision, one panel per (N, packing); C codes as lines."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    cases = sorted({(r["n"], r["packing"]) for r in results})
+    fig, axes = plt.subplots(1, len(cases), figsize=(4.8 * len(cases), 4.0), squeeze=False)
+    styles = {"lists": ("s", "C0"), "cells": ("o", "C1")}
+    for ax, (n, eta) in zip(axes[0], cases):
+        rows = [r for r in results if (r["n"], r["packing"]) == (n, eta)]
+        for kind, (marker, colour) in styles.items():
+            pts = sorted((r["events"], r["rate"], r["shell"]) for r in rows if r["mode"].split(":")[0] == kind)
+            if not pts:
+                continue
+            x, y, shell = zip(*pts)
+            ax.plot(x, y, marker=marker, color=colour, ls="-", label=f"{kind} (labels: "
+                    + ("cell width" if kind == "cells" else "shell") + ", diameters)")
+            for xi, yi, si in pts:
+                ax.annotate(f"{1 + si:.2g}" if kind == "cells" else f"{si:.2g}", (xi, yi),
+                            textcoords="offset points", xytext=(4, 4), fontsize=8, color=colour)
+        for k, r in enumerate(r for r in rows if r["mode"].startswith("C ")):
+            ax.axhline(r["rate"], color=f"C{k + 2}", ls="--", label=f"{r['mode']} code")
+        ax.axvline(2.0, color="0.6", ls=":", lw=1, label="2 events per collision")
+        ax.set_xlabel("events per collision")
+        ax.set_ylabel("million collisions per CPU second")
+        ax.set_title(f"N = {n}, packing {eta:g}")
+        ax.set_ylim(bottom=0.0)
+        ax.set_xlim(left=0.0)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"Speed against events per collision ({title})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"wrote {path}")
 
 
 def _counts(sim):

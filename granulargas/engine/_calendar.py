@@ -312,7 +312,7 @@ def _replace(failure, cal):
     return False
 
 
-@kernel
+@kernel(python=False)
 def cal_update(i, t, cal):
     """Set the event time of particle i to t. Returns False on failure (see :func:`_replace`)."""
     cs = cal.state[0]
@@ -518,7 +518,7 @@ def cal_next_time(cal):
     return cal.small[0, 0]
 
 
-@kernel
+@kernel(python=False)
 def cal_peek(cal):
     """Particle with the earliest event (moving the window forward as needed).
 

@@ -39,7 +39,7 @@ CELL_OVERFLOW = 11
 PREFETCH_CENTRES_FROM = 32768
 
 
-@inlined(python=True)  # tests call it from Python
+@inlined
 def cell_coord(x, length, n):
     c = int(x * (n / length))
     if c >= n:
@@ -147,7 +147,7 @@ def _pick(o, lo2, hi2):
     return 0.0
 
 
-@inlined(python=True)  # tests call it from Python
+@inlined
 def _reach(x, y, z, cut, space, stencil):
     """Cells around (x, y, z) that a sphere of radius ``cut`` can reach, into ``stencil``.
 
@@ -314,7 +314,7 @@ def _shift(c, n, length):
     return 0.0
 
 
-@kernel
+@kernel(python=False)
 def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     """New list centre c_i = r_i and a new neighbour list for particle i.
 

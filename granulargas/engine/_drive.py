@@ -64,7 +64,7 @@ def _uniform(key, counter):
     return np.float64(mix64(key + counter * _GAMMA) >> _S11) * _TWO53
 
 
-@inlined(python=True)  # tests call it from Python
+@inlined
 def kick_normals(seed, step, ident):
     """Three independent standard normal numbers for (seed, step k, particle id).
 

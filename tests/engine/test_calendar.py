@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from granulargas.engine._calendar import allocate_calendar, cal_build, cal_check, cal_peek, cal_update
+from granulargas.engine._calendar import allocate_calendar, cal_build, cal_check
+from tests.engine.kernels import cal_peek, cal_update
 
 
 def _width(c):

@@ -5,8 +5,8 @@ import itertools
 import numpy as np
 import pytest
 
-from granulargas.engine._cells import _reach, cell_coord
 from granulargas.engine._state import space
+from tests.engine.kernels import cell_coord, reach
 
 
 def _expected(p, cut, box, ncell, walls=()):
@@ -52,7 +52,7 @@ def test_pruned_stencil_keeps_every_cell_the_cutoff_sphere_reaches(dim, walls):
         if dim == 2:
             p[2] = 0.5
         inside = bool(np.all((p[:dim] >= 0) & (p[:dim] < box[:dim])))
-        ns = _reach(p[0], p[1], p[2], cut, spc, stencil)
+        ns = reach(p[0], p[1], p[2], cut, spc, stencil)
         got = {(int(e) >> 5, int(e) & 31) for e in stencil[:ns]}
         assert len(got) == ns
         want = _expected(p, cut, box, ncell, walls)
@@ -68,7 +68,7 @@ def test_pruned_stencil_keeps_every_cell_the_cutoff_sphere_reaches(dim, walls):
     assert np.mean(reached) < (20.7 if dim == 3 else 8.2)
     if walls:  # a point in the first cell of a wall axis reaches nothing beyond it
         p = np.array([0.5 * w[0], 0.5 * w[1], 0.5 * w[2] if dim == 3 else 0.5])
-        ns = _reach(p[0], p[1], p[2], 0.9 * w[:dim].min(), spc, stencil)
+        ns = reach(p[0], p[1], p[2], 0.9 * w[:dim].min(), spc, stencil)
         for e in stencil[:ns]:
             code = int(e) & 31
             offs = (code % 3 - 1, (code // 3) % 3 - 1, code // 9 - 1)

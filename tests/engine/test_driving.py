@@ -8,11 +8,11 @@ import pytest
 
 from granulargas import theory
 from granulargas.engine import CollisionRule, Simulation, WhiteNoise
-from granulargas.engine._drive import kick_normals
 from granulargas.initial import random_state
 from granulargas.errors import ConfigError
 
 from tests.engine.factories import walled_state
+from tests.engine.kernels import kick_normals
 
 
 def test_one_kick_from_rest_heats_by_h_dt_equally_for_every_mass_and_keeps_momentum_zero():

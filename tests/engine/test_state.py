@@ -190,7 +190,7 @@ def test_rebuild_tests_the_rounded_centre():
     """A pair whose stored (float32) centres are closer than R_i + R_j + shell must be
     listed even when the unrounded position is just beyond: at x ~ 3e4 the centre
     of i rounds down by 9e-4, which moves it from 2.0013 to 1.99998 from j."""
-    from granulargas.engine._cells import rebuild_list
+    from tests.engine.kernels import rebuild_list
 
     box = np.array([30000.0, 6.0, 6.0])
     pos = np.array([[29980.0, 3.0, 3.0], [29990.0, 3.0, 3.0]])

@@ -1,0 +1,75 @@
+"""The package's numba decorators: a cached function is recompiled when code it inlines changes."""
+
+import os
+import subprocess
+import sys
+import textwrap
+
+from granulargas import _numba
+
+_CALLEE = """
+from granulargas._numba import inlined
+
+
+@inlined
+def value():
+    return {value}
+"""
+
+_CALLER = """
+from granulargas._numba import jit
+from cachedpkg.callee import value
+
+
+@jit
+def caller():
+    return value()
+"""
+
+
+def _write_package(root, value):
+    pkg = root / "cachedpkg"
+    pkg.mkdir(exist_ok=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "callee.py").write_text(_CALLEE.format(value=value))
+    (pkg / "caller.py").write_text(_CALLER)
+
+
+def _run_caller(root, cache_dir):
+    """(result, whether it came from numba's on-disk cache) in a fresh interpreter."""
+    code = ("from cachedpkg.caller import caller; r = caller(); "
+            "print(r, sum(caller.stats.cache_hits.values()))")
+    path = [str(root)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(cache_dir))
+    env.pop("GRANULARGAS_NO_CACHE", None)
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=root, capture_output=True,
+                         text=True, check=True).stdout.split()
+    return int(out[0]), int(out[1])
+
+
+def test_an_edit_of_an_inlined_callee_in_another_file_recompiles_the_cached_caller(tmp_path):
+    cache = tmp_path / "cache"
+    _write_package(tmp_path, 1)
+    assert _run_caller(tmp_path, cache) == (1, 0)
+    assert _run_caller(tmp_path, cache) == (1, 1)  # loaded from the cache
+    _write_package(tmp_path, 2)  # caller.py itself is unchanged
+    assert _run_caller(tmp_path, cache) == (2, 0)
+    assert _run_caller(tmp_path, cache) == (2, 1)
+
+
+def test_source_stamp_changes_with_any_source_file_and_only_with_sources(tmp_path):
+    sub = tmp_path / "sub"
+    sub.mkdir()
+    (tmp_path / "a.py").write_text("x = 1\n")
+    (sub / "b.py").write_text("y = 2\n")
+    (sub / "notes.txt").write_text("not a source\n")
+    stamp = _numba.source_stamp.__wrapped__
+    s0 = stamp(str(tmp_path))
+    assert stamp(str(tmp_path)) == s0
+    (sub / "notes.txt").write_text("changed\n")
+    assert stamp(str(tmp_path)) == s0
+    (sub / "b.py").write_text("y = 3\n")
+    s1 = stamp(str(tmp_path))
+    assert s1 != s0
+    (sub / "b.py").rename(sub / "c.py")
+    assert stamp(str(tmp_path)) not in (s0, s1)
