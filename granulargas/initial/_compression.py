@@ -6,20 +6,18 @@ harmonic pair energy
 
     U = sum_{i<j} (s'_ij - d_ij)^2 / 2  for d_ij < s'_ij,  s'_ij = (1 + w)(R_i + R_j),
 
-w the swelling (a few per cent): a state with every d_ij >= (1 + w/2)(R_i + R_j)
-is a hard-sphere state without overlap, with room to spare. Forces are summed
-over a Verlet neighbour list (pairs within s'_ij + skin when the list was
-built, a full list: each pair in both particles' rows), found by a scan of
-particles sorted by cell (:func:`._montecarlo.sort_by_cell`); the list stays
-valid while every particle is less than skin/2 from where it was when the list
-was built.
+w the swelling (a few per cent), until no pair is closer than R_i + R_j: a
+hard-sphere state without overlap, most gaps near w (R_i + R_j). The last few
+overlapping pairs, which FIRE resolves slowly, are pushed apart directly
+(:func:`separate_pairs`). Forces are summed over a Verlet neighbour list: the
+pairs within s'_ij + skin when it was built, each once (j > i), found by a scan
+of particles sorted by cell (:func:`._montecarlo.sort_by_cell`); the list stays
+valid while the two largest distances moved since add up to less than the skin.
 
-Every kernel runs over fixed blocks of ``block`` consecutive particles in
-parallel threads; a particle's force is the sum over its row of the list, in
-the row's order, and the global sums FIRE needs (F.v, |v|^2, |F|^2) are summed
-per block and then over the blocks in Python. The result is the same for any
-number of threads.
-"""
+The list is built in parallel threads (each row on its own); forces and their
+sums (F.v, |v|^2, |F|^2) in one thread, in list order; the moves in parallel
+threads over fixed blocks of particles. The result is the same for any number of
+threads."""
 
 import math
 

@@ -32,10 +32,13 @@ than contact. All particles relax at once, so that the ~60 minimiser steps cost
 less than the pushes' dozens of passes over the last growth steps (where nearly
 every particle overlaps and each push opens one gap by closing another), and the
 swelling leaves gaps around the contacts: the contact value of g(r) after the
-final sweeps is close to the equilibrium fluid's (N = 2e5 at packing 0.5: ~6.9
-with Carnahan-Starling 6.0, the pushes ~10.9). Where the box is too small for
-the sorted scans, the growth steps with pushes over cell lists serve; small
-systems use cell lists and the generator's random numbers throughout.
+final sweeps is closer to the equilibrium fluid's (N = 2e5 at packing 0.5: ~7.5
+with Carnahan-Starling 6.0, the growth steps ~10.9). The compression keeps more
+of the lattice's bond order than growth steps with sweeps in between, so that
+``COMPRESSION_MELT_SWEEPS`` (25) sweeps melt the lattice before it. Where the
+box is too small for the compression's scans, the growth steps with pushes
+serve; small systems use cell lists and the generator's random numbers
+throughout.
 
 Long-wavelength density fluctuations. The sweeps move each particle by a
 fraction of a diameter: they relax the structure at short range, but a density
