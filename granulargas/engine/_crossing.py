@@ -61,6 +61,10 @@ PREV = 5
 PAIR_J = 6
 PAIR_TAG = 7
 
+#: length of ``Grid.fresh``: [0] the slot whose stored pair a crossing has just brought up
+#: to date, [1:] scratch of the scans, the first particles of the (at most 27) non-empty cells
+FRESH_SIZE = 28
+
 
 def particle_rows(n):
     """The per-particle data of a cell crossing in one 64-byte row per particle (one cache
@@ -144,6 +148,12 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     cells beyond a wall do not exist; with 3 cells on a periodic axis a cell may
     be visited twice (harmless). A call: the loop inlines only the scans of
     cells inside the grid (:func:`scan_block`), the common case.
+
+    Two passes: the first particles of the non-empty cells are listed in
+    ``grid.fresh[1:]`` (one store per cell, no branch on whether it is empty), then
+    the listed cells' particles are scanned in the same order. Most cells of a
+    dilute gas are empty, and a loop that branched on each cell's occupancy would
+    mispredict at every occupied one.
     """
     head = grid.head
     row_of = grid.cell
@@ -159,8 +169,8 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     vy = rec[i, 4]
     vz = rec[i, 5]
     ri = rec[i, 7]
-    best = before
-    p = -1
+    first = grid.fresh
+    k = 1
     for oz in range(z0, z1 + 1):
         kz = _neighbour(cz, oz, ncell[2], period[2])
         if kz < 0:
@@ -175,12 +185,18 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
                 if kx < 0:
                     continue
                 j = head[kx + row]
-                while j >= 0:
-                    tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
-                    better = tc < best
-                    best = tc if better else best
-                    p = j if better else p
-                    j = row_of[j, NEXT]
+                first[k] = j
+                k += 1 if j >= 0 else 0
+    best = before
+    p = -1
+    for q in range(1, k):
+        j = first[q]
+        while j >= 0:
+            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
+            better = tc < best
+            best = tc if better else best
+            p = j if better else p
+            j = row_of[j, NEXT]
     return best, p
 
 
@@ -196,7 +212,10 @@ def _interior(i, grid, space):
 @inlined
 def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
     """:func:`scan_cells` over cells of flat index c0 + u s1 + w s2 + v (w, u in 0..2,
-    v in 0..n0-1, in this order) -- the cells around an interior cell, without wraps."""
+    v in 0..n0-1, in this order) -- the cells around an interior cell, without wraps; the
+    same two passes. (The coordinate differences keep their nearest-image tests: a particle
+    that has just crossed a periodic face may sit a round-off distance on the far side of
+    the box from its new cell.)"""
     head = grid.head
     row_of = grid.cell
     period = space.period
@@ -207,19 +226,25 @@ def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
     vy = rec[i, 4]
     vz = rec[i, 5]
     ri = rec[i, 7]
-    best = before
-    p = -1
+    first = grid.fresh
+    k = 1
     for w in range(3):
         for u in range(3):
             b = c0 + u * s1 + w * s2
             for v in range(n0):
                 j = head[b + v]
-                while j >= 0:
-                    tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
-                    better = tc < best
-                    best = tc if better else best
-                    p = j if better else p
-                    j = row_of[j, NEXT]
+                first[k] = j
+                k += 1 if j >= 0 else 0
+    best = before
+    p = -1
+    for q in range(1, k):
+        j = first[q]
+        while j >= 0:
+            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
+            better = tc < best
+            best = tc if better else best
+            p = j if better else p
+            j = row_of[j, NEXT]
     return best, p
 
 
@@ -347,8 +372,17 @@ def build_grid(rec, grid, space):
 
 @inlined
 def prefetch_around(i, grid, space):
-    """Prefetch hints for the cell heads around particle i's cell (no effect on results)."""
+    """Prefetch hints for the cell heads around particle i's cell (no effect on results):
+    one per row of 3 cells (the middle one's line)."""
     ncell = space.ncell
+    if _interior(i, grid, space):
+        nx = ncell[0]
+        sz = nx * ncell[1]
+        c = grid.cell[i, FLAT] - nx - sz
+        for w in range(3):
+            for u in range(3):
+                prefetch(grid.head, c + u * nx + w * sz)
+        return
     period = space.period
     cx = grid.cell[i, 0]
     cy = grid.cell[i, 1]

@@ -59,7 +59,8 @@ events, ``scripts/profile_loop.py``), so that these misses overlap with the
 current work; before a list expiry it also prefetches the cell rows around the
 particle and its neighbours' list rows. Where the time goes per part of the
 loop: ``python scripts/profile_loop.py 1e4 1e6`` (cycle counters compiled into
-a second build of this loop, :mod:`granulargas.engine._probe`); two source
+a second build of this loop, :mod:`granulargas.engine._probe`); per source line of
+the production build: ``python scripts/perf_loop.py 1e4`` (``perf`` samples); two source
 trees compared by alternated runs: ``python scripts/bench_ab.py OTHER_TREE .
 --sizes 1e4 1e6``; the numbers are in docs/performance.md.
 

@@ -41,8 +41,9 @@ Record layout
   :mod:`~granulargas.engine._crossing`): its cell coordinates, flat cell index,
   next and previous particle of its cell's doubly linked list, its best pair's
   partner (-1: none) and that partner's count then; ``pair_t`` f8 the time of
-  that best pair; ``width`` (3,) f8 the cell side per axis; ``fresh`` (1,) i8
-  the slot whose stored pair a crossing has just brought up to date (-1: none).
+  that best pair; ``width`` (3,) f8 the cell side per axis; ``fresh`` (28,) i8:
+  [0] the slot whose stored pair a crossing has just brought up to date (-1: none),
+  [1:] scratch of the cell scans (the first particles of the non-empty cells).
   In this mode ``cell``, ``pair_t``, ``events.partner``, ``events.tag``,
   ``calendar.qt`` and ``calendar.where`` are strided views into one 64-byte row
   per particle (:func:`granulargas.engine._crossing.particle_rows`).

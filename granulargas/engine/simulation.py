@@ -26,7 +26,7 @@ from granulargas.engine import _loop, _state
 from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
-from granulargas.engine._crossing import MARGIN, build_grid, particle_rows
+from granulargas.engine._crossing import FRESH_SIZE, MARGIN, build_grid, particle_rows
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
@@ -406,7 +406,7 @@ class Simulation:
             events = _state.Events(partner=partner, tag=tag)
             lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), cell=cell,
                                 width=spc.box / spc.ncell, pair_t=pair_t,
-                                fresh=np.full(1, -1, dtype=np.int64))
+                                fresh=np.full(FRESH_SIZE, -1, dtype=np.int64))
             build_grid(rec, lists, spc)
             self._finish_build(particles, events, lists, None, order, qt=qt, where=where)
             return
