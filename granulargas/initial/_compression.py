@@ -1,0 +1,206 @@
+"""Compiled soft-sphere compression for initial states of large systems (numba leaf module).
+
+Spheres (disks) of radii R_i that overlap are pulled apart by the energy
+minimiser FIRE (Bitzek, Koskinen, Gähler, Moseler & Gumbsch 2006) on the
+harmonic pair energy
+
+    U = sum_{i<j} (s'_ij - d_ij)^2 / 2  for d_ij < s'_ij,  s'_ij = (1 + w)(R_i + R_j),
+
+w the swelling (a few per cent), until no pair is closer than R_i + R_j: a
+hard-sphere state without overlap, most gaps near w (R_i + R_j). The last few
+overlapping pairs, which FIRE resolves slowly, are pushed apart directly
+(:func:`separate_pairs`). Forces are summed over a Verlet neighbour list: the
+pairs within s'_ij + skin when it was built, each once (j > i), found by a scan
+of particles sorted by cell (:func:`._montecarlo.sort_by_cell`); the list stays
+valid while the two largest distances moved since add up to less than the skin.
+
+The list is built in parallel threads (each row on its own); forces and their
+sums (F.v, |v|^2, |F|^2) in one thread, in list order; the moves in parallel
+threads over fixed blocks of particles. The result is the same for any number of
+threads."""
+
+import math
+
+import numba
+import numpy as np
+
+from granulargas._numba import inlined, jit
+from granulargas.engine._geometry import min_image
+from granulargas.initial._montecarlo import _periodic_row, _radius_range, _scan_window
+
+
+@inlined
+def _row_neighbours(k, x, y, z, rk, a, b, r, radius, swell, skin, nbr, m, end, same):
+    """Particles j > k of the sorted run [a, b) within (1 + swell)(R_k + R_j) + skin of
+    (x, y, z), counted from m on and stored to nbr[m:end]; returns the new m. ``same``:
+    all radii equal."""
+    cut = (1.0 + swell) * 2.0 * rk + skin
+    for j in range(max(a, k + 1), b):
+        dx = x - r[j, 0]
+        dy = y - r[j, 1]
+        dz = z - r[j, 2]
+        if not same:
+            cut = (1.0 + swell) * (rk + radius[j]) + skin
+        if dx * dx + dy * dy + dz * dz < cut * cut:
+            if m < end:
+                nbr[m] = j
+            m += 1
+    return m
+
+
+@inlined
+def _scan_neighbours(k, r, radius, box, ncell, start, reach, swell, skin, nbr, m, end, same):
+    """:func:`_row_neighbours` over the cells a scan of reach ``reach`` visits around
+    particle k (in the box, as filed by the sort)."""
+    nx = ncell[0]
+    ny = ncell[1]
+    nz = ncell[2]
+    x = r[k, 0]
+    y = r[k, 1]
+    z = r[k, 2]
+    ly, lz, mz, a1, b1, a2, b2, sx2 = _scan_window(x, y, z, box, ncell, reach)
+    rk = radius[k]
+    for oz in range(mz):
+        kz, zz = _periodic_row(lz + oz, nz, z, box[2])
+        for oy in range(2):
+            ky, yy = _periodic_row(ly + oy, ny, y, box[1])
+            row = nx * (ky + ny * kz)
+            m = _row_neighbours(k, x, yy, zz, rk, start[row + a1], start[row + b1], r, radius, swell, skin, nbr,
+                                m, end, same)
+            m = _row_neighbours(k, x - sx2, yy, zz, rk, start[row + a2], start[row + b2], r, radius, swell, skin,
+                                nbr, m, end, same)
+    return m
+
+
+@jit(parallel=True)
+def neighbour_counts(r, radius, box, ncell, start, swell, skin, counts):
+    """counts[k] = the number of particles j > k within (1 + swell)(R_k + R_j) + skin
+    of particle k (each pair once), for particles sorted by cell (:func:`._montecarlo.sort_by_cell`, just
+    sorted) on a grid whose y and z cells (3D) are >= 2 ((1 + swell) 2 R_max + skin)
+    wide (:func:`._montecarlo.sorted_overlaps`)."""
+    rmin, rmax = _radius_range(radius)
+    reach = ((1.0 + swell) * 2.0 * rmax + skin) * (1.0 + 1e-9)  # (+ rounding margin)
+    empty = np.empty(0, dtype=np.int32)
+    for k in numba.prange(r.shape[0]):
+        counts[k] = _scan_neighbours(k, r, radius, box, ncell, start, reach, swell, skin, empty, 0, 0, rmin == rmax)
+
+
+@jit(parallel=True)
+def neighbour_rows(r, radius, box, ncell, start, swell, skin, offsets, nbr, counts):
+    """The pairs of the neighbour list, each once: row k (the particles of
+    :func:`neighbour_counts`, in scan order) in nbr[offsets[k]:offsets[k] + counts[k]],
+    counts[k] their number; a row holds at most offsets[k + 1] - offsets[k] of them.
+    Returns the number of rows that did not fit (their counts exceed the room: build
+    again with more)."""
+    rmin, rmax = _radius_range(radius)
+    reach = ((1.0 + swell) * 2.0 * rmax + skin) * (1.0 + 1e-9)
+    same = rmin == rmax
+    full = 0
+    for k in numba.prange(r.shape[0]):
+        a = offsets[k]
+        counts[k] = _scan_neighbours(k, r, radius, box, ncell, start, reach, swell, skin, nbr, a,
+                                     offsets[k + 1], same) - a
+        if counts[k] > offsets[k + 1] - a:
+            full += 1
+    return full
+
+
+@jit
+def fire_forces(r, radius, box, offsets, counts, pairs, swell, v, f):
+    """Forces f (N, 3) of the swollen harmonic overlaps (module docstring), over the
+    pairs of :func:`neighbour_rows` (each once, in order: the same sums for any
+    thread count). Returns (F.v, |v|^2, |F|^2, the number of pairs closer than
+    R_i + R_j, the largest (s'_ij - d_ij) - (R_i + R_j) w/2 of a pair: < 0 when every
+    gap is >= w/2 contact distances)."""
+    n = r.shape[0]
+    f[:] = 0.0
+    hard = 0
+    worst = -math.inf
+    for k in range(n):
+        fx = 0.0
+        fy = 0.0
+        fz = 0.0
+        rk = radius[k]
+        for e in range(offsets[k], offsets[k] + counts[k]):  # (branchless: half the pairs overlap)
+            j = pairs[e]
+            dx = min_image(r[k, 0] - r[j, 0], box[0])
+            dy = min_image(r[k, 1] - r[j, 1], box[1])
+            dz = min_image(r[k, 2] - r[j, 2], box[2])
+            s = rk + radius[j]
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            over = max(0.0, (1.0 + swell) * s - d)
+            worst = max(worst, over - 0.5 * swell * s)
+            hard += over > swell * s
+            c = over / d
+            fx += c * dx
+            fy += c * dy
+            fz += c * dz
+            f[j, 0] -= c * dx
+            f[j, 1] -= c * dy
+            f[j, 2] -= c * dz
+        f[k, 0] += fx
+        f[k, 1] += fy
+        f[k, 2] += fz
+    p = 0.0
+    vv = 0.0
+    ff = 0.0
+    for k in range(n):
+        p += f[k, 0] * v[k, 0] + f[k, 1] * v[k, 1] + f[k, 2] * v[k, 2]
+        vv += v[k, 0] * v[k, 0] + v[k, 1] * v[k, 1] + v[k, 2] * v[k, 2]
+        ff += f[k, 0] * f[k, 0] + f[k, 1] * f[k, 1] + f[k, 2] * f[k, 2]
+    return p, vv, ff, hard, worst
+
+
+@jit
+def separate_pairs(r, radius, box, offsets, counts, pairs, swell):
+    """Each listed pair closer than R_i + R_j pushed apart along its axis to (1 + swell/2)
+    (R_i + R_j), both particles by half (in list order, Gauss-Seidel: for the last few
+    overlaps of a compression, which FIRE resolves slowly). Returns the number of pairs
+    pushed."""
+    pushed = 0
+    for k in range(r.shape[0]):
+        for e in range(offsets[k], offsets[k] + counts[k]):
+            j = pairs[e]
+            dx = min_image(r[k, 0] - r[j, 0], box[0])
+            dy = min_image(r[k, 1] - r[j, 1], box[1])
+            dz = min_image(r[k, 2] - r[j, 2], box[2])
+            s = radius[k] + radius[j]
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if d < s and d > 0.0:
+                c = 0.5 * ((1.0 + 0.5 * swell) * s - d) / d
+                r[k, 0] += c * dx
+                r[k, 1] += c * dy
+                r[k, 2] += c * dz
+                r[j, 0] -= c * dx
+                r[j, 1] -= c * dy
+                r[j, 2] -= c * dz
+                pushed += 1
+    return pushed
+
+
+@jit(parallel=True)
+def fire_move(r, v, f, r0, keep, mix, dt, block, moved):
+    """One FIRE step: v = keep v + mix f (the velocity mixing; keep = 0 and mix = 0 stop
+    the particles), then v += dt f, r += dt v (semi-implicit Euler, unit masses).
+    moved[b] = the largest and the second largest distance from r0 of the particles of
+    block b (a pair has come closer by at most the sum of the two largest over all
+    blocks)."""
+    n = r.shape[0]
+    for b in numba.prange(moved.shape[0]):
+        first = 0.0
+        second = 0.0
+        for k in range(b * block, min(n, (b + 1) * block)):
+            dist2 = 0.0
+            for a in range(3):
+                w = keep * v[k, a] + mix * f[k, a] + dt * f[k, a]
+                v[k, a] = w
+                r[k, a] += dt * w
+                dist2 += (r[k, a] - r0[k, a]) ** 2
+            if dist2 > second:
+                if dist2 > first:
+                    second = first
+                    first = dist2
+                else:
+                    second = dist2
+        moved[b, 0] = math.sqrt(first)
+        moved[b, 1] = math.sqrt(second)
