@@ -230,6 +230,23 @@ def fire_forces(r, radius, box, offsets, counts, pairs, swell, v, f, slab_start,
     return p, vv, ff, hard, worst, stray
 
 
+@jit(parallel=True)
+def follow_sort(dest, v, counts, v_tmp, c_tmp):
+    """v (N, 3) and counts (N,) permuted as the particles by a sort (particle k to
+    dest[k]); v_tmp and c_tmp (like v, counts) are scratch."""
+    for k in numba.prange(dest.shape[0]):
+        i = dest[k]
+        v_tmp[i, 0] = v[k, 0]
+        v_tmp[i, 1] = v[k, 1]
+        v_tmp[i, 2] = v[k, 2]
+        c_tmp[i] = counts[k]
+    for k in numba.prange(dest.shape[0]):
+        v[k, 0] = v_tmp[k, 0]
+        v[k, 1] = v_tmp[k, 1]
+        v[k, 2] = v_tmp[k, 2]
+        counts[k] = c_tmp[k]
+
+
 @jit
 def separate_pairs(r, radius, box, offsets, counts, pairs, swell):
     """Each listed pair closer than R_i + R_j pushed apart along its axis to (1 + swell/2)
@@ -273,9 +290,9 @@ def fire_move(r, v, f, r0, keep, mix, dt, cap, block, moved):
             wx = keep * v[k, 0] + mix * f[k, 0] + dt * f[k, 0]
             wy = keep * v[k, 1] + mix * f[k, 1] + dt * f[k, 1]
             wz = keep * v[k, 2] + mix * f[k, 2] + dt * f[k, 2]
-            step = dt * math.sqrt(wx * wx + wy * wy + wz * wz)
-            if step > cap:
-                c = cap / step
+            w2 = wx * wx + wy * wy + wz * wz
+            if dt * dt * w2 > cap * cap:
+                c = cap / (dt * math.sqrt(w2))
                 wx *= c
                 wy *= c
                 wz *= c

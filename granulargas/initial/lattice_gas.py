@@ -480,15 +480,12 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
 
         def rebuild(pairs):  # sorted again (v with the particles), neighbour lists from the sort
             sort(grid)
-            dest = sorting["dest"]
-            f[dest] = v
-            v[:] = f
             start = sorting["start"]
+            # v and the last counts (room for as many pairs as the particle had neighbours,
+            # + NEIGHBOUR_SLACK) to the particles' new places
+            fire.follow_sort(sorting["dest"], v, counts, f, room)
             if len(pairs) == 0:
                 fire.neighbour_counts(r3, radii, box3, grid, start, swell, skin, counts)
-            else:  # room for as many pairs as the particle had neighbours, + NEIGHBOUR_SLACK
-                room[dest] = counts
-                counts[:] = room
             while True:
                 np.cumsum(counts + NEIGHBOUR_SLACK, out=offsets[1:])
                 if len(pairs) < offsets[-1]:
