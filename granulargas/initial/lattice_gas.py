@@ -52,9 +52,9 @@ vanishes at every G); at long wavelengths it changes S(k) by O((k a)^2) only.
 The compression then brings S(G) back to ~5-25 only: a displaced particle sees
 the hole its own site leaves in the others' expected density and is pulled back
 a little (displacements of less than half a cell let the compression rebuild
-the lattice). Disks (2D, packing >= 0.6, near the freezing of the hard-disk fluid
-at ~0.70) are pulled back more (S(G) ~ 15-25 at N = 5000 and 0.7, against ~1-4
-after sweeps): 2D states keep ``COMPRESSION_MELT_SWEEPS`` (25) sweeps at packing
+the lattice). Disks (2D, packing >= 0.6, near the end of the hard-disk fluid at
+0.70; Bernard & Krauth 2011) are pulled back more (mean S(G) 14-26 at N = 5000
+and 0.7, against 1-4 after sweeps): 2D states keep ``COMPRESSION_MELT_SWEEPS`` (25) sweeps at packing
 0.25 before the compression.
 
 Long-wavelength density fluctuations. The sweeps move each particle by a
@@ -141,7 +141,6 @@ COMPRESSION_MIN_PACKING = {3: 0.4, 2: 0.6}
 #: displacement within a lattice cell instead; module docstring): it keeps more of the
 #: lattice's order than growth steps with sweeps in between
 COMPRESSION_MELT_SWEEPS = 25
-
 
 # final Monte Carlo sweeps of systems beyond 10^5 particles (default of random_positions)
 FINAL_SWEEPS_LARGE = 6
