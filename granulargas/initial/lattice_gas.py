@@ -24,22 +24,38 @@ particles sorted by cell, slab by slab (:mod:`._montecarlo`): the slabs of one
 parity run in parallel threads, with the same result for any number of threads
 (``NUMBA_NUM_THREADS``). From packing ``COMPRESSION_MIN_PACKING`` (0.4 in 3D,
 0.6 in 2D) on, their growth of step 2 is one compression instead of steps and
-pushes (:mod:`._compression`): after the sweeps at reduced radii, all
-radii are set to full size at once and the overlaps are removed by the energy
-minimiser FIRE (Bitzek et al. 2006) on harmonic overlaps of contact distances
-swollen by ``SWELL`` (4 %; less where the swollen packing would exceed
-``SWELL_PACKING_MAX``, well below soft-sphere jamming), until no pair is closer
-than contact. All particles relax at once, so that the ~60 minimiser steps cost
-less than the pushes' dozens of passes over the last growth steps (where nearly
-every particle overlaps and each push opens one gap by closing another), and the
-swelling leaves gaps around the contacts: the contact value of g(r) after the
-final sweeps is closer to the equilibrium fluid's (N = 2e5 at packing 0.5: ~7.5
-with Carnahan-Starling 6.0, the growth steps ~10.9). The compression keeps more
-of the lattice's bond order than growth steps with sweeps in between, so that
-``COMPRESSION_MELT_SWEEPS`` (25) sweeps melt the lattice before it. Where the
-box is too small for the compression's scans, the growth steps with pushes
-serve; small systems use cell lists and the generator's random numbers
-throughout.
+pushes (:mod:`._compression`): all radii are set to full size at once and the
+overlaps are removed by the energy minimiser FIRE (Bitzek et al. 2006) on
+harmonic overlaps of contact distances swollen by ``SWELL`` (4 %; less where the
+swollen packing would exceed ``SWELL_PACKING_MAX``, well below soft-sphere
+jamming), until no pair is closer than contact. All particles relax at once, so
+that the ~60 minimiser steps cost less than the pushes' dozens of passes over the
+last growth steps (where nearly every particle overlaps and each push opens one
+gap by closing another), and the swelling leaves gaps around the contacts: the
+contact value of g(r) after the final sweeps is closer to the equilibrium
+fluid's (N = 2e5 at packing 0.5: ~7.5 with Carnahan-Starling 6.0, the growth
+steps ~10.9). Where the box is too small for the compression's scans, the growth
+steps with pushes serve; small systems use cell lists and the generator's random
+numbers throughout.
+
+Melting before the compression. Sweeps move each particle by a fraction of a
+diameter: the bond order falls to the fluid's, but the density stays modulated
+at the lattice's wavevectors G (N = 2e5 at packing 0.5: S(G) ~ 2000 at the
+nearest ones after 25 melting sweeps and the compression, ~4000 after 20 and the
+growth steps; N for a perfect lattice, ~2 in the fluid at the same |k|). In 3D
+the compression therefore starts from one random displacement of each particle,
+uniform over the FCC cell (sides a_i) centred on its site, and no sweeps: the
+expected density of such a particle is uniform, so that every Fourier
+component of the lattice averages out (the characteristic function of the
+displacement, the product over the axes of sin(G_i a_i / 2) / (G_i a_i / 2),
+vanishes at every G); at long wavelengths it changes S(k) by O((k a)^2) only.
+The compression then brings S(G) back to ~5-25 only: a displaced particle sees
+the hole its own site leaves in the others' expected density and is pulled back
+a little (displacements of less than half a cell let the compression rebuild
+the lattice). Disks (2D, packing >= 0.6, near the end of the hard-disk fluid at
+0.70; Bernard & Krauth 2011) are pulled back more (mean S(G) 14-26 at N = 5000
+and 0.7, against 1-4 after sweeps): 2D states keep ``COMPRESSION_MELT_SWEEPS`` (25) sweeps at packing
+0.25 before the compression.
 
 Long-wavelength density fluctuations. The sweeps move each particle by a
 fraction of a diameter: they relax the structure at short range, but a density
@@ -121,10 +137,9 @@ MELT_SWEEPS = 20
 #: 15.3 s, at 0.7 12.1 against 33.7 s)
 COMPRESSION_MIN_PACKING = {3: 0.4, 2: 0.6}
 
-#: melting sweeps of large systems grown by the compression: it keeps more of the
-#: lattice's bond order than growth steps with sweeps in between (N = 2e5 at packing
-#: 0.5, ~1400-particle subvolumes: Q6 0.029 after 20, 0.021 after 25, 0.019 after 30;
-#: growth steps after 20: 0.024)
+#: melting sweeps of large 2D systems grown by the compression (3D ones are melted by one
+#: displacement within a lattice cell instead; module docstring): it keeps more of the
+#: lattice's order than growth steps with sweeps in between
 COMPRESSION_MELT_SWEEPS = 25
 
 # final Monte Carlo sweeps of systems beyond 10^5 particles (default of random_positions)
@@ -167,6 +182,11 @@ FIRE_DT = 0.2
 FIRE_DT_MAX = 0.5
 FIRE_MAX_STEPS = 5000
 
+# FIRE moves each particle by at most this fraction of the largest diameter per step: the
+# first steps, from deep overlaps, would otherwise overshoot and need a new neighbour list
+# every step (N = 1e6 at packing 0.5: 70 steps and 22 lists uncapped, 58 and 10 capped)
+FIRE_MAX_MOVE = 0.025
+
 # particles per block of the compression's parallel moves
 FIRE_BLOCK = 4096
 
@@ -206,8 +226,9 @@ def _morton(cells):
 
 def _lattice(n, box):
     """Sites (M >= n, d) of an FCC (3D) / triangular (2D) lattice filling ``box``, the
-    nearest-neighbour distance, and the site indices in Z-order of their cells (runs
-    of consecutive entries are compact in space)."""
+    nearest-neighbour distance, the site indices in Z-order of their cells (runs
+    of consecutive entries are compact in space), and the sides (d,) of the cells
+    (cubic cells of 4 sites in 3D, rectangular ones of 2 in 2D)."""
     d = len(box)
     basis = (np.array([[0, 0, 0], [0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]]) if d == 3
              else np.array([[0, 0], [0.5, 0.5]]))
@@ -234,7 +255,7 @@ def _lattice(n, box):
     cells = np.stack([g.ravel() for g in grids], axis=1)
     sites = (cells[:, None, :] + basis[None, :, :]).reshape(-1, d) * a
     z_order = (np.argsort(_morton(cells))[:, None] * per_cell + np.arange(per_cell)).ravel()
-    return sites, best, z_order
+    return sites, best, z_order, a
 
 
 def _spread_out(m_keep, order, rng):
@@ -276,10 +297,11 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     sweeps : int, optional
         Monte Carlo sweeps of the melt (at packing <= 0.25) and of the final relaxation
         (default: :data:`MELT_SWEEPS` for the melt, :data:`COMPRESSION_MELT_SWEEPS`
-        before the compression of large systems; for the relaxation the same up to
-        10^5 particles, 6 beyond). Without growth (packing <= 0.25, lattice wide
-        enough) the final sweeps are the melt: the default is :data:`MELT_SWEEPS` for
-        every N.
+        before the compression of large 2D systems, none before that of large 3D
+        ones, whose melt is the displacement within a lattice cell; for the
+        relaxation the same up to 10^5 particles, 6 beyond). Without growth (packing
+        <= 0.25, lattice wide enough) the final sweeps are the melt: the default is
+        :data:`MELT_SWEEPS` for every N.
 
     Raises
     ------
@@ -293,7 +315,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     eta = float(np.sum(theory.particle_volume(2.0 * radii, d))) / float(np.prod(box))
     # M sites for N particles: S(k) = 1 - N/M = S0 at long wavelengths (docstring)
     m_sites = max(n, round(n / max(_MIN_OCCUPANCY, 1.0 - fluid_s0(eta, d))))
-    sites, dist, z_order = _lattice(m_sites, box)
+    sites, dist, z_order, cell = _lattice(m_sites, box)
     dmax = 2.0 * float(radii.max())
     # M sites kept, the extra ones dropped evenly in space; N of them at random,
     # in lattice (memory ~ space) order for fast sweeps; particle ids are
@@ -371,9 +393,14 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         sweeps = max(int(melt), int(sweeps))
     # large systems: growth by one compression (below) where the box holds its grid
     swell = min(SWELL, (SWELL_PACKING_MAX[d] / eta) ** (1.0 / d) - 1.0)
-    squeeze = (_sorted_grid(box, dmax * (1.0 + swell), FIRE_SKIN * dmax)
+    squeeze = (fire.compression_grid(box, dmax * (1.0 + swell + FIRE_SKIN))
                if large and lam < 1.0 and eta >= COMPRESSION_MIN_PACKING[d] else None)
-    if squeeze is not None and default_melt:
+    if squeeze is not None and d == 3:  # melt: each particle displaced uniformly over a lattice cell
+        r3[:, :d] += (rng.random((n, d)) - 0.5) * cell
+        state["stale"] = True
+        if default_melt:
+            melt = 0
+    elif squeeze is not None and default_melt:
         melt = COMPRESSION_MELT_SWEEPS
     if lam < 1.0:
         for _ in range(int(melt)):
@@ -452,15 +479,12 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
 
         def rebuild(pairs):  # sorted again (v with the particles), neighbour lists from the sort
             sort(grid)
-            dest = sorting["dest"]
-            f[dest] = v
-            v[:] = f
             start = sorting["start"]
+            # v and the last counts (room for as many pairs as the particle had neighbours,
+            # + NEIGHBOUR_SLACK) to the particles' new places
+            fire.follow_sort(sorting["dest"], v, counts, f, room)
             if len(pairs) == 0:
                 fire.neighbour_counts(r3, radii, box3, grid, start, swell, skin, counts)
-            else:  # room for as many pairs as the particle had neighbours, + NEIGHBOUR_SLACK
-                room[dest] = counts
-                counts[:] = room
             while True:
                 np.cumsum(counts + NEIGHBOUR_SLACK, out=offsets[1:])
                 if len(pairs) < offsets[-1]:
@@ -468,13 +492,20 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
                 if fire.neighbour_rows(r3, radii, box3, grid, start, swell, skin, offsets, pairs, counts) == 0:
                     break
             r0[:] = r3
+            slab_start[:] = start[np.arange(slabs + 1) * (int(np.prod(grid)) // slabs)]
             return pairs
 
         room = np.empty(n, dtype=np.int64)
+        slabs = int(grid[2] if d == 3 else grid[1])
+        slab_start = np.empty(slabs + 1, dtype=np.int64)
+        sums = np.empty((slabs, 6))
         pairs = rebuild(np.empty(0, dtype=np.int32))
         dt, alpha, downhill, separated = FIRE_DT, 0.1, 0, -5
         for it in range(FIRE_MAX_STEPS):
-            power, vv, ff, hard, _worst = fire.fire_forces(r3, radii, box3, offsets, counts, pairs, swell, v, f)
+            power, vv, ff, hard, _worst, stray = fire.fire_forces(r3, radii, box3, offsets, counts, pairs, swell,
+                                                                  v, f, slab_start, sums)
+            if stray:
+                raise RuntimeError(f"compression: {stray} listed pairs reach beyond the next slab")
             if hard == 0:  # no pair closer than contact
                 state["stale"] = True
                 return
@@ -493,7 +524,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
                 keep, mix = 1.0 - alpha, alpha * math.sqrt(vv / ff) if ff > 0.0 else 0.0
             else:
                 downhill, dt, alpha, keep, mix = 0, 0.5 * dt, 0.1, 0.0, 0.0
-            fire.fire_move(r3, v, f, r0, keep, mix, dt, FIRE_BLOCK, moved)
+            fire.fire_move(r3, v, f, r0, keep, mix, dt, FIRE_MAX_MOVE * dmax, FIRE_BLOCK, moved)
             state["stale"] = True
             far = np.sort(moved.ravel())[-2:]  # the two largest distances moved since the build
             if far[0] + far[1] > skin:
