@@ -16,14 +16,22 @@ is given and call other kernels or jit functions.
 :func:`inlined` is a kernel that every compiled caller inlines: it is compiled
 and optimised once, as a function of its own, and LLVM inlines the optimised
 code at each call site (the ``alwaysinline`` attribute: numba's
-``forceinline``). The event loop's hot kernels are of this kind. Numba's own
-``inline="always"`` inlines at the level of numba's IR instead: the callee's IR
-is rebuilt, deep-copied (once per block, with the whole variable scope) and
-typed again at every call site, and nested inlining repeats that at every
-level, so that a loop built of nested inline kernels compiles several seconds
-slower. An inlined kernel has no Python entry point (``python=True`` keeps one,
-for the few that tests call directly): calling one from Python crashes the
-interpreter.
+``forceinline``). The event loop's hot kernels are of this kind. An inlined
+kernel has no Python entry point (``python=True`` keeps one, for the few that
+tests call directly): calling one from Python crashes the interpreter.
+
+:func:`inlined_ir` is a kernel that numba inlines at the level of its own IR
+(``inline="always"``): the callee's IR is rebuilt, deep-copied and typed again
+at every call site, as part of the caller, and the callee is never compiled on
+its own. Numba compiles every jit function a compiled function calls as a
+library of its own -- typed, lowered, optimised by LLVM with the code of all
+its callees, and turned into machine code -- and then links that code into the
+caller and optimises it again there; for a function with a single call site,
+whose code only its caller needs, that is work done twice, and IR inlining
+does it once. At several call sites (or nested several levels deep) the copies
+and the typing repeat at each and cost more than the library saves: the loop's
+per-event steps (one call site in each build of the loop) are of this kind,
+the shared helpers are :func:`inlined` or plain kernels.
 
 Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function
@@ -145,3 +153,11 @@ def inlined(*args, python=False, **kwargs):
     """
     kwargs["forceinline"] = True
     return kernel(*args, python=python, **kwargs)
+
+
+def inlined_ir(*args, **kwargs):
+    """:func:`kernel` that numba inlines at the level of its IR into every caller
+    (``inline="always"``; module docstring): never compiled on its own, so that
+    it has no Python entry point. For a function with one call site in compiled code."""
+    kwargs["inline"] = "always"
+    return kernel(*args, python=False, **kwargs)

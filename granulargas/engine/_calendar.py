@@ -74,7 +74,7 @@ import math
 
 import numpy as np
 
-from granulargas._numba import inlined, jit, kernel
+from granulargas._numba import inlined, inlined_ir, jit, kernel
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._state import CALENDAR_STATE, Calendar
 
@@ -356,7 +356,7 @@ def _ring_append(i, t, cal, cs):
     return True
 
 
-@inlined
+@inlined_ir
 def cal_update_root(i, t, cal):
     """:func:`cal_update` of the particle whose event is the earliest (the root of the small
     heap), small enough for the loop to inline: the common case (:func:`_ring_append`,
@@ -377,7 +377,7 @@ def cal_update_root(i, t, cal):
     return cal_update(i, t, cal)
 
 
-@inlined
+@inlined_ir
 def cal_update_ring(i, t, cal):
     """:func:`cal_update` small enough for the loop to inline, for a particle whose event
     is in the ring (the partner of a collision, mostly): the common case
@@ -419,7 +419,7 @@ def _redistribute_overflow(cal):
     return _OK
 
 
-@inlined
+@inlined_ir
 def _open_bucket(slot, cal, cs):
     """Move the live events of ring bucket ``slot`` into the small heap; False if it fills."""
     chunks = cal.chunks
@@ -450,7 +450,7 @@ def _open_bucket(slot, cal, cs):
     return True
 
 
-@inlined
+@inlined_ir
 def cal_look_ahead(cal):
     """Prefetch hints for one chunk of the next bucket (no effect on results).
 
@@ -475,7 +475,7 @@ def cal_look_ahead(cal):
         cs.look = nx
 
 
-@inlined
+@inlined_ir
 def cal_after_next(cal, skip):
     """Best guess of the particle whose event follows the earliest one, or -1.
 

@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from granulargas._numba import inlined, kernel
+from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._geometry import min_image
 from granulargas.engine._prefetch import prefetch
 
@@ -208,7 +208,7 @@ def _reach(x, y, z, cut, space, stencil):
     return ns
 
 
-@inlined
+@inlined_ir
 def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     """Particles j != i with |c_j - (x,y,z)| < R_i + R_j + shell, into scratch.
 

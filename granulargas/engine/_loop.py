@@ -82,7 +82,7 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
-from granulargas._numba import inlined, kernel
+from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._calendar import (
     cal_after_next,
     cal_build,
@@ -370,7 +370,7 @@ def predict_listed(i, t, rec, count, events, lists, space, half_shell, contacts)
     return settle_event(i, t, best, p, tag, rec, events, space)
 
 
-@inlined
+@inlined_ir
 def predict_cells(i, t, rec, count, events, grid, space):
     """:func:`predict` in the cell-crossing mode (no contacts there), for the loop to inline
     at the event's own particle: the crossing, the best pair (the stored one right after a
@@ -404,7 +404,7 @@ def _collapse_watch(i, te, p, prm):
     p.lastcoll[i] = te
 
 
-@inlined
+@inlined_ir
 def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
@@ -481,7 +481,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     return DONE
 
 
-@inlined
+@inlined_ir
 def execute_expiry(i, te, p, lists, cells, c, prm):
     """List expiry of i at te: a new list centre and neighbour list (OVERFLOW/CELL_OVERFLOW
     if a list or a cell is full: nothing changed, the driver enlarges and calls again)."""
@@ -495,7 +495,7 @@ def execute_expiry(i, te, p, lists, cells, c, prm):
     return DONE
 
 
-@inlined
+@inlined_ir
 def execute_crossing(i, face, te, p, grid, c, prm):
     """Cell crossing of i at te through face ``face`` (2 a + side): into the next cell
     (:func:`granulargas.engine._crossing.cross`) and its best pair updated with the
@@ -583,7 +583,7 @@ def _prefetch_particle(i, p, ev, lists, cal):
     prefetch(cal.where, i)
 
 
-@inlined
+@inlined_ir
 def prefetch_next_cells(i1, p, ev, grid, cal, prm):
     """Prefetch hints for the next event of the cell-crossing mode: the rows of particle
     i1 and its partner, the cell heads around i1, and the rows of the likely event after
