@@ -110,7 +110,7 @@ def main(argv=None):
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--c-cell", help="binary of the C code's Cell variant")
     p.add_argument("--c-single", help="binary of the C code's Single variant")
-    p.add_argument("--c-collisions", type=float, default=5e5)
+    p.add_argument("--c-collisions", type=float, default=2e6)
     p.add_argument("--core", type=int, default=1)
     p.add_argument("--plot", help="PNG file: rate against events per collision")
     args = p.parse_args(argv)
