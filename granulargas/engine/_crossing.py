@@ -138,6 +138,25 @@ def _neighbour(c, o, n, period):
     return k
 
 
+@inlined
+def _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period):
+    """Second pass of the cell scans: the earliest collision, before ``before``, of the
+    particle at (xi, yi, zi) moving with (vx, vy, vz), radius ri, at time t, with the
+    particles of the cells whose first particles are ``first[1:k]`` (each cell's chain
+    followed through its ``NEXT`` links): (time, partner slot) or (``before``, -1)."""
+    best = before
+    p = -1
+    for q in range(1, k):
+        j = first[q]
+        while j >= 0:
+            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
+            better = tc < best
+            best = tc if better else best
+            p = j if better else p
+            j = row_of[j, NEXT]
+    return best, p
+
+
 @kernel(python=False)
 def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     """Earliest collision of particle i (streamed to t) with the particles of the cells at
@@ -187,17 +206,7 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
                 j = head[kx + row]
                 first[k] = j
                 k += 1 if j >= 0 else 0
-    best = before
-    p = -1
-    for q in range(1, k):
-        j = first[q]
-        while j >= 0:
-            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
-            better = tc < best
-            best = tc if better else best
-            p = j if better else p
-            j = row_of[j, NEXT]
-    return best, p
+    return _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period)
 
 
 @inlined
@@ -235,17 +244,7 @@ def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
                 j = head[b + v]
                 first[k] = j
                 k += 1 if j >= 0 else 0
-    best = before
-    p = -1
-    for q in range(1, k):
-        j = first[q]
-        while j >= 0:
-            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
-            better = tc < best
-            best = tc if better else best
-            p = j if better else p
-            j = row_of[j, NEXT]
-    return best, p
+    return _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period)
 
 
 @inlined
