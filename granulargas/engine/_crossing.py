@@ -90,16 +90,22 @@ def face_gap(x, v, c, width, n, period):
     moving at v, to the face it moves to, and that face's side (0 lower, 1 upper).
 
     Returns (gap >= 0, |v|, side); |v| = 0 on a wall axis at the face that is a
-    wall (never crossed) and for v = 0.
+    wall (never crossed) and for v = 0 (of either sign).
+
+    The direction of motion is a coin toss for the branch predictor, and LLVM turns a
+    select of floats into a branch: the choice is made by weights s, 1 - s in {0, 1}
+    instead (a * 1 + b * 0 = a exactly for finite a, b, up to the sign of a zero).
     """
     rel = min_image(x - c * width, period)  # position from the lower face, [-round-off, width + ...]
-    if v > 0.0:
-        gap = width - rel
-        speed = 0.0 if c == n - 1 and period == math.inf else v
-        return (gap if gap > 0.0 else 0.0), speed, 1
-    gap = rel
-    speed = 0.0 if c == 0 and period == math.inf else -v
-    return (gap if gap > 0.0 else 0.0), speed, 0
+    up = v > 0.0
+    s = 1.0 if up else 0.0
+    r = 1.0 - s
+    gap = (width - rel) * s + rel * r
+    speed = v * s - v * r
+    if period == math.inf:
+        if (c == n - 1) if up else (c == 0):
+            speed = 0.0
+    return (gap if gap > 0.0 else 0.0), speed, np.int64(up)
 
 
 @inlined
@@ -108,7 +114,8 @@ def predict_crossing(i, t, rec, grid, space):
 
     The axis whose face comes first has the least gap / speed; the times are
     compared as gap_a |v_b| < gap_b |v_a| and one division gives the delay
-    (inf if the particle crosses no face).
+    (inf if the particle crosses no face). The axis is chosen without a branch
+    (weights, as in :func:`face_gap`).
     """
     cell = grid.cell
     gap, speed, side = face_gap(rec[i, 0], rec[i, 3], cell[i, 0], grid.width[0], space.ncell[0],
@@ -117,11 +124,12 @@ def predict_crossing(i, t, rec, grid, space):
     for a in range(1, space.dims):
         g, v, sd = face_gap(rec[i, a], rec[i, 3 + a], cell[i, a], grid.width[a], space.ncell[a],
                             space.period[a])
-        if g * speed < gap * v or speed == 0.0:
-            if v > 0.0:
-                gap = g
-                speed = v
-                face = 2 * a + sd
+        take = ((g * speed < gap * v) | (speed == 0.0)) & (v > 0.0)
+        s = np.float64(take)
+        r = 1.0 - s
+        gap = g * s + gap * r
+        speed = v * s + speed * r
+        face = 2 * a + sd if take else face
     if speed == 0.0:
         return math.inf, face
     return t + gap / speed, face
