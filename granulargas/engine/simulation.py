@@ -54,6 +54,14 @@ CELLS_PER_PARTICLE = 8
 #: shell of at least 0.05 diameters: 3 x 1.05.
 MIN_BOX_DIAMETERS = 3.15
 
+#: Neighbour-list table ``nbl`` (N, width): a build cuts the width to the fullest list
+#: plus ``LIST_SLACK``; a list that outgrows it widens the table by ``max(LIST_SLACK,
+#: width // LIST_GROWTH)`` columns. The width is the table's row stride only: the lists
+#: and their order do not depend on it. The table's memory follows the longest list, a
+#: Poisson-like tail far above the mean in dilute gases, so the steps stay small.
+LIST_SLACK = 2
+LIST_GROWTH = 16
+
 
 def default_shell(packing: float, dimension: int = 3) -> float:
     """Neighbour-list shell width in units of the largest diameter.
@@ -430,7 +438,7 @@ class Simulation:
             else:
                 break
         # compact the lists to what this state needs (+ a margin; they grow on demand)
-        width = min(n - 1, int(lists.nbn.max()) + 6)
+        width = min(n - 1, int(lists.nbn.max()) + LIST_SLACK)
         nbl = lists.nbl
         if width < self._nb_width:
             nbl = np.ascontiguousarray(nbl[:, :width])
@@ -502,7 +510,7 @@ class Simulation:
     def _grow_lists(self):
         e = self._engine
         n = self.n
-        new = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.2)))
+        new = min(n - 1, self._nb_width + max(LIST_SLACK, self._nb_width // LIST_GROWTH))
         if new <= self._nb_width:
             raise SimulationError("neighbour list cannot grow further (internal error)")
         nbl = np.empty((n, new), dtype=np.int32)
