@@ -61,6 +61,8 @@ MIN_BOX_DIAMETERS = 3.15
 #: Poisson-like tail far above the mean in dilute gases, so the steps stay small.
 LIST_SLACK = 2
 LIST_GROWTH = 16
+#: The same for the cells' table ``cells.ids`` (C, K) of the list centres.
+CELL_SLACK = 2
 
 
 def default_shell(packing: float, dimension: int = 3) -> float:
@@ -443,6 +445,13 @@ class Simulation:
         if width < self._nb_width:
             nbl = np.ascontiguousarray(nbl[:, :width])
             self._nb_width = width
+        # and the cells' rows to the fullest cell (+ a margin)
+        slots = int(cells.n.max()) + CELL_SLACK
+        if slots < self._cell_width:
+            ids = _aligned_int_rows(ncells, slots)
+            ids[:] = cells.ids[:, :slots]
+            cells = cells._replace(ids=ids)
+            self._cell_width = slots
         lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
         self._finish_build(particles, events, lists, cells, order)
 
@@ -501,7 +510,7 @@ class Simulation:
     def _grow_cells(self):
         e = self._engine
         old = e.cells.ids
-        self._cell_width += 16
+        self._cell_width += max(CELL_SLACK, self._cell_width // LIST_GROWTH)
         new = _aligned_int_rows(old.shape[0], self._cell_width)
         new[:, : old.shape[1]] = old
         self._engine = e._replace(cells=e.cells._replace(ids=new),
