@@ -56,12 +56,15 @@ MIN_BOX_DIAMETERS = 3.15
 
 #: Neighbour-list table ``nbl`` (N, width): a build cuts the width to the fullest list
 #: plus ``LIST_SLACK``; a list that outgrows it widens the table by ``max(LIST_SLACK,
-#: width // LIST_GROWTH)`` columns. The width is the table's row stride only: the lists
-#: and their order do not depend on it. The table's memory follows the longest list, a
-#: Poisson-like tail far above the mean in dilute gases, so the steps stay small.
+#: width // LIST_GROWTH)`` columns (a few reallocations per run: the fullest list drifts
+#: up slowly as the run samples the tail of the list-length distribution). The table's
+#: memory follows the longest list, which in a dilute gas is some 2-2.5 times the mean
+#: (about 12, :func:`default_shell`), hence the small margin and steps. The width is
+#: the row stride only: the lists and their order do not depend on it.
 LIST_SLACK = 2
 LIST_GROWTH = 16
-#: The same for the cells' table ``cells.ids`` (C, K) of the list centres.
+#: The same rule for the cell table ``cells.ids`` (C, K) of the list centres: a build
+#: cuts K to the fullest cell plus ``CELL_SLACK``, growth by ``max(CELL_SLACK, K // LIST_GROWTH)``.
 CELL_SLACK = 2
 
 
@@ -430,8 +433,7 @@ class Simulation:
                                  nbn=np.zeros(n, dtype=np.int32), scratch=np.empty(1, np.int32),
                                  stencil=stencil, mark=np.zeros(n, dtype=np.uint8))
             cells = _state.Cells(ids=_aligned_int_rows(ncells, self._cell_width),
-                                 n=np.zeros(ncells, dtype=np.int32),
-                                 of=np.empty(n, dtype=np.int32))
+                                 n=np.zeros(ncells, dtype=np.int32))
             st = build_all_lists(pos, rec, lists, cells, spc, self.shell)
             if st == OVERFLOW:
                 self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
