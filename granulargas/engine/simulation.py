@@ -55,16 +55,16 @@ CELLS_PER_PARTICLE = 8
 MIN_BOX_DIAMETERS = 3.15
 
 #: Neighbour-list table ``nbl`` (N, width): a build cuts the width to the fullest list
-#: plus ``LIST_SLACK``; a list that outgrows it widens the table by ``max(LIST_SLACK,
-#: width // LIST_GROWTH)`` columns (a few reallocations per run: the fullest list drifts
-#: up slowly as the run samples the tail of the list-length distribution). The table's
-#: memory follows the longest list, which in a dilute gas is some 2-2.5 times the mean
-#: (about 12, :func:`default_shell`), hence the small margin and steps. The width is
-#: the row stride only: the lists and their order do not depend on it.
+#: plus ``LIST_SLACK``; a list that outgrows it widens the table by ``max(1, width //
+#: LIST_GROWTH)`` columns (a few reallocations per run: the fullest list drifts up slowly
+#: as the run samples the tail of the list-length distribution). The table's memory
+#: follows the longest list, which in a dilute gas is some 2-2.5 times the mean (about
+#: 12, :func:`default_shell`), hence the small margin and steps. The width is the row
+#: stride only: the lists and their order do not depend on it.
 LIST_SLACK = 2
 LIST_GROWTH = 16
 #: The same rule for the cell table ``cells.ids`` (C, K) of the list centres: a build
-#: cuts K to the fullest cell plus ``CELL_SLACK``, growth by ``max(CELL_SLACK, K // LIST_GROWTH)``.
+#: cuts K to the fullest cell plus ``CELL_SLACK``, growth by ``max(1, K // LIST_GROWTH)``.
 CELL_SLACK = 2
 
 
@@ -512,7 +512,7 @@ class Simulation:
     def _grow_cells(self):
         e = self._engine
         old = e.cells.ids
-        self._cell_width += max(CELL_SLACK, self._cell_width // LIST_GROWTH)
+        self._cell_width += max(1, self._cell_width // LIST_GROWTH)
         new = _aligned_int_rows(old.shape[0], self._cell_width)
         new[:, : old.shape[1]] = old
         self._engine = e._replace(cells=e.cells._replace(ids=new),
@@ -521,7 +521,7 @@ class Simulation:
     def _grow_lists(self):
         e = self._engine
         n = self.n
-        new = min(n - 1, self._nb_width + max(LIST_SLACK, self._nb_width // LIST_GROWTH))
+        new = min(n - 1, self._nb_width + max(1, self._nb_width // LIST_GROWTH))
         if new <= self._nb_width:
             raise SimulationError("neighbour list cannot grow further (internal error)")
         nbl = np.empty((n, new), dtype=np.int32)
