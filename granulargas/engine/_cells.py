@@ -102,23 +102,21 @@ def cell_remove(i, cell_head, cell_next, cell_prev, cell_of):
 
 
 @inlined
-def slot_insert(i, c, cell_ids, cell_n, cell_of):
+def slot_insert(i, c, cell_ids, cell_n):
     """Append particle i to cell c (the caller has checked the capacity)."""
     q = cell_n[c]
     cell_ids[c, q] = i
     cell_n[c] = q + 1
-    cell_of[i] = c
 
 
 @inlined
-def slot_remove(i, cell_ids, cell_n, cell_of):
-    """Remove particle i from its cell (the cell's last entry takes its slot).
+def slot_remove(i, c, cell_ids, cell_n):
+    """Remove particle i from its cell c (the cell's last entry takes its slot).
 
     A scan of the row (one or two cache lines, just read by the rebuild) rather
     than a stored slot index: that saves 4 bytes per particle and a store into
     the moved particle's row.
     """
-    c = cell_of[i]
     last = cell_n[c] - 1
     for q in range(last + 1):
         if cell_ids[c, q] == i:
@@ -332,13 +330,15 @@ def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     mark = lists.mark
     cell_ids = cells.ids
     cell_n = cells.n
-    cell_of = cells.of
+    # the cell of the old centre (a function of the stored centre, so not stored itself)
+    was = cell_index(np.float64(centre[i, 0]), np.float64(centre[i, 1]), np.float64(centre[i, 2]),
+                     space.box, space.ncell)
     # the new centre, rounded as stored: the cell, the candidates and the expiry all use it
     x = np.float64(np.float32(rec[i, 0]))
     y = np.float64(np.float32(rec[i, 1]))
     z = np.float64(np.float32(rec[i, 2]))
     c = cell_index(x, y, z, space.box, space.ncell)
-    if c != cell_of[i] and cell_n[c] >= cell_ids.shape[1]:
+    if c != was and cell_n[c] >= cell_ids.shape[1]:
         return CELL_OVERFLOW
     m = nbl.shape[1]
     count = _collect(i, x, y, z, rec[i, 7], rmax, m, shell, rec, lists, cells, space)
@@ -386,9 +386,9 @@ def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     for k in range(count):
         nbl[i, k] = scratch[k]
     nbn[i] = count
-    if c != cell_of[i]:
-        slot_remove(i, cell_ids, cell_n, cell_of)
-        slot_insert(i, c, cell_ids, cell_n, cell_of)
+    if c != was:
+        slot_remove(i, was, cell_ids, cell_n)
+        slot_insert(i, c, cell_ids, cell_n)
     centre[i, 0] = x
     centre[i, 1] = y
     centre[i, 2] = z
@@ -407,7 +407,6 @@ def build_all_lists(r, rec, lists, cells, space, shell):
     nbn = lists.nbn
     cell_ids = cells.ids
     cell_n = cells.n
-    cell_of = cells.of
     box = space.box
     ncell = space.ncell
     period = space.period
@@ -423,7 +422,7 @@ def build_all_lists(r, rec, lists, cells, space, shell):
                        np.float64(centre[i, 2]), box, ncell)
         if cell_n[c] >= cell_ids.shape[1]:
             return CELL_OVERFLOW
-        slot_insert(i, c, cell_ids, cell_n, cell_of)
+        slot_insert(i, c, cell_ids, cell_n)
     nbn[:] = 0
     for i in range(n):
         # every test uses the stored (float32) centres, as every later rebuild does

@@ -640,7 +640,7 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
         for k in range(nbn[i1]):
             prefetch(nbl, nbl[i1, k])
             prefetch(nbn, nbl[i1, k])
-        prefetch(cells.of, i1)
+        prefetch(lists.centre, i1)  # the rebuild finds its old cell from it
     for k in range(nbn[i1]):
         prefetch(rec, nbl[i1, k])
     prefetch(cal.where, i1)

@@ -32,8 +32,8 @@ Record layout
 * ``lists`` :class:`Lists` -- ``centre`` (N, 3) f4 list centres, ``nbl`` (N, M) i4
   neighbour lists, ``nbn`` i4 lengths; work space ``scratch`` i4, ``stencil`` i8 and
   ``mark`` (N,) u1 (all zero between list rebuilds).
-* ``cells`` :class:`Cells` -- ``ids`` (C, K) i4 slots of each cell, ``n`` i4 fill,
-  ``of`` (N,) i4 cell of each list centre.
+* ``cells`` :class:`Cells` -- ``ids`` (C, K) i4 slots of each cell, ``n`` i4 fill
+  (a particle's cell is that of its stored list centre, computed when needed).
 * In the cell-crossing mode (:mod:`granulargas.engine._crossing`) ``lists`` is a
   :class:`Grid` instead and ``cells`` is None: ``head`` (C,) i4 the first
   particle of each cell (-1: empty); ``cell`` (N, 8) i4 one int32 row per
@@ -72,7 +72,7 @@ import numpy as np
 Particles = namedtuple("Particles", ["rec", "img", "mass", "count", "lastcoll", "rapid", "ident"])
 Events = namedtuple("Events", ["partner", "tag"])
 Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil", "mark"])
-Cells = namedtuple("Cells", ["ids", "n", "of"])
+Cells = namedtuple("Cells", ["ids", "n"])
 Grid = namedtuple("Grid", ["head", "cell", "width", "pair_t", "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])

@@ -54,6 +54,19 @@ CELLS_PER_PARTICLE = 8
 #: shell of at least 0.05 diameters: 3 x 1.05.
 MIN_BOX_DIAMETERS = 3.15
 
+#: Neighbour-list table ``nbl`` (N, width): a build cuts the width to the fullest list
+#: plus ``LIST_SLACK``; a list that outgrows it widens the table by ``max(1, width //
+#: LIST_GROWTH)`` columns (a few reallocations per run: the fullest list drifts up slowly
+#: as the run samples the tail of the list-length distribution). The table's memory
+#: follows the longest list, which in a dilute gas is some 2-2.5 times the mean (about
+#: 12, :func:`default_shell`), hence the small margin and steps. The width is the row
+#: stride only: the lists and their order do not depend on it.
+LIST_SLACK = 2
+LIST_GROWTH = 16
+#: The same rule for the cell table ``cells.ids`` (C, K) of the list centres: a build
+#: cuts K to the fullest cell plus ``CELL_SLACK``, growth by ``max(1, K // LIST_GROWTH)``.
+CELL_SLACK = 2
+
 
 def default_shell(packing: float, dimension: int = 3) -> float:
     """Neighbour-list shell width in units of the largest diameter.
@@ -420,8 +433,7 @@ class Simulation:
                                  nbn=np.zeros(n, dtype=np.int32), scratch=np.empty(1, np.int32),
                                  stencil=stencil, mark=np.zeros(n, dtype=np.uint8))
             cells = _state.Cells(ids=_aligned_int_rows(ncells, self._cell_width),
-                                 n=np.zeros(ncells, dtype=np.int32),
-                                 of=np.empty(n, dtype=np.int32))
+                                 n=np.zeros(ncells, dtype=np.int32))
             st = build_all_lists(pos, rec, lists, cells, spc, self.shell)
             if st == OVERFLOW:
                 self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
@@ -430,11 +442,18 @@ class Simulation:
             else:
                 break
         # compact the lists to what this state needs (+ a margin; they grow on demand)
-        width = min(n - 1, int(lists.nbn.max()) + 6)
+        width = min(n - 1, int(lists.nbn.max()) + LIST_SLACK)
         nbl = lists.nbl
         if width < self._nb_width:
             nbl = np.ascontiguousarray(nbl[:, :width])
             self._nb_width = width
+        # and the cells' rows to the fullest cell (+ a margin)
+        slots = int(cells.n.max()) + CELL_SLACK
+        if slots < self._cell_width:
+            ids = _aligned_int_rows(ncells, slots)
+            ids[:] = cells.ids[:, :slots]
+            cells = cells._replace(ids=ids)
+            self._cell_width = slots
         lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
         self._finish_build(particles, events, lists, cells, order)
 
@@ -493,7 +512,7 @@ class Simulation:
     def _grow_cells(self):
         e = self._engine
         old = e.cells.ids
-        self._cell_width += 16
+        self._cell_width += max(1, self._cell_width // LIST_GROWTH)
         new = _aligned_int_rows(old.shape[0], self._cell_width)
         new[:, : old.shape[1]] = old
         self._engine = e._replace(cells=e.cells._replace(ids=new),
@@ -502,7 +521,7 @@ class Simulation:
     def _grow_lists(self):
         e = self._engine
         n = self.n
-        new = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.2)))
+        new = min(n - 1, self._nb_width + max(1, self._nb_width // LIST_GROWTH))
         if new <= self._nb_width:
             raise SimulationError("neighbour list cannot grow further (internal error)")
         nbl = np.empty((n, new), dtype=np.int32)

@@ -94,6 +94,26 @@ def test_invariants_hold_during_dense_runs():
             assert check(sim) == [], (d, eta, t)
 
 
+#: the engine state's memory budget per particle (all arrays of ``Simulation._engine``)
+STATE_BYTES_PER_PARTICLE = 300
+
+
+@pytest.mark.parametrize("d, packing", [(2, 0.05), (2, 0.3), (3, 0.05), (3, 0.3)])
+def test_state_bytes_per_particle(d, packing):
+    """The neighbour-list mode's state stays within the budget per particle, also dilute,
+    where the longest list (the table's width) is a Poisson tail far above the mean."""
+    from granulargas.engine._state import nbytes
+
+    n = 20000
+    sim = make_sim(n=n, packing=packing, dimension=d, seed=1)
+    assert sim.neighbours == "lists"
+    sim.run(np.inf, max_collisions=10 * n)  # 20 collisions per particle: lists outgrow the build
+    lists = sim._engine.lists
+    assert lists.nbl.shape[1] >= lists.nbn.max()
+    assert nbytes(sim._engine) / n <= STATE_BYTES_PER_PARTICLE, (
+        nbytes(sim._engine) / n, lists.nbl.shape)
+
+
 def test_neighbour_lists_grow_when_full():
     """Lists cut to their current fullest length overflow during the run, grow, and
     the trajectory is bit-identical to an undisturbed run."""
