@@ -90,16 +90,22 @@ def face_gap(x, v, c, width, n, period):
     moving at v, to the face it moves to, and that face's side (0 lower, 1 upper).
 
     Returns (gap >= 0, |v|, side); |v| = 0 on a wall axis at the face that is a
-    wall (never crossed) and for v = 0.
+    wall (never crossed) and for v = 0 (of either sign).
+
+    The direction of motion is a coin toss for the branch predictor, and LLVM turns a
+    select of floats into a branch: the choice is made by weights s, 1 - s in {0, 1}
+    instead (a * 1 + b * 0 = a exactly for finite a, b, up to the sign of a zero).
     """
     rel = min_image(x - c * width, period)  # position from the lower face, [-round-off, width + ...]
-    if v > 0.0:
-        gap = width - rel
-        speed = 0.0 if c == n - 1 and period == math.inf else v
-        return (gap if gap > 0.0 else 0.0), speed, 1
-    gap = rel
-    speed = 0.0 if c == 0 and period == math.inf else -v
-    return (gap if gap > 0.0 else 0.0), speed, 0
+    up = v > 0.0
+    s = 1.0 if up else 0.0
+    r = 1.0 - s
+    gap = (width - rel) * s + rel * r
+    speed = v * s - v * r
+    if period == math.inf:
+        if (c == n - 1) if up else (c == 0):
+            speed = 0.0
+    return (gap if gap > 0.0 else 0.0), speed, np.int64(up)
 
 
 @inlined
@@ -108,7 +114,8 @@ def predict_crossing(i, t, rec, grid, space):
 
     The axis whose face comes first has the least gap / speed; the times are
     compared as gap_a |v_b| < gap_b |v_a| and one division gives the delay
-    (inf if the particle crosses no face).
+    (inf if the particle crosses no face). The axis is chosen without a branch
+    (weights, as in :func:`face_gap`).
     """
     cell = grid.cell
     gap, speed, side = face_gap(rec[i, 0], rec[i, 3], cell[i, 0], grid.width[0], space.ncell[0],
@@ -117,11 +124,12 @@ def predict_crossing(i, t, rec, grid, space):
     for a in range(1, space.dims):
         g, v, sd = face_gap(rec[i, a], rec[i, 3 + a], cell[i, a], grid.width[a], space.ncell[a],
                             space.period[a])
-        if g * speed < gap * v or speed == 0.0:
-            if v > 0.0:
-                gap = g
-                speed = v
-                face = 2 * a + sd
+        take = ((g * speed < gap * v) | (speed == 0.0)) & (v > 0.0)
+        s = np.float64(take)
+        r = 1.0 - s
+        gap = g * s + gap * r
+        speed = v * s + speed * r
+        face = 2 * a + sd if take else face
     if speed == 0.0:
         return math.inf, face
     return t + gap / speed, face
@@ -158,10 +166,13 @@ def _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, p
 
 
 @kernel(python=False)
-def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
+def scan_cells(i, t, before, rec, head, row_of, first, ncell, period, x0, x1, y0, y1, z0, z1):
     """Earliest collision of particle i (streamed to t) with the particles of the cells at
     offsets [x0, x1] x [y0, y1] x [z0, z1] from its cell, before ``before``: (time,
-    partner slot) or (``before``, -1).
+    partner slot) or (``before``, -1). It takes ``head``, ``row_of`` (= ``cell``) and
+    ``first`` (= ``fresh``) of the :class:`~granulargas.engine._state.Grid` and ``ncell``,
+    ``period`` of the ``Space``, not the whole records: a call passes each array as
+    several words on the stack.
 
     i itself may be among the candidates and gives inf (no relative motion). The
     cells beyond a wall do not exist; with 3 cells on a periodic axis a cell may
@@ -169,18 +180,14 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     cells inside the grid (:func:`scan_block`), the common case.
 
     Two passes: the first particles of the non-empty cells are listed in
-    ``grid.fresh[1:]`` (one store per cell, no branch on whether it is empty), then
+    ``first[1:]`` (one store per cell, no branch on whether it is empty), then
     the listed cells' particles are scanned in the same order. Most cells of a
     dilute gas are empty, and a loop that branched on each cell's occupancy would
     mispredict at every occupied one.
     """
-    head = grid.head
-    row_of = grid.cell
-    ncell = space.ncell
-    period = space.period
-    cx = grid.cell[i, 0]
-    cy = grid.cell[i, 1]
-    cz = grid.cell[i, 2]
+    cx = row_of[i, 0]
+    cy = row_of[i, 1]
+    cz = row_of[i, 2]
     xi = rec[i, 0]
     yi = rec[i, 1]
     zi = rec[i, 2]
@@ -188,7 +195,6 @@ def scan_cells(i, t, before, rec, grid, space, x0, x1, y0, y1, z0, z1):
     vy = rec[i, 4]
     vz = rec[i, 5]
     ri = rec[i, 7]
-    first = grid.fresh
     k = 1
     for oz in range(z0, z1 + 1):
         kz = _neighbour(cz, oz, ncell[2], period[2])
@@ -267,7 +273,8 @@ def predict_pair_cells(i, t, before, rec, count, grid, space):
             pt, pj = scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz, 3)
         else:
             zr = 1 if space.ncell[2] >= 3 else 0
-            pt, pj = scan_cells(i, t, math.inf, rec, grid, space, -1, 1, -1, 1, -zr, zr)
+            pt, pj = scan_cells(i, t, math.inf, rec, grid.head, grid.cell, grid.fresh, space.ncell, space.period,
+                                -1, 1, -1, 1, -zr, zr)
         grid.pair_t[i] = pt
         grid.cell[i, PAIR_J] = pj
         grid.cell[i, PAIR_TAG] = count[pj] if pj >= 0 else 0
@@ -304,7 +311,8 @@ def scan_new_layer(i, t, face, rec, count, grid, space):
         y1 = o if a == 1 else 1
         z0 = o if a == 2 else -zr
         z1 = o if a == 2 else zr
-        pt, pn = scan_cells(i, t, grid.pair_t[i], rec, grid, space, x0, x1, y0, y1, z0, z1)
+        pt, pn = scan_cells(i, t, grid.pair_t[i], rec, grid.head, grid.cell, grid.fresh, space.ncell, space.period,
+                            x0, x1, y0, y1, z0, z1)
     if pn >= 0:
         grid.pair_t[i] = pt
         grid.cell[i, PAIR_J] = pn
