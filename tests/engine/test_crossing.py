@@ -159,14 +159,27 @@ def test_invariants_momentum_energy_no_overlap(d, rule):
 
 @pytest.mark.parametrize("d", [2, 3])
 def test_collision_frequency_and_pressure_vs_enskog_at_packing_005(d):
-    """omega against Enskog and Z against Carnahan-Starling / Henderson at packing 0.05 (2 %)."""
+    """omega against Enskog and Z against Carnahan-Starling / Henderson at packing 0.05 (2 %);
+    cell crossings per collision against free streaming between Enskog collisions (3 %).
+
+    A particle crosses the faces normal to axis a at the rate <|v_a|>/w_a, with
+    <|v_a|> = sqrt(2T/(pi m)) for a Maxwell distribution; N omega / 2 collisions happen in
+    the same time, so a collision costs 2 sum_a <|v_a|>/w_a / omega crossings (in 3D at
+    equal widths 3 lambda / w, lambda the Enskog mean free path)."""
     sim = cells(n=1000, packing=0.05, dimension=d, seed=21)
     sim.run(5.0)
     sim.pressure_window()
+    c0 = sim._engine.counters[0].copy()
     sim.run(60.0)
+    c1 = sim._engine.counters[0]
     z = sim.pressure_window() * np.prod(sim.box) / (sim.n * sim.temperature)
     assert z == pytest.approx(z_theory(0.05, d), rel=0.02)
-    assert sim.collision_rate == pytest.approx(enskog_frequency(0.05, d, sim.temperature), rel=0.02)
+    omega = enskog_frequency(0.05, d, sim.temperature)
+    assert sim.collision_rate == pytest.approx(omega, rel=0.02)
+    widths = np.asarray(sim.box, dtype=float) / np.asarray(sim._space.ncell[:d], dtype=float)
+    mean_abs = math.sqrt(2.0 * sim.temperature / math.pi)
+    per_collision = (c1["crossings"] - c0["crossings"]) / float(c1["collisions"] - c0["collisions"])
+    assert per_collision == pytest.approx(2.0 * np.sum(mean_abs / widths) / omega, rel=0.03)
 
 
 def test_the_modes_agree_until_round_off_separates_them():
