@@ -40,11 +40,14 @@ def min_image(dx, length):
 def collision_delay(dx, dy, dz, ux, uy, uz, sigma):
     """Time until contact of a pair, or inf.
 
-    Written without data-dependent branches (every quantity is computed and
-    the answer selected at the end): whether a neighbour approaches is a coin
-    toss for the branch predictor, and the square root and division pipeline
-    across the neighbours of a prediction loop. 10-20 % faster per prediction
-    than rejecting early.
+    Written without early returns (every quantity is computed and the answer
+    selected at the end): whether a neighbour approaches is a coin toss for the
+    branch predictor, and the square root and division pipeline across the
+    neighbours of a prediction loop. 10-20 % faster per prediction than
+    rejecting early. LLVM may still compile the final selects into one branch on
+    ``hit`` (it does in the cell-crossing build, where hits are rare and the
+    branch skips the square root and division); a form with 0/1 weights, free of
+    branches in the machine code too, was 2-3 % slower there.
 
     Parameters
     ----------
