@@ -68,6 +68,12 @@ LIST_GROWTH = 16
 CELL_SLACK = 2
 
 
+def _wider(width: int) -> int:
+    """Width of the list or cell table after one growth step: ``width // LIST_GROWTH``
+    more columns, at least one."""
+    return width + max(1, width // LIST_GROWTH)
+
+
 def default_shell(packing: float, dimension: int = 3) -> float:
     """Neighbour-list shell width in units of the largest diameter.
 
@@ -512,7 +518,7 @@ class Simulation:
     def _grow_cells(self):
         e = self._engine
         old = e.cells.ids
-        self._cell_width += max(1, self._cell_width // LIST_GROWTH)
+        self._cell_width = _wider(self._cell_width)
         new = _aligned_int_rows(old.shape[0], self._cell_width)
         new[:, : old.shape[1]] = old
         self._engine = e._replace(cells=e.cells._replace(ids=new),
@@ -521,7 +527,7 @@ class Simulation:
     def _grow_lists(self):
         e = self._engine
         n = self.n
-        new = min(n - 1, self._nb_width + max(1, self._nb_width // LIST_GROWTH))
+        new = min(n - 1, _wider(self._nb_width))
         if new <= self._nb_width:
             raise SimulationError("neighbour list cannot grow further (internal error)")
         nbl = np.empty((n, new), dtype=np.int32)
