@@ -68,7 +68,7 @@ def _header(info) -> list[str]:
         f"  {info.dimension}D, N = {info.particles}, box = {' x '.join(_fmt(float(L)) for L in info.box)}, "
         f"packing fraction = {info.packing_fraction:.4g}, model = {info.model}"
         + (f" (restitution {info.restitution:g})" if info.restitution is not None and info.model == "constant" else "")
-        + (f" (prefactor k = {info.prefactor:.4g})" if info.prefactor is not None and info.model == "viscoelastic" else ""),
+        + (f" (damping {info.damping:.4g})" if info.damping is not None else ""),
     ]
     if info.method == "dsmc":
         lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; the pressure is not "
@@ -114,8 +114,9 @@ def cooling_report(a, rows: int = 10) -> str:
         lines.append(f"  fit T0 (1 + t/tau0)^-{f.exponent:.4g}: tau0 = {f.tau0:.5g} +- {f.tau0_err:.2g}, theory "
                      f"{ref:.5g}{_dev(f.tau0, ref)}; closed form {p.tau0:.5g}{_dev(f.tau0, p.tau0)}")
         ref_e = tg.exponent if tg is not None else p.exponent
-        lines.append(f"  fit with free exponent: exponent = -{g.exponent:.4f} +- {g.exponent_err:.2g}, theory "
-                     f"-{ref_e:.4f} (the same fit of the theory curve), closed form -{p.exponent:.4g}")
+        lines.append(f"  fit T0 (1 + t/tau0)^-p with free exponent (the figure's fit): tau0 = {g.tau0:.5g} +- "
+                     f"{g.tau0_err:.2g}, p = {g.exponent:.4f} +- {g.exponent_err:.2g}; theory p = {ref_e:.4f} "
+                     f"(the same fit of the theory curve), closed form {p.exponent:.4g}")
     ts, a2, _ = a.sonine
     if ts.size:
         k = np.unique(np.linspace(0, ts.size - 1, min(ts.size, 6)).astype(int))
