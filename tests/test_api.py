@@ -130,3 +130,33 @@ def test_a_loaded_run_is_the_same_file(result):
     again = gg.load_run(result.path)
     assert again.summary is None
     assert again.parameters["summary"]["collisions"] == read_parameters(result.path)["summary"]["collisions"]
+
+
+def test_the_getting_started_session_runs_as_shown(tmp_path, monkeypatch, capsys):
+    """The Python blocks of docs/getting-started.md#from-python, run in order in a fresh
+    directory holding the quickstart config: each works and prints what the page shows."""
+    import re
+    import shutil
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    root = Path(__file__).resolve().parents[1]
+    page = (root / "docs" / "getting-started.md").read_text()
+    section = page[page.index("## From Python"):]
+    section = section[:section.index("\n## ", 1)] if "\n## " in section[1:] else section
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    assert len(blocks) == 3
+    (tmp_path / "configs").mkdir()
+    (tmp_path / "runs").mkdir()
+    shutil.copy(root / "configs" / "quickstart.toml", tmp_path / "configs")
+    monkeypatch.chdir(tmp_path)
+    namespace = {}
+    for block in blocks:
+        exec(compile(block, "getting-started.md", "exec"), namespace)
+    out = capsys.readouterr().out
+    shown = re.search(r"print\(res\)\s+# (.*)", blocks[0]).group(1)
+    assert shown in out
+    assert namespace["df"].index.name == "time" and namespace["sim"].time == 5.0
+    assert namespace["old"].path == namespace["res"].path

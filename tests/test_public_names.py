@@ -87,3 +87,11 @@ def test_config_and_readers_stay_in_io():
     from granulargas.io import config, h5md
 
     assert callable(config.load_config) and callable(h5md.read_observables) and callable(h5md.iter_snapshots)
+
+
+def test_api_docs_list_every_front_door_name():
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "api" / "granulargas.md").read_text()
+    assert [n for n in granulargas.__all__ if f"`gg.{n}" not in page] == []
+    assert "::: granulargas.api" in page
