@@ -54,6 +54,9 @@ Record layout
 * ``counters`` (1,) :data:`COUNTERS` record.
 * ``walls`` :class:`Walls` -- ``impulse`` (3, 2) f8: normal momentum delivered to
   the lower / upper wall of each axis since the last reset.
+* ``stress`` (1,) :data:`granulargas.engine._shear.STRESS` record -- the pressure
+  tensor's kinetic sums and their time integrals and the collisional sums (None
+  unless asked for: the loop then compiles without them).
 * ``contacts`` :class:`Contacts` -- collisions that take time
   (:mod:`granulargas.engine._resolved`): ``until`` f8, the time at which the
   particle's last contact ends (-inf: none), ``partner`` i4 the slot of that
@@ -78,7 +81,7 @@ Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", 
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
-                               "walls", "contacts"])
+                               "walls", "contacts", "stress"])
 
 # Read-only parameters.
 #: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
@@ -92,9 +95,13 @@ RuleParams = namedtuple("RuleParams", ["kind", "eps", "tc_time", "prefactor", "i
                                        "ob_coeffs"])
 #: Geometry: ``box`` (3,) side lengths (the cell grid spans [0, L)); ``period`` (3,)
 #: the period of each axis (L when periodic, inf on a wall axis, so that the
-#: minimum image and the wrap leave wall axes alone); ``ncell`` (3,) cells per
-#: axis; ``wall_axes`` (k,) the axes with flat walls at 0 and L; ``dims`` 2 or 3.
-Space = namedtuple("Space", ["box", "period", "ncell", "wall_axes", "dims"])
+#: minimum image and the wrap leave wall axes alone; inf on the sheared axis too,
+#: which :mod:`granulargas.engine._shear` wraps); ``ncell`` (3,) cells per
+#: axis; ``wall_axes`` (k,) the axes with flat walls at 0 and L; ``dims`` 2 or 3;
+#: ``shear`` the Lees-Edwards geometry (:class:`~granulargas.engine._shear.ShearGeometry`)
+#: or None. The kernels take ``shear`` as an argument of their own, so that numba removes
+#: its branches when it is None.
+Space = namedtuple("Space", ["box", "period", "ncell", "wall_axes", "dims", "shear"])
 #: Everything else the loop reads: ``shell`` (list shell width), ``half_shell``
 #: (how far a particle may move from its list centre, with a round-off margin),
 #: ``rmax`` (largest radius), ``collapse_dt`` and ``collapse_count`` (inelastic-
@@ -149,12 +156,12 @@ def contacts(n: int, until=None, partner=None) -> Contacts:
     return Contacts(u, q, np.zeros(3), np.zeros(5))
 
 
-def space(box3, period3, ncell, wall_axes, dims) -> Space:
+def space(box3, period3, ncell, wall_axes, dims, shear=None) -> Space:
     """A :class:`Space` with the dtypes the kernels are compiled for."""
     return Space(np.ascontiguousarray(box3, dtype=np.float64),
                  np.ascontiguousarray(period3, dtype=np.float64),
                  np.ascontiguousarray(ncell, dtype=np.int64),
-                 np.ascontiguousarray(wall_axes, dtype=np.int64), int(dims))
+                 np.ascontiguousarray(wall_axes, dtype=np.int64), int(dims), shear)
 
 
 def params(rule: RuleParams, spc: Space, shell: float, rmax: float, collapse_dt: float,
