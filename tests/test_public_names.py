@@ -36,7 +36,7 @@ def test_every_command_module_has_parser_and_run(name):
     ("granulargas.io.runner", "granulargas.run.runner", ["run_config", "output_schedule", "mean_free_time"]),
     ("granulargas.io.setup", "granulargas.run.prepare", ["prepare", "fresh_state", "reduced_prefactor"]),
     ("granulargas.io.lammps", "granulargas.dem.lammps", ["DemContact", "write_lammps_gas", "find_lmp"]),
-    ("granulargas.engine.initial", "granulargas.initial.lattice_gas", ["random_state", "InitialState"]),
+    ("granulargas.engine.initial", "granulargas.initial.lattice_gas", ["random_state", "random_positions"]),
     ("granulargas.advise", "granulargas.run.advise", ["advise", "summary_line"]),
     ("granulargas.validity", "granulargas.run.validity", ["check_run", "raise_if_invalid"]),
     ("granulargas.sweep", "granulargas.run.sweep", ["load_sweep", "run_sweep"]),
