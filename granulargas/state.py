@@ -15,9 +15,10 @@ Per-particle quantities are declared once, in :data:`PARTICLE_FIELDS`: name, dty
 per-particle shape in d dimensions, default, H5MD element, whether the element is
 written once or per frame, and whether it is an observable or kept for restarts only.
 The record converts each field to its dtype, the simulations check its shape from the
-table, and the H5MD writer and reader store and read every field of the table, so a
-model that needs a new per-particle quantity adds one entry there and a field of the
-same name to :class:`State` (ARCHITECTURE.md, "Adding a per-particle field").
+table, the simulations keep the fields they do not use as given, and the H5MD writer
+and reader store and read every field of the table, so a model that needs a new
+per-particle quantity adds one entry there, which also makes it an attribute of
+:class:`State` (ARCHITECTURE.md, "Adding a per-particle field").
 """
 
 from __future__ import annotations
@@ -63,7 +64,7 @@ class ParticleField:
 
 #: Every per-particle quantity of the state, in particle-id order.
 PARTICLE_FIELDS = (
-    # name            dtype       shape    default  H5MD element    per frame  restart only
+    # name, dtype, per-particle shape(d), default, H5MD element, per frame, restart only, description
     ParticleField("positions", np.float64, _vector, None, "position", True, False,
                   "positions, wrapped into the box on periodic axes"),
     ParticleField("velocities", np.float64, _vector, None, "velocity", True, False,

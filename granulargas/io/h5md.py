@@ -141,6 +141,11 @@ def _frame_fields(positions: bool, fields) -> tuple:
     return tuple(x.name for x in PARTICLE_FIELDS if x.name in core or x.name in fields)
 
 
+def _describe(fld) -> str:
+    """The ``description`` attribute of a per-particle element."""
+    return fld.description + (" (kept for exact restarts)" if fld.restart_only else "")
+
+
 class H5MDWriter:
     """Append-only H5MD writer for one run.
 
@@ -291,6 +296,7 @@ class H5MDWriter:
             tail = fld.shape(d)
             g.create_dataset("value", shape=(0, n) + tail, maxshape=(None, n) + tail, dtype=fld.dtype,
                              chunks=_frame_chunks(n, tail))
+            g.attrs["description"] = _describe(fld)
             groups.append(g)
         if not self.positions:
             part["velocity"].attrs["description"] = (
@@ -313,6 +319,7 @@ class H5MDWriter:
         for fld in PARTICLE_FIELDS:
             if not fld.per_frame:  # time-independent: written once
                 part.create_dataset(fld.element, data=state.array(fld.name))
+                part[fld.element].attrs["description"] = _describe(fld)
 
         obs = f.create_group("observables")
         self._obs = {}

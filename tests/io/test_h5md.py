@@ -179,6 +179,11 @@ def test_write_state_and_read_state_round_trip_every_field(tmp_path, d):
                 assert got.dtype == want.dtype and np.array_equal(got, want), name
             else:
                 assert got == want, name
+    with h5py.File(p, "r") as f:  # each element says what it holds, and which are restart state only
+        part = f["particles/all"]
+        assert part["last_collision"].attrs["description"].endswith("(kept for exact restarts)")
+        assert part["position"].attrs["description"] == "positions, wrapped into the box on periodic axes"
+        assert part["species"].attrs["description"] == "species indices"
     # a frame without an observables sample at its time is no restart state
     with H5MDWriter(tmp_path / "t.h5", first) as w:
         w.write_observables(0, 0.0, {"collisions": 0, "dissipated_energy": 0.0})
