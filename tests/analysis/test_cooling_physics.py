@@ -13,6 +13,7 @@ import pytest
 
 from granulargas import theory as th
 from granulargas.analysis.run import analyze_cooling
+from granulargas.theory.hcs import hcs_reference
 
 CONFIG = """
 [system]
@@ -52,7 +53,9 @@ def _check_homogeneous_box(a, eps):
 
 
 def _haff(tmp_path, dim, n, eta, seeds, eps=0.9, span=60.0):
-    tau0 = th.haff_tau0(eps, th.number_density(eta, dim), dim=dim)
+    # Haff's tau0 with the cooling rate of the HCS reference (theory.hcs)
+    tau0 = 2.0 / (th.enskog_cooling_rate(eps, th.number_density(eta, dim), 1.0, dim, a2=0.0)
+                  * hcs_reference(eps, dim).zeta_factor)
     out = []
     for seed in seeds:
         a = _run(tmp_path, dim, n, eta, seed, f'model = "constant"\nrestitution = {eps}', span * tau0, tau0 / 10)
