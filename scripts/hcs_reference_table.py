@@ -267,7 +267,9 @@ def main(argv=None):
     hcs.write_table(args.out, rows, header=(
         f"HCS of smooth inelastic hard {{disks, spheres}} by DSMC (homogeneous Enskog-Boltzmann equation): "
         f"scripts/hcs_reference_table.py, N = {args.n}, {args.seeds} seeds x {args.samples} snapshots one "
-        f"collision per particle apart after {args.relax} to relax; errors: standard error of the seed means"))
+        f"collision per particle apart after {args.relax} to relax; errors: standard error of the seed means; "
+        f"relaxation_rate: {args.relax_seeds} gases over {args.relax} collisions per particle from a Maxwellian "
+        f"start, nan where not resolved"))
     print(f"\nwrote {args.out}")
     return 0
 

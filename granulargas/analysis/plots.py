@@ -123,7 +123,8 @@ def plot_cooling(analysis, path):
     ax.set_xscale("log")
     _no_offset(ax)
     ax.set_ylabel("Sonine coefficients")
-    ax.margins(y=0.45)  # room above the points for the legend
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 1.2 * (hi - lo))  # room above the points for the legend
     ax.legend(fontsize=7, loc="upper center", ncol=2, framealpha=0.85)
     ax.set_xlabel("time t  [$\\sigma\\,(m/T_0)^{1/2}$]" + (f", since the first sample at {a.t_offset:.4g}"
                                                           if a.t_offset else ""))

@@ -121,11 +121,11 @@ def cooling_report(a, rows: int = 10) -> str:
     return "\n".join(lines)
 
 
-def _sigmas(value, ref, error, ref_error=0.0) -> str:
-    """'(ratio r, +x sigma)' of a measured value against a reference with their errors."""
+def _sigmas(value, ref, error, ref_error=0.0, label="a2/reference") -> str:
+    """'label = r, +x sigma' of a measured value against a reference with their errors."""
     if not all(x is not None and math.isfinite(x) for x in (value, ref)):
         return ""
-    out = f"a2/reference = {value / ref:.4f}" if ref != 0 else ""
+    out = f"{label} = {value / ref:.4f}" if ref != 0 else ""
     sig = math.hypot(*(x if x is not None and math.isfinite(x) else 0.0 for x in (error, ref_error)))
     if math.isfinite(sig) and sig > 0:
         out += (", " if out else "") + f"{(value - ref) / sig:+.1f} sigma"
@@ -156,7 +156,7 @@ def _a2_lines(a) -> list[str]:
     lines.append(f"  a2 reference ({name}): {_pm(ref, ref_err, '+.5f')}; {_sigmas(mean, ref, err, ref_err)}")
     if a.hcs is not None and a.hcs.name != FIRST_SONINE:
         fs = float(theory.sonine_a2(a.info.restitution, a.info.dimension))
-        lines.append(f"  for comparison, {FIRST_SONINE}: {fs:+.5f}; {_sigmas(mean, fs, err)}")
+        lines.append(f"  for comparison, {FIRST_SONINE}: {fs:+.5f}; {_sigmas(mean, fs, err, label='a2/first Sonine')}")
     return lines
 
 
