@@ -41,7 +41,7 @@ count small over many decades of time.
 Constant restitution: the best reference
 ----------------------------------------
 For a constant eps the first Sonine approximation is off at strong inelasticity (a2 by
-10-25 %, the cooling rate by up to 0.7 %), and the homogeneous cooling state (HCS) is
+up to 28 %, the cooling rate by up to 1.2 %), and the homogeneous cooling state (HCS) is
 known better: :func:`granulargas.theory.hcs.hcs_reference` gives a2, the cooling-rate
 factor c_zeta = zeta/zeta_M and the collision-frequency factor c_omega = omega/omega_M
 of the HCS from a DSMC table (exact up to statistics; first Sonine where the table
@@ -56,7 +56,7 @@ c_omega(0) = 1 - a2(0)/16 the first-Sonine factors at the start, and lambda = r 
 factors and a2 relax from the start to the HCS as exp(-r s) in the collisions per particle
 s, with the reference's measured rate r (``HCSReference.relaxation_rate``, the rate that
 gives the DSMC's offset of ln T after the transient), or, where the table has none, the
-first-Sonine rate of (G2), r = -d(da2/dt)/da2 / omega (the DSMC relaxes 1.5-2 times
+first-Sonine rate of (G2), r = -d(da2/dt)/da2 / omega (the DSMC relaxes up to 1.8 times
 faster). The transient lasts a few collisions per particle; after it, T(t) is Haff's law
 with the reference's cooling rate. ``reference="first_sonine"`` integrates (G1)-(G3) as
 they stand.
@@ -455,8 +455,8 @@ def hcs_of(gas: Gas, reference: str = "best") -> HCSReference | None:
 def relaxation_collisions(gas: Gas, fraction: float = 0.01, a2: float = 0.0) -> float:
     """Collisions per particle after which a2 of (G2) has come within ``fraction`` of the way to its
     stationary value: ``ln(1/fraction) omega / lambda`` at the gas's T0 (for a constant eps a
-    number of eps and d). First Sonine: the DSMC relaxes 1.5-2 times faster, so this errs on the
-    long side, which is the safe side for a mean that must start after the relaxation."""
+    number of eps and d). First Sonine: the DSMC's a2 relaxes as fast or up to 1.8 times faster,
+    so this errs on the long side, the safe side for a mean that must start after the relaxation."""
     _, d0, omega = cooling_rates(gas, gas.temperature, a2)
     _, d1, _ = cooling_rates(gas, gas.temperature, a2 + 1.0)
     rate = -(float(d1) - float(d0))

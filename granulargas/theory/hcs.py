@@ -13,9 +13,9 @@ Two references give them:
 
 * **first Sonine, van Noije & Ernst 1998** (:data:`FIRST_SONINE`): a2 of
   :func:`granulargas.theory.sonine_a2`, a3 = 0, c_zeta = 1 + 3 a2/16,
-  c_omega = 1 - a2/16. Good near eps = 1 (a few per cent of a2 at eps = 0.9); at
-  strong inelasticity it overestimates a2 by 10-25 % (Santos & Montanero 2009), and
-  c_zeta by up to 0.7 % (2D, eps = 0.1);
+  c_omega = 1 - a2/16. Good near eps = 1 (8-12 % of a2 and 6e-4 in c_zeta at
+  eps = 0.9); at strong inelasticity its a2 is 10-28 % too large (Santos & Montanero
+  2009), and c_zeta up to 1.2 % (2D, eps = 0.1);
 * **Enskog-Boltzmann, DSMC table** (:data:`DSMC_TABLE`): the homogeneous
   Enskog-Boltzmann equation solved by this package's DSMC, which is exact up to
   statistics, at eps = 0.10, 0.15, ..., 0.95 in 2D and 3D
@@ -40,8 +40,8 @@ temperature sees it: in collisions per particle s, ln T(s) = -k q s + delta once
 (k = (1 - eps^2)/d, q = c_zeta/c_omega, 1 at the start), and a factor relaxing as
 exp(-rate s) gives delta = k (q - 1)/rate; the DSMC's delta (32 gases of 10^5 particles)
 gives the rate, nan where q - 1 is too small to resolve it (near eps = 0.7, where the
-transient does not matter). The DSMC relaxes 1.5-2 times faster than the first Sonine
-moment equations say.
+transient does not matter). At eps <= 0.6 the DSMC relaxes 1.2-1.8 times faster than the
+first Sonine moment equations say, near eps = 0.9 somewhat slower.
 """
 
 from __future__ import annotations
