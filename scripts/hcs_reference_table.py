@@ -41,7 +41,7 @@ transient's rate with its error, the rate of an exponential fitted to the seed-m
 of the transient (s >= 2; where |a2| > 0.02) and the relaxation rate of a2 in the first
 Sonine moment equations; then the leave-one-out check of the interpolation.
 
-    python scripts/hcs_reference_table.py                 # ~20 min on one core; writes the table
+    python scripts/hcs_reference_table.py                 # 7e9 collisions: 10-15 min on one idle core; writes the table
     python scripts/hcs_reference_table.py --quick --out /tmp/t.csv   # checks the script (~1 min)
     python scripts/hcs_reference_table.py --update-relaxation        # only the transient (~5 min)
 """

@@ -20,8 +20,9 @@ Two references give them:
   Enskog-Boltzmann equation solved by this package's DSMC, which is exact up to
   statistics, at eps = 0.10, 0.15, ..., 0.95 in 2D and 3D
   (``hcs_dsmc_table.csv`` beside this module, made by ``scripts/hcs_reference_table.py``
-  in about 20 minutes; 8 independent gases of 10^5 particles per point, each 400
-  collisions per particle; errors are the standard errors of those 8 means).
+  from 7e9 collisions, 10-15 minutes on one idle core; 8 independent gases of 10^5
+  particles per point, each 400 collisions per particle; errors are the standard errors
+  of those 8 means).
 
 :func:`hcs_reference` gives the best of the two: the table for 0.1 <= eps < 1 and the
 first Sonine values outside it (eps < 0.1; eps = 1 is exact in both: a Maxwellian).
