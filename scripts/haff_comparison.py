@@ -280,7 +280,7 @@ def main(argv=None):
                                       span * tau_v, tau_v / 20, 30, 0.02 * tau_v, args.reuse)) for s in seeds]
     summarize(f"constant restitution {eps}, 3D (Haff)", const)
     summarize(f"viscoelastic, damping {k}, 3D", visco)
-    figure_cooling({"const": (f"$\\epsilon$ = {eps}", const), "visco": (f"viscoelastic, k = {k}", visco)},
+    figure_cooling({"const": (f"$\\epsilon$ = {eps}", const), "visco": (f"viscoelastic, damping {k}", visco)},
                    Path(args.figdir) / "cooling_haff.png")
 
     if args.no_instability:
