@@ -137,7 +137,7 @@ def test_sonine_a2_of_the_hcs_matches_van_noije_ernst(tmp_path):
     for seed in range(1, 13):
         path = tmp_path / f"a2_{seed}.h5"
         text = CONFIG.format(dim=3, n=N, eta=eta, seed=seed, collision=f'model = "constant"\nrestitution = {eps}',
-                             end=30 * tau0, dt=tau0, file=path).replace("snapshots = 6", f"snapshot_interval = {30 * tau0 / 39}")
+                             end=30 * tau0, dt=tau0, file=path, neighbours="auto").replace("snapshots = 6", f"snapshot_interval = {30 * tau0 / 39}")
         run_config(parse_config(text, source="test"), overwrite=True)
         t, a2, _ = sonine_history(path)
         vals.append(a2[t > 2 * tau0].mean())
