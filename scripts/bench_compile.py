@@ -34,8 +34,10 @@ import sys, time
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
 st = random_state(64, 0.05, 3, seed=0)
+# a tree whose initial state is a set of keyword arguments (as_kwargs) or a state record
+args = ((), st.as_kwargs()) if hasattr(st, "as_kwargs") else ((st,), {})
 cpu, wall = time.process_time(), time.perf_counter()
-Simulation(**st.as_kwargs(), rule=CollisionRule.elastic(), neighbours=sys.argv[1]).run(0.5)
+Simulation(*args[0], rule=CollisionRule.elastic(), neighbours=sys.argv[1], **args[1]).run(0.5)
 print(time.process_time() - cpu, time.perf_counter() - wall)
 """
 

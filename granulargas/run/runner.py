@@ -303,6 +303,16 @@ def _plain(v):
     return f'"{v}"' if isinstance(v, str) else ("{...}" if hasattr(v, "__dataclass_fields__") else f"{v}")
 
 
+def stored_fields(config: RunConfig, sim) -> tuple:
+    """The per-frame fields of :data:`granulargas.state.PARTICLE_FIELDS` a run stores besides
+    positions, velocities and images: the restart state its model needs
+    (:class:`granulargas.io.h5md.H5MDWriter`)."""
+    if config.run.method == "dsmc":
+        return ()
+    tc = config.collision.model == "constant" and config.collision.tc_time is not None
+    return (("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if sim.rule.resolved else ())
+
+
 def _observables(sim, pressure: bool) -> dict:
     if hasattr(sim, "observables"):  # a DSMC run (run.dsmc_run.DSMCRun)
         return sim.observables()
@@ -392,24 +402,16 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     run = config.run
     if run.end_time is not None and st.time >= run.end_time:
         raise ConfigError(f"{config.source}: run.end_time = {run.end_time:g}: the restart file "
-                          f"{st.source} is already at t = {st.time:g}; nothing to run")
+                          f"{setup.source} is already at t = {st.time:g}; nothing to run")
     if run.collisions_per_particle is not None and st.collisions >= collision_budget(config):
         raise ConfigError(f"{config.source}: run.collisions_per_particle = {run.collisions_per_particle:g}: the "
-                          f"restart file {st.source} already has {st.collisions} collisions; nothing to run")
+                          f"restart file {setup.source} already has {st.collisions} collisions; nothing to run")
 
     dsmc = config.run.method == "dsmc"
     if dsmc:
         sim = make_dsmc(config, setup)
     else:
-        sim = Simulation(
-            st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
-            time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
-            events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
-            wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
-            injected_energy=st.injected_energy, contact_until=st.contact_until,
-            contact_partner=st.contact_partner, three_body_contacts=st.three_body_contacts,
-            neighbours=config.run.neighbours,
-        )
+        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours)
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
     # event loop; both paths of a restart do it, so restart equality is unaffected
@@ -424,16 +426,14 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     if config.run.collisions_per_particle is not None:
         budget = collision_budget(config)
 
-    tc = setup.rule_name == "constant" and config.collision.tc_time is not None
     resolved = not dsmc and sim.rule.resolved
+    fields = stored_fields(config, sim)
     if append:
-        writer = H5MDWriter.append(path, particles=len(st.radii), dimension=st.box.shape[0], last_collision=tc,
-                                   step=st.events, time=st.time, contacts=resolved)
+        writer = H5MDWriter.append(path, st, fields=fields)
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
-        writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
-                            last_collision=tc, overwrite=overwrite, boundary=sim.boundary,
-                            driven=sim.driving is not None, positions=not dsmc, contacts=resolved)
+        writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
+                            driven=sim.driving is not None)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached
@@ -464,10 +464,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
 
     def snapshot():
         sim.synchronise()
-        lc = np.asarray(sim.last_collision) if tc else None
-        contacts = (sim.contact_until, sim.contact_partner) if resolved else None
-        writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc,
-                              dsmc_state=sim.state if dsmc else None, contacts=contacts)
+        writer.write_state(sim.state)
         frame[0] = (sim.events, sim.time)
 
     wall0 = _time.perf_counter()
