@@ -23,6 +23,7 @@ Usage::
 
     python scripts/bench_compile.py                          # quickstart, variants, warm; 3 rounds
     python scripts/bench_compile.py --what quickstart --rounds 5
+    python scripts/bench_compile.py --what variants --trees /tmp/main . --rounds 2
     python scripts/bench_compile.py --what engine --trees /tmp/main . --modes lists cells --core 1
 """
 
@@ -109,34 +110,36 @@ def _line(name, r):
     return f"{name}: CPU {cpu:.1f} s, wall {wall:.1f} s; summary start-up {startup:.3g} s, compiling {compiled:.3g} s"
 
 
-def first_runs(args, rows):
-    """One round of quickstart / variants / warm (module docstring), appended to ``rows``."""
+def first_runs(args, rows, tree=ROOT):
+    """One round of quickstart / variants / warm (module docstring) with the package of
+    ``tree``, appended to ``rows`` (keys prefixed with the tree when several are compared)."""
+    tag = f"[{tree}] " if len(args.trees) > 1 else ""
     work = tempfile.mkdtemp(prefix="bench-compile-")
     try:
         numba_cache, table_cache = os.path.join(work, "numba"), os.path.join(work, "tables")
         out = os.path.join(work, "out.h5")
         qs = run_cli(["run", "configs/quickstart.toml", "--output", out, "--quiet"], numba_cache, table_cache,
-                     core=args.core)
+                     tree=tree, core=args.core)
         if "quickstart" in args.what:
-            rows.setdefault("quickstart (fresh install)", []).append(qs)
-            print(_line("quickstart (fresh install)", qs), flush=True)
+            rows.setdefault(tag + "quickstart (fresh install)", []).append(qs)
+            print(_line(tag + "quickstart (fresh install)", qs), flush=True)
         if "variants" in args.what:
             for name, config, extra in VARIANT_RUNS:
                 copy = os.path.join(work, f"numba-{len(rows)}-{name}")
                 shutil.copytree(numba_cache, copy)
                 r = run_cli(["run", f"configs/{config}", "--output", out, "--overwrite", "--quiet", *extra], copy,
-                            table_cache, core=args.core)
+                            table_cache, tree=tree, core=args.core)
                 shutil.rmtree(copy, ignore_errors=True)
-                rows.setdefault(f"after the quickstart: {name}", []).append(r)
-                print(_line(f"after the quickstart: {name}", r), flush=True)
+                rows.setdefault(f"{tag}after the quickstart: {name}", []).append(r)
+                print(_line(f"{tag}after the quickstart: {name}", r), flush=True)
         if "warm" in args.what:
             config, extra = WARM
             run_cli(["run", f"configs/{config}", "--output", out, "--overwrite", "--quiet", *extra], numba_cache,
-                    table_cache, core=args.core)  # compiles the 2D run's kernels
+                    table_cache, tree=tree, core=args.core)  # compiles the 2D run's kernels
             r = run_cli(["run", f"configs/{config}", "--output", out, "--overwrite", "--quiet", *extra], numba_cache,
-                        table_cache, core=args.core)
-            rows.setdefault("warm small 2D run (400 disks)", []).append(r)
-            print(_line("warm small 2D run (400 disks)", r), flush=True)
+                        table_cache, tree=tree, core=args.core)
+            rows.setdefault(tag + "warm small 2D run (400 disks)", []).append(r)
+            print(_line(tag + "warm small 2D run (400 disks)", r), flush=True)
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -145,7 +148,8 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--what", nargs="+", default=["quickstart", "variants", "warm"],
                    choices=["quickstart", "variants", "warm", "engine"])
-    p.add_argument("--trees", nargs="+", default=[ROOT], help="engine: source trees to compare (default: this one)")
+    p.add_argument("--trees", nargs="+", default=[ROOT],
+                   help="source trees to compare, alternated (default: this one; the configs are this tree's)")
     p.add_argument("--modes", nargs="+", default=["lists", "cells"], choices=["lists", "cells"])
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--core", type=int, default=None, help="pin the runs to this core (taskset)")
@@ -158,11 +162,12 @@ def main(argv=None):
     rows = {}
     first, cached = {}, {}
     for r in range(args.rounds):
+        order = args.trees if r % 2 == 0 else args.trees[::-1]
         if set(args.what) - {"engine"}:
-            first_runs(args, rows)
+            for tree in order:
+                first_runs(args, rows, tree)
         if "engine" not in args.what:
             continue
-        order = args.trees if r % 2 == 0 else args.trees[::-1]
         for mode in args.modes:
             for tree in order:
                 cache = tempfile.mkdtemp(prefix="numba-cache-")
