@@ -61,7 +61,6 @@ starts, and adds up the time they take, so that a run can count it as start-up;
 import functools
 import hashlib
 import os
-import sys
 import time
 
 import numba
@@ -196,16 +195,19 @@ def cache_location() -> str:
 class CompileWatch(event.Listener):
     """Within a ``with`` block: numba's compilations (cache misses) in this process.
 
-    ``announce``: called once, with no argument, when the first compilation starts
-    (e.g. to say what is being compiled before the pause); ``seconds`` and
+    ``announce``: called once, with no argument, when the first compilation after
+    :attr:`armed` is set starts (e.g. to say what is being compiled before the pause;
+    ``armed`` is True unless given); ``seconds`` and
     ``cpu_seconds``: the wall-clock and CPU time spent compiling so far (outermost
     compilations only: a function compiled while compiling its caller counts once);
     ``count``: functions compiled. Numba sends no event for a function loaded from
     its cache, so a run whose code is all cached records nothing.
     """
 
-    def __init__(self, announce=None):
+    def __init__(self, announce=None, armed=True):
         self.announce = announce
+        self.armed = armed
+        self.announced = False
         self.seconds = 0.0
         self.cpu_seconds = 0.0
         self.count = 0
@@ -214,7 +216,8 @@ class CompileWatch(event.Listener):
 
     def on_start(self, ev):
         if self._depth == 0:
-            if self.count == 0 and self.announce is not None:
+            if self.armed and not self.announced and self.announce is not None:
+                self.announced = True
                 self.announce()
             self._start = (time.perf_counter(), time.process_time())
         self._depth += 1
@@ -239,7 +242,3 @@ def announcement(what: str) -> str:
     """The line that says what is being compiled, that it happens once, and where it is kept."""
     return f"compiling {what} (once; cached in {cache_location()})"
 
-
-def print_announcement(what: str, file=None) -> None:
-    """Print :func:`announcement` on ``file`` (default stderr) at once (before the pause)."""
-    print(announcement(what), file=file or sys.stderr, flush=True)

@@ -379,13 +379,15 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
 
     Start-up: everything before the first event (initial state, compiling the run's
     kernels the first time such a run is made or loading them from numba's cache, the
-    event queue, the first frame) is ``RunSummary.startup_time``; the first compilation
-    is announced with one line on ``log`` before it starts. A compilation during the run
-    itself (a kernel first needed there) counts as start-up too, never as run time.
+    event queue, the first frame) is ``RunSummary.startup_time``. The engine's first
+    compilation is announced with one line on ``log`` before it starts (the initial
+    placement's, before the config has passed every check, is not: bad input gets one
+    line). A compilation during the run itself (a kernel first needed there) counts as
+    start-up too, never as run time.
     """
     start = _time.perf_counter()
-    what = [describe(variants_for(config))]
-    with CompileWatch(announce=lambda: (log or _stderr)(announcement(what[0]))) as watch:
+    what = [describe([v for v in variants_for(config) if v.announced])]
+    with CompileWatch(announce=lambda: (log or _stderr)(announcement(what[0])), armed=False) as watch:
         return _run(config, overwrite, quiet, progress, log, append, stop, start, what, watch)
 
 
@@ -410,6 +412,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
                           f"restart file {st.source} already has {st.collisions} collisions; nothing to run")
 
     dsmc = config.run.method == "dsmc"
+    watch.armed = True  # from here on a compile is announced (bad input has had its one line)
     if dsmc:
         sim = make_dsmc(config, setup)
     else:
@@ -423,7 +426,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
             neighbours=config.run.neighbours,
         )
     if not dsmc:  # the engine's own choice of neighbour mode ("auto" at the state's packing)
-        what[0] = describe(variants_for(config, sim.neighbours))
+        what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
     # event loop; both paths of a restart do it, so restart equality is unaffected

@@ -84,6 +84,10 @@ class Variant:
     uses: Callable[[RunConfig, str], bool]
     after: tuple = ()
     build: Callable[[], None] | None = field(default=None, compare=False)
+    #: a run announces the variant before compiling it; the initial placement compiles
+    #: before the run can tell a bad config from a good one (a placement too dense for
+    #: its radii fails there), and bad input gets one line on stderr: not announced
+    announced: bool = True
 
 
 def _build_placement():
@@ -104,10 +108,11 @@ def _build_large_placement():
 
 #: every compiled variant, one entry each (module docstring)
 VARIANTS = (
-    Variant("placement", "the initial placement", None, lambda c, m: _placement(c), build=_build_placement),
+    Variant("placement", "the initial placement", None, lambda c, m: _placement(c), build=_build_placement,
+            announced=False),
     Variant("placement-large", f"the initial placement of large systems (from {SORTED_MIN_PARTICLES} particles)",
             None, lambda c, m: _placement(c) and c.system.particles >= SORTED_MIN_PARTICLES,
-            after=("placement",), build=_build_large_placement),
+            after=("placement",), build=_build_large_placement, announced=False),
     Variant("lists", "the neighbour-list engine", {"run.neighbours": "lists"}, _engine("lists"),
             after=("placement",)),
     Variant("cells", "the cell-crossing engine", {"run.neighbours": "cells"}, _engine("cells"),

@@ -13,6 +13,8 @@ from numba.core import event
 
 from granulargas import _numba
 from granulargas.cli import main
+from granulargas.engine import Simulation
+from granulargas.errors import ConfigError
 from granulargas.io.config import load_config
 from granulargas.run import runner
 from granulargas.run.variants import BY_NAME, VARIANTS, describe, run_neighbours, tiny_config, variants_for
@@ -95,22 +97,39 @@ def test_compiling_is_announced_once_before_it_starts(tmp_path, monkeypatch):
     path.write_text(SMALL.format(out=tmp_path / "o.h5"))
     cfg = load_config(path)
     order = []
-    prepare = runner.prepare
+    run = Simulation.run
 
-    def compiling_prepare(config):
-        _fake_compile(0.01)
-        order.append("first compile done")
-        _fake_compile(0.01)
-        return prepare(config)
+    def compiling_run(self, *args, **kwargs):
+        if not order:
+            _fake_compile(0.01)
+            order.append("first compile done")
+            _fake_compile(0.01)
+        return run(self, *args, **kwargs)
 
-    monkeypatch.setattr(runner, "prepare", compiling_prepare)
+    monkeypatch.setattr(Simulation, "run", compiling_run)
     summary = runner.run_config(cfg, log=order.append)
     lines = [x for x in order if x.startswith("compiling")]
-    assert lines == [f"compiling the initial placement and the neighbour-list engine (once; cached in "
-                     f"{_numba.cache_location()})"]
+    assert lines == [f"compiling the neighbour-list engine (once; cached in {_numba.cache_location()})"]
     assert order.index(lines[0]) < order.index("first compile done")
     assert summary.compile_time >= 0.02
     assert "of it compiling, once" in summary.lines()[2]
+
+
+def test_bad_input_found_while_compiling_the_placement_stays_one_line(tmp_path, monkeypatch, capsys):
+    """The initial placement compiles before it can find a config too dense for it: that
+    compile is counted, not announced, so the error is the only line on stderr."""
+    path = tmp_path / "c.toml"
+    path.write_text(SMALL.format(out=tmp_path / "o.h5"))
+
+    def compiling_then_refusing(config):
+        _fake_compile(0.01)
+        raise ConfigError(f"{config.source}: system.packing_fraction = 0.9: too dense")
+
+    monkeypatch.setattr(runner, "prepare", compiling_then_refusing)
+    assert main(["run", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("error: ")
+    assert not (tmp_path / "o.h5").exists()
 
 
 def test_a_compile_during_the_run_counts_as_start_up(tmp_path, monkeypatch):
