@@ -21,18 +21,11 @@ compile the same kernel twice), and the test of a config that selects it.
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
-import tempfile
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
 
-from granulargas import _numba
 from granulargas.engine.simulation import neighbour_mode
-from granulargas.errors import ConfigError
 from granulargas.initial.lattice_gas import SORTED_MIN_PARTICLES
 from granulargas.io.config import RunConfig, parse_config
 
@@ -170,86 +163,3 @@ def tiny_config(variant: Variant, directory) -> RunConfig:
         text.append(f"[{section}]")
         text += [f"{name} = {json.dumps(value)}" for name, value in values.items()]
     return parse_config("\n".join(text) + "\n", source=f"<{variant.name}>")
-
-
-def build(name: str) -> None:
-    """Compile (or load from the cache) the kernels of variant ``name`` in this process: a
-    tiny run of that kind by the steps of ``granulargas run`` (the checks before the run,
-    the run, the advice after it)."""
-    from granulargas.run.advise import method_line, summary_line
-    from granulargas.run.runner import run_config
-    from granulargas.run.validity import raise_if_invalid
-
-    variant = BY_NAME[name]
-    if variant.build is not None:
-        variant.build()
-        return
-    with tempfile.TemporaryDirectory(prefix="granulargas-compile-") as tmp:
-        config = tiny_config(variant, tmp)
-        raise_if_invalid(config)
-        run_config(config, quiet=True, log=lambda line: None)
-        summary_line(config)
-        method_line(config)
-
-
-@dataclass
-class Built:
-    """What building one variant took: ``compiled`` functions (0: all loaded from the cache),
-    ``compile_seconds`` (wall clock), ``cpu_seconds`` and ``wall_seconds`` of its process."""
-
-    name: str
-    compiled: int
-    compile_seconds: float
-    cpu_seconds: float
-    wall_seconds: float
-    error: str = ""
-
-
-def _child(name: str) -> None:
-    """Entry point of a build process: build ``name``, print a :class:`Built` as JSON."""
-    wall = time.perf_counter()
-    with _numba.CompileWatch() as watch:
-        build(name)
-    times = os.times()
-    print(json.dumps({"name": name, "compiled": watch.count, "compile_seconds": watch.seconds,
-                      "cpu_seconds": times.user + times.system, "wall_seconds": time.perf_counter() - wall}))
-
-
-def build_all(names=None, jobs: int | None = None, report=None) -> list[Built]:
-    """Build the variants ``names`` (default: all), each in a process of its own, at most
-    ``jobs`` at once (default: the number of CPUs), a variant after those it builds on.
-    ``report(built)`` is called as each one finishes. Returns them in order of completion."""
-    names = list(BY_NAME) if not names else list(names)
-    for n in names:
-        if n not in BY_NAME:
-            raise ConfigError(f"variant {n!r}: not one of {', '.join(BY_NAME)}")
-    jobs = max(1, jobs or os.cpu_count() or 1)
-    pending = [n for n in BY_NAME if n in names]
-    running: dict[str, tuple[subprocess.Popen, float]] = {}
-    done: list[Built] = []
-    finished: set[str] = set()
-    while pending or running:
-        for n in list(pending):
-            if len(running) >= jobs:
-                break
-            if all(dep in finished or dep not in names for dep in BY_NAME[n].after):
-                cmd = [sys.executable, "-c", "import sys; from granulargas.run.variants import _child; _child(sys.argv[1])", n]
-                running[n] = (subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True),
-                              time.perf_counter())
-                pending.remove(n)
-        time.sleep(0.05)
-        for n, (proc, start) in list(running.items()):
-            if proc.poll() is None:
-                continue
-            out, err = proc.communicate()
-            del running[n]
-            finished.add(n)
-            try:
-                b = Built(**json.loads(out.strip().splitlines()[-1]))
-            except (ValueError, IndexError, TypeError):
-                b = Built(n, 0, 0.0, 0.0, time.perf_counter() - start,
-                          error=(err.strip().splitlines() or ["failed"])[-1])
-            done.append(b)
-            if report is not None:
-                report(b)
-    return done

@@ -217,7 +217,7 @@ def test_after_compile_a_first_run_compiles_nothing(tmp_path):
 
     built = granulargas("compile", "placement", "lists")
     assert "compiled  placement" in built.stdout and "compiled  lists" in built.stdout
-    run = granulargas("run", str(cfg), "--overwrite", "--set", "collision.restitution=0.7", "--set", "system.dimension=3",
-                      "--set", 'run.neighbours="lists"')
+    run = granulargas("run", str(cfg), "--overwrite", "--set", "collision.restitution=0.7",
+                      "--set", "system.dimension=3", "--set", 'run.neighbours="lists"')
     assert "compiling" not in run.stderr, run.stderr
     assert "compiled code from the cache" in run.stdout
