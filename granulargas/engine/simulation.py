@@ -400,8 +400,8 @@ class Simulation:
             build_grid(rec, lists, spc)
             self._finish_build(particles, events, lists, None, order, qt=qt, where=where)
             return
-        events = _state.Events(partner=np.full(n, -1, dtype=np.int32),
-                               tag=np.zeros(n, dtype=np.int32))
+        partner, tag, where, qt = _state.event_rows(n)
+        events = _state.Events(partner=partner, tag=tag)
         centre = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
         pos = np.ascontiguousarray(rec[:, :3])
         stencil = np.empty(27, dtype=np.int64)
@@ -432,11 +432,12 @@ class Simulation:
             cells = cells._replace(ids=ids)
             self._cell_width = slots
         lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
-        self._finish_build(particles, events, lists, cells, order)
+        self._finish_build(particles, events, lists, cells, order, qt=qt, where=where)
 
     def _finish_build(self, particles, events, lists, cells, order, qt=None, where=None):
         """Contacts, every particle's event, counters and the calendar (after the neighbour search;
-        ``qt``, ``where``: the calendar's per-particle arrays, if the mode keeps them elsewhere)."""
+        ``qt``, ``where``: the calendar's per-particle arrays, views into the mode's per-particle
+        rows)."""
         n = self.n
         spc = self._space
         rec = particles.rec
