@@ -66,7 +66,7 @@ MAX_PACKING = {3: math.pi / (3.0 * math.sqrt(2.0)), 2: math.pi / (2.0 * math.sqr
 MODELS = ("elastic", "constant", "viscoelastic")
 CONTACT_ENDS = ("overlap", "force")
 DURATIONS = ("instantaneous", "resolved")
-BOUNDARIES = ("periodic", "wall")
+BOUNDARIES = ("periodic", "wall", "lees-edwards")
 DRIVING_MODELS = ("white_noise",)
 #: ``run.method``: event-driven molecular dynamics, or DSMC of the homogeneous Enskog-Boltzmann equation
 METHODS = ("edmd", "dsmc")
@@ -106,6 +106,18 @@ class SystemConfig:
     def walls(self) -> bool:
         """Whether any axis has walls."""
         return "wall" in self.boundary
+
+
+@dataclass(frozen=True)
+class ShearConfig:
+    """``[shear]`` (optional): uniform shear flow, the flow a (y - L_y/2) along x with
+    Lees-Edwards boundaries on y (``system.boundary`` marks y ``"lees-edwards"``);
+    optionally a thermostat that rescales the peculiar velocities to
+    ``thermostat_temperature`` every ``thermostat_interval``."""
+
+    rate: float = 0.0
+    thermostat_temperature: float | None = None
+    thermostat_interval: float | None = None
 
 
 @dataclass(frozen=True)
@@ -234,6 +246,7 @@ class RunConfig:
     source: str = "<config>"
     text: str = ""
     driving: DrivingConfig | None = None
+    shear: ShearConfig | None = None
 
     def to_toml(self) -> str:
         """The resolved configuration (defaults filled in) as TOML text."""
@@ -392,7 +405,8 @@ SCHEMA: tuple[Key, ...] = (
         "state on every machine.", default=1, low=0, high=2**63 - 1, reason="any TOML integer >= 0"),
     Key("system", "boundary", "list of strings",
         'One entry per axis (x, y, z): `"periodic"`, or `"wall"` for flat hard walls at 0 and L on '
-        "that axis (the packing fraction counts the whole box).",
+        'that axis (the packing fraction counts the whole box), or `"lees-edwards"` on y with `[shear]` '
+        "(sliding images: uniform shear flow).",
         default_text='"periodic" on every axis', choices=BOUNDARIES,
         run_check="a wall axis must be at least 4.15 largest diameters long"),
     # [particles]
@@ -489,6 +503,24 @@ SCHEMA: tuple[Key, ...] = (
         "Time between kicks; observables are sampled half-way between kicks.",
         default_text="0.02 of the cooling time of the theoretical steady state", unit="reduced time",
         low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
+    # [shear]
+    Key("shear", "rate", "number",
+        "Uniform shear flow: the shear rate a of the flow a (y − L_y/2) along x, with Lees–Edwards "
+        'boundaries on y (`system.boundary = ["periodic", "lees-edwards", ...]`; x periodic, z periodic '
+        "or walls). Viscous heating balances the collisional loss of an inelastic gas; an elastic gas "
+        "needs the thermostat. Required whenever `[shear]` is given.",
+        unit="1 / reduced time", low=0.0, low_open=True, high=SCALE_RANGE[1], reason="a rate",
+        run_check="the gas must reach its steady state (theory: the Grad solution) within the run: "
+                  "a rate that drives it there more slowly, or past the clock's resolution, is refused"),
+    Key("shear", "thermostat_temperature", "number",
+        "A thermostat: the peculiar velocities (relative to the flow) are rescaled to this temperature "
+        "at regular intervals (a Gaussian thermostat applied at discrete times, as in the elastic "
+        "uniform shear flow of the literature). Leave it out for none.",
+        unit="T0", low=SCALE_RANGE[0], high=SCALE_RANGE[1], reason=_SPEED),
+    Key("shear", "thermostat_interval", "number",
+        "Time between the thermostat's rescalings (with `thermostat_temperature`).",
+        default_text="0.1 of the mean free time at the thermostat temperature", unit="reduced time",
+        low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
     # [run]
     Key("run", "end_time", "number",
         "Stop at this time (give `end_time`, `collisions_per_particle` or both; the first reached stops).",
@@ -541,11 +573,11 @@ SCHEMA: tuple[Key, ...] = (
 SECTION_CLASSES = {
     "system": SystemConfig, "particles": ParticlesConfig, "initial": InitialConfig,
     "collision": CollisionConfig, "collision.material": MaterialConfig, "driving": DrivingConfig,
-    "run": RunSection, "output": OutputConfig,
+    "shear": ShearConfig, "run": RunSection, "output": OutputConfig,
 }
-SECTIONS = ("system", "particles", "initial", "collision", "driving", "run", "output")
+SECTIONS = ("system", "particles", "initial", "collision", "driving", "shear", "run", "output")
 #: sections that may be left out as a whole (absent: None in RunConfig)
-OPTIONAL_SECTIONS = ("driving",)
+OPTIONAL_SECTIONS = ("driving", "shear")
 #: keys whose value is a sub-table with its own section in SCHEMA
 SUBTABLES = {"collision.material": "collision.material"}
 #: keys that take a number or an inline table of sub-keys (dotted in SCHEMA)
@@ -841,6 +873,29 @@ def _check_dsmc_supported(v: Values):
                                     'method = "dsmc" (a homogeneous DSMC gas shows no inelastic collapse)')
 
 
+def _check_shear(v: Values):
+    boundary = v.get("system.boundary")
+    marked = [a for a, b in enumerate(boundary or ()) if b == "lees-edwards"]
+    if not v.section_given("shear"):
+        if marked:
+            v.fail("system.boundary", '"lees-edwards" needs [shear] (the rate of the flow along x)')
+        return
+    if not v.has("shear.rate"):
+        v.fail("shear.rate", "missing; [shear] needs rate > 0 (the flow a (y - L_y/2) along x)")
+    if marked != [1] or boundary[0] != "periodic":
+        shown = boundary if boundary is not None else ("periodic",) * int(v.get("system.dimension"))
+        v.fail("system.boundary", 'a shear flow needs "lees-edwards" on y and a periodic x, e.g. '
+                                  f'{_show(["periodic", "lees-edwards"] + ["periodic"] * (len(shown) - 2))} '
+                                  "(walls only on z)", list(shown))
+    if v.get("collision.duration") == "resolved":
+        v.fail("collision.duration", '"resolved" is not available with [shear] (Lees-Edwards boundaries)')
+    if v.has("shear.thermostat_interval") and not v.has("shear.thermostat_temperature"):
+        v.fail("shear.thermostat_interval", "needs shear.thermostat_temperature")
+    if v.get("collision.model") == "elastic" and not v.has("shear.thermostat_temperature"):
+        v.fail("shear.rate", 'an elastic gas only heats under shear and never reaches a steady state: give '
+                             "shear.thermostat_temperature or an inelastic collision model")
+
+
 RULES: tuple[Rule, ...] = (
     Rule('`model = "constant"` needs `restitution`.', _check_constant_needs_restitution),
     _only_with("collision.restitution", ("constant",)),
@@ -871,6 +926,9 @@ RULES: tuple[Rule, ...] = (
     Rule("`[driving]` needs `heating_rate`.", _check_driving_needs_heating_rate),
     Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls and no `tc_time`.',
          _check_dsmc_supported),
+    Rule('`[shear]` needs `rate` and `boundary` with `"lees-edwards"` on y and a periodic x (walls only on '
+         'z), and `"lees-edwards"` needs `[shear]`; not with `duration = "resolved"`; an elastic gas needs '
+         "the thermostat; `thermostat_interval` needs `thermostat_temperature`.", _check_shear),
 )
 
 

@@ -43,6 +43,7 @@ from granulargas.contact.oblique import DELTA_MAX, compression_prefactor
 from granulargas.contact.oblique_grid import BETA_MAX as OBLIQUE_BETA_MAX
 from granulargas import theory
 from granulargas.engine import CollisionRule, WhiteNoise
+from granulargas.engine.shear import Shear
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
 from granulargas.initial import box_for_packing, random_state
@@ -72,6 +73,8 @@ class Setup:
     driving: object = None
     #: the restart file the state was read from (None: a fresh state)
     source: str | None = None
+    #: uniform shear flow (``[shear]``: :class:`granulargas.engine.shear.Shear`), or None
+    shear: object = None
 
 
 # ------------------------------------------------------------------- particles
@@ -127,7 +130,8 @@ def fresh_state(config: RunConfig) -> State:
             )
     try:
         return random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
-                            radii=radii, masses=masses, rng=rng, boundary=s.boundary)
+                            radii=radii, masses=masses, rng=rng, boundary=s.boundary,
+                            shear=None if config.shear is None else config.shear.rate)
     except ConfigError as exc:
         limit = RANDOM_PLACEMENT_MAX[s.dimension]
         raise ConfigError(f"{config.source}: system.packing_fraction = {s.packing_fraction:g}: {exc}; random "
@@ -299,6 +303,51 @@ def driven_energy_bound(config: RunConfig, prefactor: float, state: State) -> fl
     return 2.0 * max(e0, 0.5 * s.dimension * len(state.masses) * t_ss)
 
 
+def sheared_energy_bound(config: RunConfig, prefactor: float, state: State) -> float:
+    """The peculiar kinetic energy the restitution table of a sheared viscoelastic run must cover
+    (as :func:`driven_energy_bound`): twice the larger of the initial peculiar energy and
+    N d T / 2 at the steady or thermostat temperature (:func:`granulargas.theory.shear.steady_temperature`),
+    with the relative speed a sigma the flow adds over a contact folded into the temperature."""
+    s, sh = config.system, config.shear
+    sigma, m = mean_particle(config)
+    n = float(len(state.radii)) / float(np.prod(state.box))
+    if sh.thermostat_temperature is not None:
+        t_ss = sh.thermostat_temperature
+    else:
+        end = config.collision.contact_end
+        t_ss = theory.shear.steady_temperature(
+            sh.rate, lambda T: float(theory.effective_restitution(prefactor, T, s.dimension, sigma, m, end)), n,
+            s.dimension, sigma, m, s.packing_fraction)
+    t_ss = (math.sqrt(t_ss) + sh.rate * 2.0 * float(state.radii.max()) * math.sqrt(m)) ** 2
+    c = state.velocities.copy()
+    if state.positions is not None:
+        c[:, 0] -= sh.rate * (state.positions[:, 1] - 0.5 * state.box[1])
+    e0 = 0.5 * float((state.masses[:, None] * c**2).sum())
+    return 2.0 * max(e0, 0.5 * s.dimension * len(state.masses) * t_ss)
+
+
+def make_shear(config: RunConfig, state: State):
+    """(Shear or None, parameters) of the config's ``[shear]``: the thermostat's interval,
+    unless given, 0.1 of the mean free time at its temperature."""
+    sh = config.shear
+    if sh is None:
+        return None, None
+    params = {"rate": sh.rate, "flow": "x", "gradient": "y",
+              "description": "uniform shear flow u = rate (y - L_y/2) along x; Lees-Edwards boundaries on y "
+                             "(engine), homogeneous shear flow in the Lagrangian frame (DSMC)"}
+    if sh.thermostat_temperature is None:
+        return Shear(sh.rate), params
+    interval = sh.thermostat_interval
+    if interval is None:
+        sigma, m = mean_particle(config)
+        n = float(len(state.radii)) / float(np.prod(state.box))
+        omega = float(theory.collision_frequency(n, sh.thermostat_temperature, config.system.dimension, sigma, m))
+        interval = 0.1 / omega
+    params.update(thermostat_temperature=sh.thermostat_temperature, thermostat_interval=interval,
+                  thermostat="the peculiar velocities rescaled to thermostat_temperature at (k + 1/2) interval")
+    return Shear(sh.rate, sh.thermostat_temperature, interval), params
+
+
 def make_rule(config: RunConfig, state: State):
     """(rule, name, prefactor, table, warnings, parameters) for the config."""
     c = config.collision
@@ -311,7 +360,10 @@ def make_rule(config: RunConfig, state: State):
         return rule, "constant", None, None, [], params
     k = reduced_prefactor(config)
     driven = config.driving is not None and config.driving.heating_rate > 0.0
-    bmax = beta_bound(k, state, driven_energy_bound(config, k, state) if driven else None)
+    energy = driven_energy_bound(config, k, state) if driven else None
+    if config.shear is not None:
+        energy = sheared_energy_bound(config, k, state)
+    bmax = beta_bound(k, state, energy)
     if not bmax <= TABLE_BETA_MAX:
         key = (f"collision.damping = {c.damping:g}" if c.material is None else "collision.material")
         energy = "the driving's energy bound" if driven else "the run's kinetic energy"
@@ -406,6 +458,7 @@ def prepare(config: RunConfig) -> Setup:
     source = str(Path(config.initial.from_file)) if config.initial.from_file else None
     rule, name, k, table, warns, rule_params = make_rule(config, state)
     driving, driving_params = make_driving(config, k, state)
+    shear, shear_params = make_shear(config, state)
     s = config.system
     vol = particle_volume(2.0 * state.radii, s.dimension).sum()
     parameters = {
@@ -426,6 +479,8 @@ def prepare(config: RunConfig) -> Setup:
     }
     if driving_params is not None:
         parameters["driving"] = driving_params
+    if shear_params is not None:
+        parameters["shear"] = shear_params
     if config.run.method == "dsmc":
         parameters["dsmc"] = {
             "chi": float(theory.contact_value(parameters["packing_fraction"], s.dimension)),
@@ -440,4 +495,4 @@ def prepare(config: RunConfig) -> Setup:
     if source:
         parameters["restart"] = {"file": source, "time": state.time, "step": state.events,
                                  "collisions": state.collisions}
-    return Setup(rule, name, state, k, table, parameters, warns, driving, source)
+    return Setup(rule, name, state, k, table, parameters, warns, driving, source, shear)

@@ -335,15 +335,22 @@ def _observables(sim, pressure: bool) -> dict:
         "events": int(sim.events),
         "dissipated_energy": float(sim.dissipated_energy),
         "momentum": np.asarray(sim.momentum, dtype=np.float64),
-        "pressure": float(sim.pressure_window()) if pressure else math.nan,
         "sonine_a2": float(a2),
         "sonine_a3": float(a3),
     }
+    d = sim.dimension
+    if pressure:
+        p, tensor = sim.pressure_windows()
+    else:
+        p, tensor = math.nan, (np.full((d, d), math.nan) if sim.stress else None)
+    out["pressure"] = float(p)
+    if tensor is not None:
+        out["pressure_tensor"] = np.asarray(tensor, dtype=np.float64)
     if "wall" in sim.boundary:
         out["wall_collisions"] = int(sim.wall_collisions)
         out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
-    if sim.driving is not None:
-        out["injected_energy"] = float(sim.injected_energy)
+    if sim.driving is not None or (sim.shear is not None and sim.shear.thermostat):
+        out["injected_energy"] = float(sim.injected_energy)  # the thermostat's: the heat taken out, < 0
         out["kick_step"] = int(sim.kick_step)
     if sim.rule.resolved:
         out["three_body_contacts"] = int(sim.three_body_contacts)
@@ -440,7 +447,8 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
     if dsmc:
         sim = make_dsmc(config, setup)
     else:
-        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours)
+        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
+                         shear=setup.shear, stress=True)
     if not dsmc:  # the engine's own choice of neighbour mode ("auto" at the state's packing)
         what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     # a zero-length run compiles (or loads) the engine and builds its queue before
@@ -462,7 +470,8 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None)
+                            driven=sim.driving is not None or (setup.shear is not None and setup.shear.thermostat),
+                            tensor=not dsmc or setup.shear is not None)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached

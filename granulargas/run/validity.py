@@ -58,6 +58,18 @@ neighbour-list events per collision grow without bound (x500 by T/T0 = 1e-40,
 the predicted ``T_end / T0 < DRIFT_T_RATIO = 1e-30``; the remedy is a restart
 with the centre-of-mass velocity removed.
 
+Shear flow
+----------
+A sheared gas ([shear]) heads for the steady state where viscous heating balances the
+collisional loss (:mod:`granulargas.theory.shear`: the Grad solution, ``T_s`` of
+:func:`granulargas.theory.shear.steady_temperature`, a viscoelastic gas at its effective
+restitution), or is held at the thermostat's temperature. A run is refused when its
+shear rate drives the gas there more slowly than the run lasts: the dilute Grad moment
+equations (collision rates times chi) from T0 do not bring T within a factor 1.25 of
+``T_s`` by ``end_time`` or within ``collisions_per_particle``
+(:func:`granulargas.theory.shear.grad_transient`); and, as any run, when the clock at
+the end cannot resolve the events at ``T_s``.
+
 Runner API (one line each, for the run summary)
 -----------------------------------------------
 * :func:`check_run` ``(config) -> RunValidity``: all the numbers;
@@ -220,10 +232,14 @@ class RunValidity:
     warnings: list = field(default_factory=list)
     errors: list = field(default_factory=list)
     driven: bool = False
+    #: what holds the steady state of a sheared run (None: not sheared)
+    steady: str | None = None
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
-        if self.driven:
+        if self.steady is not None:
+            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady shear flow: {self.steady})"]
+        elif self.driven:
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady state of the driving, "
                    "Enskog theory)"]
         else:
@@ -281,6 +297,61 @@ def _check_driven(config, gas) -> RunValidity:
     return rv
 
 
+def _check_sheared(config, gas) -> RunValidity:
+    """Checks of a sheared run (module doc, "Shear flow")."""
+    sh = config.shear
+    src = gas.source
+    d, n, sigma, m = gas.dimension, gas.density, gas.sigma, gas.mass
+    chi = float(theory.contact_value(gas.packing_fraction, d))
+    if sh.thermostat_temperature is not None:
+        rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, sh.thermostat_temperature,
+                         driven=True)
+        rv.steady = "the thermostat"
+        t_end = gas.end_time if gas.end_time is not None else math.nan
+        clock = _clock_error(gas, t_end, math.log(sh.thermostat_temperature), "run.end_time")
+        if clock:
+            rv.errors.append(clock)
+        return rv
+    if gas.model == "constant":
+        eps = gas.restitution
+    else:
+        prefactor = gas.prefactor
+
+        def eps(T):
+            return float(theory.effective_restitution(prefactor, T, d, sigma, m, gas.end))
+    T_s = theory.shear.steady_temperature(sh.rate, eps, n, d, sigma, m, gas.packing_fraction)
+    rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, float(T_s), driven=True)
+    rv.steady = "viscous heating = collisional loss, Grad solution"
+    if not (UNDERFLOW_T < T_s / m < 1e100):
+        rv.errors.append(f"{src}: shear.rate = {sh.rate:g}: the steady temperature would be T = {T_s:.3g} (Grad "
+                         "solution), out of float64's range for squared speeds; choose a rate near the steady "
+                         f"one at T0 ({sh.rate * math.sqrt(gas.temperature / T_s):.4g})")
+        return rv
+    horizon = gas.end_time if gas.end_time is not None else math.inf
+    t_reach, s_reach = theory.shear.grad_transient(sh.rate, eps, n, gas.temperature, d, sigma, m, chi,
+                                                   t_end=horizon if math.isfinite(horizon) else math.inf)
+    short_t = gas.end_time is not None and not t_reach <= gas.end_time
+    short_s = gas.collisions_per_particle is not None and not s_reach <= gas.collisions_per_particle
+    if short_t or short_s:
+        key = "run.end_time" if short_t else "run.collisions_per_particle"
+        value = gas.end_time if short_t else gas.collisions_per_particle
+        need = (f"t = {t_reach:.3g}" if short_t else f"{s_reach:.3g} collisions per particle")
+        if not math.isfinite(t_reach):
+            need = "longer than the run"
+        a_near = sh.rate * math.sqrt(gas.temperature / T_s)
+        rv.errors.append(f"{src}: shear.rate = {sh.rate:g}: the gas would move from T0 = {gas.temperature:g} to its "
+                         f"steady T = {T_s:.3g} (Grad solution) in {need}, beyond {key} = {value:g}: the run would "
+                         f"end far from the steady state; lengthen the run or choose a rate near {a_near:.4g} "
+                         "(steady at T0)")
+        return rv
+    t_end = gas.end_time if gas.end_time is not None else t_reach
+    clock = _clock_error(gas, float(t_end), math.log(T_s), "run.end_time" if gas.end_time is not None
+                         else "run.collisions_per_particle")
+    if clock:
+        rv.errors.append(clock)
+    return rv
+
+
 def _warn_contact(rv: RunValidity, gas: RunGas, spread) -> None:
     """Warnings of contacts the event-driven model misstates: contact durations that are not
     short against the mean free time, and damping beyond the quasi-static force's range."""
@@ -309,6 +380,8 @@ def check_run(config) -> RunValidity:
         rv = RunValidity(gas, math.nan, gas.temperature, math.nan)
         rv.errors.append(table)
         return rv
+    if getattr(config, "shear", None) is not None:
+        return _check_sheared(config, gas)
     driving = getattr(config, "driving", None)
     if driving is not None and driving.heating_rate > 0.0:
         return _check_driven(config, gas)

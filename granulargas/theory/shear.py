@@ -93,9 +93,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import optimize
+from scipy.integrate import solve_ivp
 from scipy.special import erfc
 
-from granulargas.theory.enskog import _check_dim, contact_value, number_density, sonine_a2
+from granulargas.theory.enskog import _check_dim, collision_frequency, contact_value, number_density, sonine_a2
 
 __all__ = [
     "dilute_viscosity",
@@ -104,6 +105,8 @@ __all__ = [
     "grad_usf",
     "navier_stokes_viscosity",
     "navier_stokes_viscosity_reduced",
+    "steady_temperature",
+    "grad_transient",
 ]
 
 #: nodes of the direction grid: Gauss-Legendre in cos(theta) and azimuth points (3D); azimuth (2D)
@@ -366,3 +369,74 @@ def navier_stokes_viscosity_reduced(eps, dimension=3, packing=0.0, chi=None, for
 def navier_stokes_viscosity(eps, T=1.0, dimension=3, packing=0.0, sigma=1.0, m=1.0, chi=None):
     """The shear viscosity eta = eta* eta0(T) of eq. (S7)."""
     return navier_stokes_viscosity_reduced(eps, dimension, packing, chi) * dilute_viscosity(T, dimension, sigma, m)
+
+
+def steady_temperature(rate, eps, n, dimension=3, sigma=1.0, m=1.0, packing=0.0, chi=None):
+    """The temperature of the steady unthermostatted USF at the shear rate ``rate`` (Grad,
+    :func:`grad_usf`): a = a*(alpha) nu0(n, T), so T = m (a / (a* nu0(n, T = m)))^2 for a
+    constant alpha. ``eps`` may be a callable eps(T) (the effective restitution of a
+    viscoelastic gas at T): then T solves a*(eps(T)) nu0(n, T) = a (bisection in ln T)."""
+    nu1 = float(reference_frequency(n, m, dimension, sigma, m))  # nu0 at T = m: sqrt(T/m) = 1
+    if not callable(eps):
+        a_star = grad_usf(eps, dimension, packing, chi).a_star
+        return m * (rate / (a_star * nu1)) ** 2
+
+    def mismatch(lnT):
+        e = float(eps(math.exp(lnT)))
+        if e >= 1.0:
+            return -1.0  # elastic: no heat is lost, the gas warms
+        return math.log(grad_usf(e, dimension, packing, chi).a_star * nu1 * math.exp(0.5 * lnT) / math.sqrt(m)) \
+            - math.log(rate)
+
+    lo, hi = math.log(m) - 10.0, math.log(m) + 10.0
+    while mismatch(lo) > 0.0 and lo > -700.0:
+        lo -= 10.0
+    while mismatch(hi) < 0.0 and hi < 700.0:
+        hi += 10.0
+    return math.exp(optimize.brentq(mismatch, lo, hi, xtol=1e-10))
+
+
+def grad_transient(rate, eps, n, T0, dimension=3, sigma=1.0, m=1.0, chi=1.0, t_end=math.inf, tolerance=0.25):
+    """The approach to the steady USF from a Maxwellian gas at T0, by the dilute Grad moment
+    equations (S2) with (S5), every collision rate times the contact value ``chi`` (an estimate
+    of the Enskog gas's pace). ``eps`` a number or a callable eps(T).
+
+    Returns (t_reach, s_reach): the time, and the collisions per particle by then, at which
+    |ln(T / T_s)| first falls below ln(1 + tolerance) (T_s of :func:`steady_temperature`
+    with the same rates); inf if not by ``t_end``.
+    """
+    d = dimension
+    eps_of = eps if callable(eps) else (lambda T: eps)
+    T_s = steady_temperature(rate, eps_of if callable(eps) else eps, n, d, sigma, m, 0.0, 1.0) / chi**2
+    nu1 = float(reference_frequency(n, m, d, sigma, m)) * chi
+    om1 = float(collision_frequency(n, m, d, sigma, m, chi=chi))  # per particle, at T = m
+
+    def rhs3(t, y):
+        pxx, pyy, pzz, pxy, s = y
+        temp = (pxx + pyy + pzz) / (d * n)
+        nu = nu1 * math.sqrt(max(temp, 1e-300) / m)
+        nu_eta, zeta = _dilute_rates(float(eps_of(temp)), d)
+        p = n * temp
+        return [-2.0 * rate * pxy - nu * (nu_eta * (pxx - p) + zeta * p),
+                -nu * (nu_eta * (pyy - p) + zeta * p),
+                -nu * (nu_eta * (pzz - p) + zeta * p) if d == 3 else 0.0,
+                -rate * pyy - nu * nu_eta * pxy,
+                om1 * math.sqrt(max(temp, 1e-300) / m)]
+
+    def temp_of(y):
+        return (y[0] + y[1] + (y[2] if d == 3 else 0.0)) / (d * n)
+
+    def reached(t, y):
+        return abs(math.log(max(temp_of(y), 1e-300) / T_s)) - math.log(1.0 + tolerance)
+
+    reached.terminal = True
+    reached.direction = -1
+    y0 = [n * T0, n * T0, n * T0 if d == 3 else 0.0, 0.0, 0.0]
+    if reached(0.0, y0) <= 0.0:
+        return 0.0, 0.0
+    horizon = t_end if math.isfinite(t_end) else 1e6 / (nu1 * math.sqrt(min(T0, T_s) / m))
+    sol = solve_ivp(rhs3, (0.0, horizon), y0, events=reached, rtol=1e-6, atol=1e-12 * n * max(T0, T_s),
+                    method="LSODA")
+    if sol.t_events[0].size:
+        return float(sol.t_events[0][0]), float(sol.y_events[0][0][4])
+    return math.inf, math.inf
