@@ -245,8 +245,10 @@ def _mean_particle_mass(radii, masses, dim) -> float:
 
 
 def run_kind(info: RunInfo) -> str:
-    """``"driven"`` (white-noise driving), ``"elastic"`` (energy conserved: eps = 1 or
-    damping 0) or ``"cooling"``."""
+    """``"shear"`` (uniform shear flow), ``"driven"`` (white-noise driving), ``"elastic"``
+    (energy conserved: eps = 1 or damping 0) or ``"cooling"``."""
+    if isinstance(info.parameters.get("shear"), dict):
+        return "shear"
     drv = info.parameters.get("driving")
     if isinstance(drv, dict) and float(drv.get("heating_rate", 0.0)) > 0.0:
         return "driven"
@@ -265,6 +267,8 @@ def theory_name(info: RunInfo) -> str:
         return f"Enskog, {eos} equation of state"
     if info.kind == "driven":
         return "Enskog, driven steady state (zeta(T) T = H)"
+    if info.kind == "shear":
+        return "Grad solution of uniform shear flow (theory.shear)"
     if info.model == "viscoelastic":
         return (f"moment equations of the Enskog-Boltzmann equation, first Sonine, exact eps(g) "
                 f"(Brilliantov & Pöschel 2000); chi from {eos}")
