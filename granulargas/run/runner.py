@@ -55,7 +55,7 @@ from tqdm import tqdm
 from granulargas.engine import Simulation
 from granulargas.errors import ConfigError, InputFileError, SimulationError, UserError
 from granulargas.io.config import RunConfig, parse_config
-from granulargas.io.h5md import H5MDWriter, read_parameters
+from granulargas.io.h5md import H5MDWriter, read_parameters, read_text
 from granulargas.io.paths import existing_directory, output_file
 from granulargas.observables import sonine_coefficients
 from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
@@ -559,8 +559,7 @@ def _continuation_record(writer, config: RunConfig, setup, st) -> dict:
     (``config``) and, under ``continuations/<k>``, where it started and the config it replaced."""
     g = writer.file["parameters"]
     k = len(g["continuations"]) if "continuations" in g else 0
-    previous = g["config"][()] if "config" in g else b""
-    previous = previous.decode() if isinstance(previous, bytes) else str(previous)
+    previous = read_text(g["config"]) if "config" in g else ""
     return {
         "config": setup.parameters["config"],
         "config_source": setup.parameters["config_source"],
