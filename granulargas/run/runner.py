@@ -57,10 +57,10 @@ from granulargas.errors import ConfigError, InputFileError, SimulationError, Use
 from granulargas.io.config import RunConfig, parse_config
 from granulargas.io.h5md import H5MDWriter, read_parameters, read_text
 from granulargas.io.paths import existing_directory, output_file
-from granulargas.observables import sonine_coefficients
 from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
 from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
+from granulargas.run.record import observables
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
     Schedule,
@@ -303,32 +303,6 @@ def _plain(v):
     return f'"{v}"' if isinstance(v, str) else ("{...}" if hasattr(v, "__dataclass_fields__") else f"{v}")
 
 
-def _observables(sim, pressure: bool) -> dict:
-    if hasattr(sim, "observables"):  # a DSMC run (run.dsmc_run.DSMCRun)
-        return sim.observables()
-    a2, a3 = sonine_coefficients(sim.velocities, sim.masses)
-    out = {
-        "temperature": float(sim.temperature),
-        "kinetic_energy": float(sim.kinetic_energy),
-        "collisions": int(sim.collisions),
-        "events": int(sim.events),
-        "dissipated_energy": float(sim.dissipated_energy),
-        "momentum": np.asarray(sim.momentum, dtype=np.float64),
-        "pressure": float(sim.pressure_window()) if pressure else math.nan,
-        "sonine_a2": float(a2),
-        "sonine_a3": float(a3),
-    }
-    if "wall" in sim.boundary:
-        out["wall_collisions"] = int(sim.wall_collisions)
-        out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
-    if sim.driving is not None:
-        out["injected_energy"] = float(sim.injected_energy)
-        out["kick_step"] = int(sim.kick_step)
-    if sim.rule.resolved:
-        out["three_body_contacts"] = int(sim.three_body_contacts)
-    return out
-
-
 def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True, progress=None,
                log=None, append: bool = False, stop: StopRequest | None = None) -> RunSummary:
     """Run a validated config to the end and write its H5MD file.
@@ -461,7 +435,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     stop_reason = "end_time" if schedule.clock == "time" else "collisions_per_particle"
     try:
         if not append:  # a continued file already holds the starting frame and its sample
-            writer.write_observables(sim.events, sim.time, _observables(sim, False), flush=False)
+            writer.write_observables(sim.events, sim.time, observables(sim, False), flush=False)
             snapshot()
         last_sample = (sim.events, sim.time)
         for target, snap, sample in zip(targets, is_snap, is_sample):
@@ -476,7 +450,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
                 hit_budget = False
             if not (sample or hit_budget):
                 continue  # an engine pacing stop (run.schedule.pacing_stops): no output
-            writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
+            writer.write_observables(sim.events, sim.time, observables(sim, True), flush=False)
             last_sample = (sim.events, sim.time)
             if snap or hit_budget:
                 snapshot()
@@ -490,7 +464,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         name = signal.Signals(stop.signum).name
         try:
             if (sim.events, sim.time) != last_sample:  # the stop may fall right after a sample
-                writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
+                writer.write_observables(sim.events, sim.time, observables(sim, True), flush=False)
             if (sim.events, sim.time) != frame[0]:  # ... or right after a scheduled frame
                 snapshot()
             writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
