@@ -67,7 +67,7 @@ def _header(info) -> list[str]:
     if info.method == "dsmc":
         lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; the pressure is not "
                      "sampled)")
-    if not info.monodisperse:
+    if info.scene.shows("polydisperse_theory"):
         lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
                      f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
                      f"same number density (packing {info.packing_fraction:.4g})")
@@ -86,10 +86,11 @@ def cooling_report(a, rows: int = 10) -> str:
     info, p, h = a.info, a.prediction, a.history
     lines = _header(info)
     lines.append(f"  theory: {a.theory_name}")
+    space = info.scene.shows("instability")  # a DSMC run has no box to compare with L_c
     lines.append(f"  closed form ({p.law}, reference): T0 = {p.T0:.4g}, tau0 = {_fmt(p.tau0)}, "
-                 f"exponent = -{p.exponent:.4g}, a2 = {p.a2:.4g}; mean free path = {p.mean_free_path:.4g}, "
-                 f"instability length L_c = {_fmt(p.instability_length)}")
-    if math.isfinite(p.instability_length):
+                 f"exponent = -{p.exponent:.4g}, a2 = {p.a2:.4g}; mean free path = {p.mean_free_path:.4g}"
+                 + (f", instability length L_c = {_fmt(p.instability_length)}" if space else ""))
+    if space and math.isfinite(p.instability_length):
         L = float(info.box.max())
         side = "below" if L < p.instability_length else "ABOVE"
         lines.append(f"  box length {L:.4g} is {side} L_c ({p.instability_length:.4g})"
