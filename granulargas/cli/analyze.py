@@ -141,9 +141,10 @@ def elastic_report(a, rows: int = 10) -> str:
     if a.info.walls:
         lines.append("  (walls: Z and the collision frequency below use the mean density of the whole box, "
                      "depleted next to the walls; the wall pressure against the bulk density is the test)")
-    lines.append(f"  Z = P/(nT) = {_pm(s['Z'], s['Z_error'])}; {s['Z_theory_name']} {s['Z_theory']:.5g}"
-                 f"{_dev(s['Z'], s['Z_theory'])}; {s['Z_reference_name']} {s['Z_reference']:.5g}"
-                 f"{_dev(s['Z'], s['Z_reference'])}")
+    if a.info.scene.shows("pressure"):  # DSMC samples no pressure
+        lines.append(f"  Z = P/(nT) = {_pm(s['Z'], s['Z_error'])}; {s['Z_theory_name']} {s['Z_theory']:.5g}"
+                     f"{_dev(s['Z'], s['Z_theory'])}; {s['Z_reference_name']} {s['Z_reference']:.5g}"
+                     f"{_dev(s['Z'], s['Z_reference'])}")
     lines.append(f"  collision frequency per particle {_pm(s['collision_frequency'], s['collision_frequency_error'])}; "
                  f"Enskog {s['collision_frequency_theory']:.5g}"
                  f"{_dev(s['collision_frequency'], s['collision_frequency_theory'])}")

@@ -66,14 +66,15 @@ class Scene:
     @classmethod
     def from_config(cls, config) -> "Scene":
         """The scene of a :class:`granulargas.io.config.RunConfig`."""
-        s, c = config.system, config.collision
+        s, c, p = config.system, config.collision, config.particles
         driving = config.driving
         return cls(
             method=config.run.method, dimension=s.dimension, model=c.model,
             kind=_kind(c.model, c.restitution, c.damping if c.material is None else 1.0,
                        driving is not None and driving.heating_rate > 0.0),
             walls="wall" in s.boundary, resolved=c.duration == "resolved",
-            polydisperse=bool(config.particles.polydisperse), tc_model=c.tc_time is not None,
+            polydisperse=bool(p.polydisperse and p.diameter_max > p.diameter_min),
+            tc_model=c.tc_time is not None,
             material=c.material is not None,
         )
 

@@ -44,6 +44,15 @@ advice predicts, with kinetic theory and no simulation
    among the config's particles (:func:`fastest_impact_bounds`) is beyond its table,
    which the run would refuse.
 
+Every line applies to the config's scene (:class:`granulargas.io.scene.Scene`,
+:data:`granulargas.io.scene.STATEMENTS`): steps 2-4 compare cooling curves and are
+made for cooling gases only; a driven gas is predicted by its relaxation towards the
+steady temperature of the driving (:func:`granulargas.run.validity.driven_end`, the
+theory ``granulargas analyze`` compares with) and told how many relaxation times the
+run lasts; an elastic gas keeps T0; step 5 needs space, so a DSMC config (whose box
+only sets the density) is told instead how long a box of its gas could be. The
+predicted temperature at the end is the run summary's (:func:`granulargas.run.validity.check_run`).
+
 For a constant-eps config the advice reports the config ``damping`` (beta at
 g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
@@ -494,7 +503,8 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         if math.isfinite(rv.T_steady):
             adv.relaxation_time = rv.T_steady / config.driving.heating_rate  # 1/zeta(T_ss) = T_ss / H
     if scene.shows("instability") or scene.shows("homogeneous_by_construction"):
-        adv.instability_length = gas.instability_length()
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+            adv.instability_length = gas.instability_length()
         adv.T_stable_instability = rv.T_stable / T0
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         chosen = choose_duration(config, tolerance)

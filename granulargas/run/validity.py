@@ -419,8 +419,9 @@ def check_run(config) -> RunValidity:
     rv.tc_ratio = contact_time_ratio(gas)
     _warn_contact(rv, gas, spread)
     if scene.shows("instability") and not isinstance(config, RunGas):
-        rv.box, rv.instability_length = box_length(config), gas.instability_length()
-        if rv.unstable:
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # absurdly dilute configs: inf
+            rv.box, rv.instability_length = box_length(config), gas.instability_length()
+        if rv.unstable and math.isfinite(rv.instability_length):
             rv.T_stable = stable_temperature(gas, rv.box, T_end)
             grows = ""
             if gas.model == "viscoelastic":

@@ -98,6 +98,7 @@ def test_advise_run_and_analyze_agree_and_speak_of_the_scene(name, tmp_path):
     if method == "dsmc":
         assert "box" not in summary and "L_c" not in summary
 
+    assert Scene.from_file(out) == scene  # the file says what the config said
     report = _call(["analyze", str(out)])
     result = json.loads(_call(["analyze", str(out), "--json"]))
     assert result["scene"]["kind"] == kind and result["scene"]["method"] == method

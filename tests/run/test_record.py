@@ -14,7 +14,6 @@ from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
 from granulargas.io.h5md import H5MDWriter, read_parameters, snapshot_count
-from granulargas.run.record import RunWriter
 
 N, PACKING = 500, 0.1
 
@@ -33,6 +32,8 @@ def _simulation(model):
 
 
 def _write(path, sim, t_end=10.0):
+    from granulargas.run.record import RunWriter
+
     with RunWriter(path, sim) as out:
         for k, t in enumerate(np.linspace(t_end / 40, t_end, 40)):
             sim.run(until=t)
