@@ -59,8 +59,10 @@ def _dev(value, ref):
 def _header(info) -> list[str]:
     lines = [
         f"{info.path}",
-        f"  {info.dimension}D, N = {info.particles}, box = {' x '.join(_fmt(float(L)) for L in info.box)}, "
-        f"packing fraction = {info.packing_fraction:.4g}, model = {info.model}"
+        f"  {info.dimension}D, N = {info.particles}, "
+        + (f"box = {' x '.join(_fmt(float(L)) for L in info.box)}, " if info.scene.space else
+           f"number density = {info.number_density:.4g}, ")
+        + f"packing fraction = {info.packing_fraction:.4g}, model = {info.model}"
         + (f" (restitution {info.restitution:g})" if info.restitution is not None and info.model == "constant" else "")
         + (f" (prefactor k = {info.prefactor:.4g})" if info.prefactor is not None and info.model == "viscoelastic" else ""),
     ]
