@@ -32,6 +32,8 @@ from typing import Callable
 
 import numpy as np
 
+from granulargas.io.h5md import load_snapshot, read_parameters
+
 __all__ = ["Scene", "Statement", "STATEMENTS", "MODELS", "KINDS"]
 
 #: collision models the theory knows
@@ -105,8 +107,6 @@ class Scene:
     @classmethod
     def from_file(cls, path) -> "Scene":
         """The scene of one of our H5MD files."""
-        from granulargas.io.h5md import load_snapshot, read_parameters
-
         snap = load_snapshot(path, 0)
         return cls.from_parameters(read_parameters(path), snap.box.shape[0], snap.boundary, snap.radii,
                                    snap.masses, snap.contact_until is not None)
