@@ -28,6 +28,7 @@ counters a restart needs). The observables are those the runner samples
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -36,6 +37,7 @@ from granulargas import __version__, theory
 from granulargas.dsmc import DSMC
 from granulargas.io.h5md import H5MDWriter
 from granulargas.observables import sonine_coefficients
+from granulargas.state import State
 
 __all__ = ["RunWriter", "run_parameters", "rule_parameters", "observables"]
 
@@ -78,6 +80,22 @@ def _box(sim) -> np.ndarray:
 
 def _boundary(sim) -> tuple:
     return ("periodic",) * sim.dimension if _is_dsmc(sim) else tuple(sim.boundary)
+
+
+def _state(sim) -> State:
+    """The simulation's state (:class:`granulargas.state.State`) with a box (a DSMC given a density
+    has none: the cube of its volume)."""
+    state = sim.state
+    return state if state.box is not None else dataclasses.replace(state, box=_box(sim))
+
+
+def _fields(sim) -> tuple:
+    """The per-frame fields a restart of ``sim`` needs besides positions, velocities and images."""
+    if _is_dsmc(sim):
+        return ()
+    rule = sim.rule
+    tc = rule.kind == "constant" and rule.tc_time is not None
+    return (("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if rule.resolved else ())
 
 
 def run_parameters(sim) -> dict:
@@ -162,14 +180,9 @@ class RunWriter:
     def __init__(self, path, sim, *, overwrite: bool = False, parameters: dict | None = None):
         self.sim = sim
         self.dsmc = _is_dsmc(sim)
-        rule = sim.rule
-        self.tc = rule.kind == "constant" and rule.tc_time is not None
-        self.resolved = not self.dsmc and rule.resolved
         params = {**run_parameters(sim), **(parameters or {})}
-        self.writer = H5MDWriter(path, _box(sim), sim.radii, sim.masses, parameters=params,
-                                 last_collision=self.tc, overwrite=overwrite, boundary=_boundary(sim),
-                                 driven=sim.driving is not None, positions=not self.dsmc,
-                                 contacts=self.resolved)
+        self.writer = H5MDWriter(path, _state(sim), fields=_fields(sim), parameters=params, overwrite=overwrite,
+                                 driven=sim.driving is not None)
         self.path = self.writer.path
         self._last_sample = None
         try:
@@ -196,19 +209,11 @@ class RunWriter:
     def snapshot(self):
         """Append one frame (synchronising an engine run) and an observables sample at its time
         unless one was just taken."""
-        sim = self.sim
         if not self.dsmc:
-            sim.synchronise()
+            self.sim.synchronise()
         if self._clock() != self._last_sample:
             self.sample()
-        step, time = self._clock()
-        if self.dsmc:
-            self.writer.write_snapshot(step, time, None, sim.velocities, None, dsmc_state=sim.state)
-        else:
-            lc = np.asarray(sim.last_collision) if self.tc else None
-            contacts = (sim.contact_until, sim.contact_partner) if self.resolved else None
-            self.writer.write_snapshot(step, time, sim.positions, sim.velocities, sim.images, lc,
-                                       contacts=contacts)
+        self.writer.write_state(_state(self.sim))
 
     def close(self):
         """Record where the run ended (``parameters/summary``) and close the file."""

@@ -10,6 +10,7 @@ from granulargas.errors import InputFileError
 from granulargas.io.config import parse_config
 from granulargas.io.h5md import H5MDWriter, read_observables, read_parameters
 from granulargas.run.runner import run_config
+from granulargas.state import DSMCContinuation, State
 
 CONFIG = """
 [system]
@@ -58,20 +59,20 @@ def test_every_dataset_of_a_run_carries_a_checksum(run_file):
 
 def test_every_optional_element_carries_a_checksum(tmp_path):
     n, d = 20, 3
-    box, rng = np.full(d, 6.0), np.random.default_rng(1)
-    for kw in ({"last_collision": True, "contacts": True, "boundary": ("periodic", "periodic", "wall"),
-                "driven": True}, {"positions": False}):
-        path = tmp_path / f"{len(kw)}.h5"
-        with H5MDWriter(path, box, np.full(n, 0.5), np.ones(n), parameters={"table": np.zeros(3)}, **kw) as w:
+    rng = np.random.default_rng(1)
+    velocities, radii, masses = rng.normal(size=(n, d)), np.full(n, 0.5), np.ones(n)
+    engine = State(rng.uniform(1, 5, (n, d)), velocities, radii, masses, np.full(d, 6.0),
+                   boundary=("periodic", "periodic", "wall"), last_collision=np.zeros(n),
+                   contact_until=np.full(n, -np.inf), contact_partner=np.full(n, -1), kick_step=0)
+    dsmc = State(None, velocities, radii, masses, np.full(d, 6.0), dsmc=DSMCContinuation(
+        rng=np.zeros(5, np.uint64), candidates=0, pending_pair=(0, 0), pending_time=0.0,
+        frame_velocity=np.zeros(d)))
+    for name, state, fields in (("engine", engine, ("last_collision", "contact_until", "contact_partner")),
+                                ("dsmc", dsmc, ())):
+        path = tmp_path / f"{name}.h5"
+        with H5MDWriter(path, state, fields=fields, parameters={"table": np.zeros(3)}, driven=True) as w:
             w.write_observables(0, 0.0, {"temperature": 1.0})
-            if kw.get("positions", True):
-                w.write_snapshot(0, 0.0, rng.uniform(1, 5, (n, d)), rng.normal(size=(n, d)),
-                                 np.zeros((n, d), np.int64), np.zeros(n),
-                                 contacts=(np.full(n, -np.inf), np.full(n, -1)))
-            else:
-                w.write_snapshot(0, 0.0, None, rng.normal(size=(n, d)), None, dsmc_state={
-                    "rng": np.zeros(5, np.uint64), "candidates": 0, "pending_pair": (0, 0), "pending_time": 0.0,
-                    "frame_velocity": np.zeros(d)})
+            w.write_state(state)
             w.mark_interrupted("test")
         sets = _datasets(path)
         assert len(sets) > 15 and all(sets.values()), [k for k, v in sets.items() if not v]
