@@ -61,7 +61,7 @@ from granulargas.io.paths import existing_directory, output_file
 from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
 from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
-from granulargas.run.record import observables
+from granulargas.run.record import observables as _observables  # one sample, as RunWriter takes it
 from granulargas.run.variants import describe, variants_for
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
@@ -475,7 +475,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
     wall0, compiled0 = _time.perf_counter(), watch.seconds
     try:
         if not append:  # a continued file already holds the starting frame and its sample
-            writer.write_observables(sim.events, sim.time, observables(sim, False), flush=False)
+            writer.write_observables(sim.events, sim.time, _observables(sim, False), flush=False)
             snapshot()
         # the first frame (its observables' and synchronisation's kernels) is start-up too
         wall0, compiled0 = _time.perf_counter(), watch.seconds
@@ -492,7 +492,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
                 hit_budget = False
             if not (sample or hit_budget):
                 continue  # an engine pacing stop (run.schedule.pacing_stops): no output
-            writer.write_observables(sim.events, sim.time, observables(sim, True), flush=False)
+            writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
             last_sample = (sim.events, sim.time)
             if snap or hit_budget:
                 snapshot()
@@ -506,7 +506,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
         name = signal.Signals(stop.signum).name
         try:
             if (sim.events, sim.time) != last_sample:  # the stop may fall right after a sample
-                writer.write_observables(sim.events, sim.time, observables(sim, True), flush=False)
+                writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
             if (sim.events, sim.time) != frame[0]:  # ... or right after a scheduled frame
                 snapshot()
             writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
