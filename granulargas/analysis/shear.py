@@ -34,7 +34,8 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.analysis.cooling import block_mean
-from granulargas.analysis.run import RunInfo, _clean
+from granulargas.analysis.run import RunInfo, _clean, run_identity
+from granulargas.errors import InputFileError
 from granulargas.io.h5md import read_observables
 
 __all__ = ["ShearAnalysis", "analyze_shear", "shear_theory", "RELAXATION_FRACTION", "RELAXATION_COLLISIONS"]
@@ -175,9 +176,8 @@ class ShearAnalysis:
         """JSON-friendly numbers (``granulargas analyze --json``)."""
         r = self.reduced()
         st = self.theory.state
-        out = {"kind": self.kind, "model": self.info.model, "method": self.info.method,
-               "dimension": self.info.dimension, "particles": self.info.particles,
-               "packing_fraction": self.info.solid_fraction, "shear_rate": self.rate,
+        out = {**run_identity(self.info, self.kind), "method": self.info.method,
+               "solid_fraction": self.info.solid_fraction, "shear_rate": self.rate,
                "thermostat_temperature": self.thermostat, "theory": self.theory.name,
                "relaxed_from": self.t_relaxed, "t_final": float(self.time[-1]),
                "samples": int(np.count_nonzero(self.steady))}
@@ -205,7 +205,8 @@ def analyze_shear(path, **_) -> ShearAnalysis:
     thermostat = None if thermostat is None else float(thermostat)
     obs = read_observables(path)
     if "pressure_tensor" not in obs:
-        raise ValueError("the file holds no pressure_tensor observable")
+        raise InputFileError(f"{path}: the file holds no pressure_tensor observable, which the analysis of a "
+                             "sheared run needs (granulargas run and RunWriter write it)")
     _, t, T = obs["temperature"]
     t, idx = np.unique(np.asarray(t, dtype=float), return_index=True)
     T = np.asarray(T, dtype=float)[idx]
@@ -231,7 +232,7 @@ def analyze_shear(path, **_) -> ShearAnalysis:
         relax = max(relax, RELAXATION_COLLISIONS * free)
     t_relaxed = float(t[0] + relax)
     if t_relaxed >= t[-2]:
-        raise ValueError(f"the run ends at t = {t[-1]:.4g}, before the relaxation to the steady shear flow "
+        raise InputFileError(f"{path}: the run ends at t = {t[-1]:.4g}, before the relaxation to the steady shear flow "
                          f"(t = {t_relaxed:.4g}); run it longer")
     # the theory at the measured steady temperature (a viscoelastic gas's effective eps, a* with thermostat)
     a = ShearAnalysis(info, rate, thermostat, t, T, tensor, diss, inj, t_relaxed, th)
