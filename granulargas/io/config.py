@@ -891,6 +891,13 @@ def _check_shear(v: Values):
         v.fail("collision.duration", '"resolved" is not available with [shear] (Lees-Edwards boundaries)')
     if v.has("shear.thermostat_interval") and not v.has("shear.thermostat_temperature"):
         v.fail("shear.thermostat_interval", "needs shear.thermostat_temperature")
+    if v.section_given("driving"):
+        v.fail("driving.heating_rate", "[driving] is not available with [shear] (the shear's thermostat holds "
+                                       "the temperature of a sheared gas)")
+    lo, hi = v.get("particles.diameter.min"), v.get("particles.diameter.max")
+    if v.get("run.method") == "dsmc" and lo is not None and hi is not None and lo < hi:
+        v.fail("particles.diameter", 'the DSMC of uniform shear flow takes identical particles: one diameter '
+                                     '(or method = "edmd")', v.raw.get("particles.diameter"))
     if v.get("collision.model") == "elastic" and not v.has("shear.thermostat_temperature"):
         v.fail("shear.rate", 'an elastic gas only heats under shear and never reaches a steady state: give '
                              "shear.thermostat_temperature or an inelastic collision model")
@@ -927,8 +934,9 @@ RULES: tuple[Rule, ...] = (
     Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls and no `tc_time`.',
          _check_dsmc_supported),
     Rule('`[shear]` needs `rate` and `boundary` with `"lees-edwards"` on y and a periodic x (walls only on '
-         'z), and `"lees-edwards"` needs `[shear]`; not with `duration = "resolved"`; an elastic gas needs '
-         "the thermostat; `thermostat_interval` needs `thermostat_temperature`.", _check_shear),
+         'z), and `"lees-edwards"` needs `[shear]`; not with `duration = "resolved"` nor `[driving]`; with '
+         '`method = "dsmc"` one diameter; an elastic gas needs the thermostat; `thermostat_interval` needs '
+         "`thermostat_temperature`.", _check_shear),
 )
 
 

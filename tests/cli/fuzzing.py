@@ -64,6 +64,22 @@ BASES = {
         "run": {"collisions_per_particle": 1.0},
         "output": {"file": "out.h5"},
     },
+    "shear-3d": {
+        "system": {"dimension": 3, "particles": 64, "packing_fraction": 0.1, "seed": 6,
+                   "boundary": ["periodic", "lees-edwards", "periodic"]},
+        "collision": {"model": "constant", "restitution": 0.9},
+        "shear": {"rate": 0.4},
+        "run": {"end_time": 1.0},
+        "output": {"file": "out.h5", "snapshots": 2},
+    },
+    "shear-thermostat-2d": {
+        "system": {"dimension": 2, "particles": 100, "packing_fraction": 0.1, "seed": 7,
+                   "boundary": ["periodic", "lees-edwards"]},
+        "collision": {"model": "elastic"},
+        "shear": {"rate": 0.1, "thermostat_temperature": 1.0, "thermostat_interval": 0.05},
+        "run": {"end_time": 1.0, "method": "dsmc"},
+        "output": {"file": "out.h5", "snapshots": 2},
+    },
     "tc-2d": {
         "system": {"dimension": 2, "particles": 100, "packing_fraction": 0.3, "seed": 5},
         "collision": {"model": "constant", "restitution": 0.5, "tc_time": 1e-3},
