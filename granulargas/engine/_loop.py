@@ -448,7 +448,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
             eps = 1.0
         else:
             r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
-            eps_pair, k_pair = pair_law(rule, species, i, j)
+            eps_pair, k_pair = pair_law(rule.eps, rule.prefactor, species, i, j)
             eps = restitution(rule.kind, eps_pair, k_pair, rule.inv_h, rule.coeffs, -un,
                               r_eff, mi * mj / (mi + mj))
             if eps < 0.0:
@@ -529,7 +529,7 @@ def execute_wall(i, wall, te, p, c, walls, prm, species):
         if rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time:
             eps = 1.0
         else:
-            eps_wall, k_wall = wall_law(rule, species, i)
+            eps_wall, k_wall = wall_law(rule.wall_eps, rule.prefactor, species, i)
             eps = restitution(rule.kind, eps_wall, k_wall, rule.inv_h, rule.coeffs,
                               abs(vn), rec[i, 7], mi)
             if eps < 0.0:

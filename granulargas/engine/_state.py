@@ -67,8 +67,8 @@ Record layout
 * ``species`` :class:`Species` -- the collision law per pair of species
   (:mod:`granulargas.engine._species`): ``of`` i4 the species of each slot, ``count``
   the number S of species, ``eps`` and ``prefactor`` (S*S,) f8 the pair table,
-  ``wall_eps`` and ``wall_prefactor`` (S,) f8 per species, ``pairs`` (S*S,) i8 the pair
-  collision counts. None for a rule without a pair table, whose loop then compiles
+  ``wall_eps`` and ``wall_prefactor`` (S,) f8 per species, ``weight`` (S*S,) f8 the DSMC's
+  acceptance weights (ones in the engine), ``pairs`` (S*S,) i8 the pair collision counts. None for a rule without a pair table, whose loop then compiles
   without any of this.
 """
 
@@ -87,7 +87,8 @@ Grid = namedtuple("Grid", ["head", "cell", "width", "pair_t", "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
-Species = namedtuple("Species", ["of", "count", "eps", "prefactor", "wall_eps", "wall_prefactor", "pairs"])
+Species = namedtuple("Species", ["of", "count", "eps", "prefactor", "wall_eps", "wall_prefactor", "weight",
+                                 "pairs"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
                                "walls", "contacts", "species"])
 
@@ -160,15 +161,17 @@ def contacts(n: int, until=None, partner=None) -> Contacts:
     return Contacts(u, q, np.zeros(3), np.zeros(5))
 
 
-def species_record(of, table, pairs=None) -> Species:
+def species_record(of, table, pairs=None, weight=None) -> Species:
     """A :class:`Species` record for the slots' species ``of`` and a
-    :class:`granulargas.engine.pairs.PairTable` (``pairs``: the counts to continue from)."""
+    :class:`granulargas.engine.pairs.PairTable` (``pairs``: the counts to continue from;
+    ``weight`` (S, S): the DSMC's acceptance weights, default ones)."""
     size = table.count
     flat = lambda a: np.ascontiguousarray(np.asarray(a, dtype=np.float64).reshape(-1))  # noqa: E731
     counts = np.zeros(size * size, dtype=np.int64) if pairs is None else \
         np.ascontiguousarray(np.asarray(pairs, dtype=np.int64).reshape(-1))
     return Species(np.ascontiguousarray(of, dtype=np.int32), int(size), flat(table.restitution),
-                   flat(table.prefactor), flat(table.wall_restitution), flat(table.wall_prefactor), counts)
+                   flat(table.prefactor), flat(table.wall_restitution), flat(table.wall_prefactor),
+                   flat(np.ones((size, size)) if weight is None else weight), counts)
 
 
 def space(box3, period3, ncell, wall_axes, dims) -> Space:

@@ -29,6 +29,7 @@ from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
 from granulargas.engine._crossing import FRESH_SIZE, MARGIN, build_grid, particle_rows
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
+from granulargas.engine.pairs import pair_count_matrix, species_of_state
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import (
     ConfigError,
@@ -968,36 +969,6 @@ class Simulation:
         walls = "" if "wall" not in self.boundary else f", boundary={self.boundary}"
         return (f"Simulation(N={self.n}, d={self.dimension}, packing={self.packing_fraction:.4g}, "
                 f"rule={self.rule.kind}{walls}, time={self.time:.6g}, collisions={self.collisions})")
-
-
-def species_of_state(state: State, rule: CollisionRule):
-    """(species (N,) int32, raw pair counts (S*S,) int64) of a state for a rule with a pair table
-    of S species: every species index in [0, S); the counts to continue from are the state's
-    ``species_collisions`` (S, S) (their upper triangle, :func:`pair_count_matrix` inverted)."""
-    size = rule.pairs.count
-    of = state.array("species")
-    bad = np.flatnonzero((of < 0) | (of >= size))
-    if len(bad):
-        k = int(bad[0])
-        raise ConfigError(f"species: particle {k} has species {int(of[k])}, but the rule's pair table has "
-                          f"{size} species (indices 0 to {size - 1})")
-    counts = np.zeros((size, size), dtype=np.int64)
-    given = state.species_collisions
-    if given is not None:
-        given = np.asarray(given)
-        if given.shape != (size, size):
-            raise ConfigError(f"species_collisions: shape {given.shape}, the rule has {size} species")
-        counts = np.triu(given).astype(np.int64)
-    return np.ascontiguousarray(of, dtype=np.int32), counts.reshape(-1)
-
-
-def pair_count_matrix(raw, size: int) -> np.ndarray:
-    """The symmetric (S, S) collision counts per pair of species from the engine's raw counts
-    (S*S,) by ordered slot pair: C = R + R^T off the diagonal, R on it."""
-    r = np.asarray(raw, dtype=np.int64).reshape(size, size)
-    c = r + r.T
-    np.fill_diagonal(c, np.diagonal(r))
-    return c
 
 
 def _boundary(boundary, d):

@@ -58,7 +58,7 @@ from granulargas.errors import ConfigError, InelasticCollapseError, InputFileErr
 from granulargas.io.config import RunConfig, parse_config
 from granulargas.io.h5md import H5MDWriter, read_parameters
 from granulargas.io.paths import existing_directory, output_file
-from granulargas.observables import sonine_coefficients
+from granulargas.observables import sonine_coefficients, species_moments
 from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
 from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
@@ -347,7 +347,22 @@ def _observables(sim, pressure: bool) -> dict:
         out["kick_step"] = int(sim.kick_step)
     if sim.rule.resolved:
         out["three_body_contacts"] = int(sim.three_body_contacts)
+    out.update(species_observables(sim))
     return out
+
+
+def species_observables(sim) -> dict:
+    """The observables of a mixture (its rule has a pair table; else none): the temperature
+    and a2 of each species (:func:`granulargas.observables.species_moments`) and the collisions
+    per pair of species so far."""
+    size = sim.rule.species
+    if not size:
+        return {}
+    of = sim.species
+    of = np.zeros(sim.n, dtype=np.int32) if of is None else of
+    temperature, a2 = species_moments(sim.velocities, sim.masses, of, size)
+    return {"species_temperature": temperature, "species_sonine_a2": a2,
+            "species_collisions": np.asarray(sim.species_collisions, dtype=np.int64)}
 
 
 def collapse_message(config: RunConfig, where: str) -> str:
@@ -462,7 +477,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None)
+                            driven=sim.driving is not None, species=setup.rule.species)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached

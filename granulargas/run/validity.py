@@ -79,7 +79,7 @@ from granulargas.contact.material import damping_from_prefactor, rho_from_materi
 from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX
 from granulargas.theory.moments import speed_quadrature
-from granulargas.run.prepare import mean_particle, reduced_prefactor
+from granulargas.run.prepare import mean_particle, mean_restitution, reduced_prefactor
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -139,14 +139,19 @@ class RunGas(Gas):
 def gas_from_config(config) -> RunGas:
     """The gas of a :class:`~granulargas.io.config.RunConfig`: particles of the mean
     diameter (:func:`granulargas.run.prepare.mean_particle`), the reduced prefactor
-    (:func:`granulargas.run.prepare.reduced_prefactor`), the stop conditions."""
+    (:func:`granulargas.run.prepare.reduced_prefactor`), the stop conditions. A mixture is
+    checked as the one-component gas of its mean particle, mean restitution
+    (:func:`granulargas.run.prepare.mean_restitution`) and mean prefactor: the run checks need
+    its temperature range and collision times, which that gas gives to within the spread of
+    the species' temperatures."""
     s, c = config.system, config.collision
     d = s.dimension
     sigma, mass = mean_particle(config)
     k = float(reduced_prefactor(config)) if c.model == "viscoelastic" else None
     return RunGas(
         dimension=d, packing_fraction=s.packing_fraction, density=float(theory.number_density(s.packing_fraction, d, sigma)),
-        sigma=sigma, mass=mass, temperature=config.initial.temperature, model=c.model, restitution=c.restitution,
+        sigma=sigma, mass=mass, temperature=config.initial.temperature, model=c.model,
+        restitution=mean_restitution(config) if c.model == "constant" else c.restitution,
         prefactor=k, end=c.contact_end, end_time=config.run.end_time,
         collisions_per_particle=config.run.collisions_per_particle,
         tc_time=c.tc_time, material=c.material, source=config.source, duration=c.duration,
