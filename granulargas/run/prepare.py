@@ -511,20 +511,47 @@ def species_parameters(config: RunConfig) -> dict:
     return out
 
 
-def mixture_contact_values(config: RunConfig, state: State) -> np.ndarray:
-    """chi_ij (S, S) of a mixture's DSMC at the state's packing fraction: the one-component
-    contact value (:func:`granulargas.theory.contact_value`) for every pair when the species have
-    one diameter (so that a mixture of identical species is the one-component gas), else the
-    mixture's (:func:`granulargas.theory.mixture.mixture_contact_values`)."""
+def mixture_of_config(config: RunConfig) -> "theory.mixture.Mixture":
+    """The kinetic theory's view of a mixture config (:class:`granulargas.theory.mixture.Mixture`):
+    species, total number density of ``system.packing_fraction``, the law per pair (constant
+    eps_ij or viscoelastic k_ij), and the Enskog chi_ij at that packing fraction
+    (:func:`contact_values_at`)."""
     d = config.system.dimension
-    size = len(config.species)
+    sp = config.species
+    x = species_fractions(config)
+    diam = np.array([s.diameter for s in sp])
+    n = config.system.packing_fraction / float(np.sum(x * particle_volume(diam, d)))
+    c = config.collision
+    eps = pair_restitutions(config) if c.model == "constant" else None
+    k = pair_prefactors(config) if c.model == "viscoelastic" else None
+    as_tuple = lambda a: None if a is None else tuple(tuple(float(v) for v in row) for row in a)  # noqa: E731
+    return theory.mixture.Mixture(
+        names=config.species_names, masses=tuple(s.particle_mass(d) for s in sp), diameters=tuple(diam.tolist()),
+        counts=tuple(s.count for s in sp), dimension=d, number_density=float(n), restitution=as_tuple(eps),
+        prefactor=as_tuple(k), end=c.contact_end,
+        chi=as_tuple(contact_values_at(diam, x * n, config.system.packing_fraction, d)))
+
+
+def contact_values_at(diameters, densities, packing: float, dimension: int) -> np.ndarray:
+    """chi_ij (S, S) of species of ``diameters`` at number ``densities``: the one-component contact
+    value (:func:`granulargas.theory.contact_value`) for every pair when the species have one
+    diameter (so that a mixture of identical species is the one-component gas), else the
+    mixture's (:func:`granulargas.theory.mixture.mixture_contact_values`)."""
+    diam = np.asarray(diameters, dtype=float)
+    size = diam.size
+    if np.all(diam == diam[0]):
+        return np.full((size, size), float(theory.contact_value(packing, dimension)))
+    return theory.mixture.mixture_contact_values(diam, np.asarray(densities, dtype=float), dimension)
+
+
+def mixture_contact_values(config: RunConfig, state: State) -> np.ndarray:
+    """chi_ij (S, S) of a mixture's DSMC at the state's packing fraction (:func:`contact_values_at`)."""
+    d = config.system.dimension
     diam = np.array([sp.diameter for sp in config.species])
     volume = float(np.prod(state.box))
     packing = float(particle_volume(2.0 * state.radii, d).sum() / volume)
-    if np.all(diam == diam[0]):
-        return np.full((size, size), float(theory.contact_value(packing, d)))
     counts = np.array([sp.count for sp in config.species], dtype=float)
-    return theory.mixture.mixture_contact_values(diam, counts / volume, d)
+    return contact_values_at(diam, counts / volume, packing, d)
 
 
 def initial_state(config: RunConfig) -> State:

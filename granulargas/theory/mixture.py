@@ -80,6 +80,7 @@ contact values (:func:`granulargas.theory.contact_value` with ``form="closed"``)
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -89,6 +90,7 @@ from scipy.optimize import brentq, least_squares
 from granulargas.theory.enskog import _check_dim, particle_volume
 
 __all__ = [
+    "Mixture",
     "NOISES",
     "mixture_contact_values",
     "mixture_cooling_rates",
@@ -326,3 +328,116 @@ def temperature_history(times, initial, masses, diameters, densities, restitutio
     if not sol.success:
         raise ValueError(f"temperature_history: {sol.message}")
     return np.exp(sol.y.T)
+
+
+@dataclass(frozen=True)
+class Mixture:
+    """A homogeneous mixture for the theory of this module: what a run's config or file holds.
+
+    Attributes
+    ----------
+    names : tuple of str
+    masses, diameters, counts : tuples (S,)
+    dimension : int
+    number_density : float
+        Total number density n (particles per volume; reduced units).
+    restitution : tuple of tuples (S, S) or None
+        Constant eps_ij (None: viscoelastic, ``prefactor``; both None: elastic).
+    prefactor : tuple of tuples (S, S) or None
+        Viscoelastic k_ij: eps_ij(u) = eps(beta), beta = k_ij (R_eff u / m_eff^2)^(1/5), the
+        contact's eps(beta) of :mod:`granulargas.contact` (``end``).
+    end : str
+        The contact's end ("overlap" or "force").
+    chi : tuple of tuples (S, S) or None
+        Contact values (None: the dilute limit, 1).
+    """
+
+    names: tuple
+    masses: tuple
+    diameters: tuple
+    counts: tuple
+    dimension: int = 3
+    number_density: float = 0.0
+    restitution: tuple | None = None
+    prefactor: tuple | None = None
+    end: str = "overlap"
+    chi: tuple | None = None
+
+    @property
+    def fractions(self) -> np.ndarray:
+        c = np.asarray(self.counts, dtype=float)
+        return c / c.sum()
+
+    @property
+    def densities(self) -> np.ndarray:
+        """Number density of each species."""
+        return self.fractions * self.number_density
+
+    def restitution_law(self):
+        """What :func:`mixture_cooling_rates` takes: the (S, S) eps_ij, or for viscoelastic
+        particles a function ``eps(i, j, u)`` of the normal impact speed."""
+        size = len(self.names)
+        if self.prefactor is None:
+            return np.ones((size, size)) if self.restitution is None else np.array(self.restitution)
+        from granulargas.contact.material import pair_constant
+        from granulargas.contact.table import restitution_table
+
+        m = np.asarray(self.masses, dtype=float)
+        r = 0.5 * np.asarray(self.diameters, dtype=float)
+        k = np.asarray(self.prefactor, dtype=float)
+        b = np.array([[float(pair_constant(k[i, j], r[i], r[j], m[i], m[j])) for j in range(size)]
+                      for i in range(size)])
+        cache = {}
+
+        def eps(i, j, u):
+            # the table reaches beta = 40; the quadrature's fastest nodes (weights below e^-100)
+            # may lie beyond it, and get its end value
+            beta = np.minimum(b[i, j] * np.asarray(u, dtype=float) ** 0.2, 39.0)
+            top = float(np.max(beta)) if np.size(beta) else 0.0
+            table = cache.get("table")
+            if table is None or table.beta_limit <= top:
+                table = cache["table"] = restitution_table(min(max(top * 1.5, 1.0), 39.5), end=self.end)
+            return table.restitution(beta)
+        return eps
+
+    def _args(self):
+        chi = None if self.chi is None else np.asarray(self.chi, dtype=float)
+        return (np.asarray(self.masses, dtype=float), np.asarray(self.diameters, dtype=float), self.densities,
+                self.restitution_law(), self.dimension, chi)
+
+    def cooling_rates(self, temperatures) -> np.ndarray:
+        """zeta_i (S,) at the species' temperatures (:func:`mixture_cooling_rates`)."""
+        m, s, n, law, d, chi = self._args()
+        return mixture_cooling_rates(temperatures, m, s, n, law, d, chi)
+
+    def temperature_history(self, times, initial) -> np.ndarray:
+        """T_i(t) (len(times), S) from ``initial`` temperatures (:func:`temperature_history`)."""
+        m, s, n, law, d, chi = self._args()
+        return temperature_history(times, initial, m, s, n, law, d, chi)
+
+    def _balance(self, weight, guess_temperature: float) -> np.ndarray:
+        """T_i / T with zeta_i T_i weight_i equal, the rates evaluated at mixture temperature
+        ``guess_temperature`` (the constant-eps ratios do not depend on it)."""
+        m, s, n, law, d, chi = self._args()
+        x = self.fractions
+
+        def residual(g):
+            temp = np.exp(np.concatenate(([0.0], g)))
+            temp = temp / float(np.sum(x * temp)) * guess_temperature
+            zeta = mixture_cooling_rates(temp, m, s, n, law, d, chi) * weight(temp, m)
+            return (zeta[1:] - zeta[0]) / (np.abs(zeta[1:]) + abs(zeta[0]))
+
+        temp = np.exp(np.concatenate(([0.0], _solve_ratios(residual, m.size))))
+        return temp / float(np.sum(x * temp))
+
+    def hcs_ratios(self, temperature: float = 1.0) -> np.ndarray:
+        """T_i / T of the homogeneous cooling state (eq. (M1) with equal zeta_i); viscoelastic
+        particles: the quasi-static ratios at mixture temperature ``temperature``."""
+        return self._balance(lambda t, m: 1.0, temperature)
+
+    def driven_ratios(self, noise: str = "equal_heating", temperature: float = 1.0) -> np.ndarray:
+        """T_i / T of the white-noise driven state (:func:`driven_temperature_ratios`)."""
+        if noise not in NOISES:
+            raise ValueError(f"noise = {noise!r}: one of {', '.join(NOISES)}")
+        q = NOISES[noise]
+        return self._balance(lambda t, m: t / m ** (1.0 - q), temperature)

@@ -191,3 +191,23 @@ def test_bad_input():
         mixture_cooling_rates([1, 1], [1, 2], [1, 1], [1, 1], np.array([[0.9, 0.8], [0.7, 0.9]]))
     with pytest.raises(ValueError, match="one entry per species"):
         mixture_cooling_rates([1, 1], [1, 2], [1], [1, 1], 0.9)
+
+
+def test_mixture_record_and_viscoelastic_pairs():
+    from granulargas.contact import restitution
+    from granulargas.contact.material import pair_constant
+    from granulargas.theory.mixture import Mixture
+
+    mix = Mixture(("a", "b"), (4.0, 1.0), (1.0, 1.0), (50, 50), 3, 0.1, restitution=((0.8, 0.8), (0.8, 0.8)))
+    assert mix.hcs_ratios() == pytest.approx(hcs_temperature_ratios([4.0, 1.0], [1.0, 1.0], [0.5, 0.5], 0.8),
+                                             rel=1e-10)
+    assert mix.driven_ratios("equal_force") == pytest.approx(
+        driven_temperature_ratios([4.0, 1.0], [1.0, 1.0], [0.5, 0.5], 0.8, noise="equal_force"), rel=1e-10)
+    k = ((0.2, 0.3), (0.3, 0.1))
+    visco = Mixture(("a", "b"), (4.0, 1.0), (1.2, 0.8), (30, 70), 3, 0.1, prefactor=k)
+    law = visco.restitution_law()
+    u = np.array([0.1, 1.0, 3.0])
+    b = float(pair_constant(0.3, 0.6, 0.4, 4.0, 1.0))
+    assert law(0, 1, u) == pytest.approx(restitution(b * u**0.2), rel=1e-7)
+    # hotter gas, faster impacts, more inelastic: the ratios move with the temperature
+    assert abs(visco.hcs_ratios(1.0)[0] - visco.hcs_ratios(1e-4)[0]) > 1e-3
