@@ -49,6 +49,16 @@ g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
 over the run, plus the inelastic-collapse risk.
 
+8. A mixture (``[[species]]``, :func:`species_advice`): the temperature of each species,
+   which equipartition does not fix -- in the homogeneous cooling state (constant eps) or
+   at the run's end (viscoelastic: the species' balance equations integrated over the run)
+   or in the driven steady state, from the Maxwellian theory of Garzó & Dufty (1999) with
+   the Enskog chi_ij (:mod:`granulargas.theory.mixture`). The run's temperature range, the
+   clustering and the method are those of the one-component gas of the mixture's mean
+   particle and mean law (:func:`granulargas.run.validity.gas_from_config`); the
+   constant-versus-viscoelastic comparison of items 2-4 is one of one kind of particle and
+   is not made for a mixture.
+
 The prediction is the kinetic theory of :mod:`granulargas.theory.gas`: a homogeneous
 gas whose temperature and second Sonine coefficient a2 evolve together (moment
 equations with the exact eps(g)); it is checked against real runs in
@@ -69,8 +79,8 @@ from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import ConfigError
 from granulargas.run import validity as V
-from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds, reduced_compression,
-                                     reduced_prefactor)
+from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, mean_restitution, mixture_of_config,
+                                     oblique_bounds, reduced_compression, reduced_prefactor)
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
@@ -272,6 +282,8 @@ class Advice:
     duration, duration_reason : str or None
         The collision duration the contact time needs (:func:`choose_duration`) and why;
         None off the material route.
+    species : list of str
+        A mixture: the lines of :func:`species_advice`.
     notes : list of str
     """
 
@@ -292,10 +304,13 @@ class Advice:
     configured_method: str = "edmd"
     duration: str | None = None
     duration_reason: str = ""
+    species: tuple = ()
     notes: tuple = ()
 
     def lines(self) -> list[str]:
-        out = [f"run          T {1:g} -> {self.T_end:.3g} T0 by t = {self.t_end:.4g} (kinetic theory)"]
+        mean = " of the mean particle" if self.species else ""
+        out = [f"run          T {1:g} -> {self.T_end:.3g} T0 by t = {self.t_end:.4g} (kinetic theory{mean})"]
+        out += list(self.species)
         if self.model == "elastic":
             out.append("advice       elastic collisions: nothing to choose")
         if self.spread is not None:
@@ -388,6 +403,41 @@ def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.Cooling
     return cooling_curve(gas, t_end=t_end, t_min_ratio=None)
 
 
+def species_advice(config, t_end: float) -> list[str]:
+    """The temperature of each species of a mixture (module docstring, item 8), as lines: the
+    homogeneous cooling state's T_i / T (constant eps), T_i / T at the predicted end ``t_end``
+    of a viscoelastic run from equal temperatures at the start, or the driven steady state's
+    (granulargas's driving: the same heating rate dT_i/dt for every species)."""
+    mix = mixture_of_config(config)
+    c = config.collision
+    names = mix.names
+    driving = config.driving
+    t0 = config.initial.temperature
+
+    def listed(ratios):
+        return ", ".join(f"{n} {r:.4g}" for n, r in zip(names, ratios))
+
+    out = []
+    if c.model == "elastic":
+        return ["species      elastic collisions: every species keeps the temperature T (equipartition)"]
+    if driving is not None and driving.heating_rate > 0.0:
+        t_ss = float(theory.driven_temperature(driving.heating_rate, mean_restitution(config), mix.number_density,
+                                               mix.dimension, *mean_particle(config))) if c.model == "constant" else t0
+        ratios = mix.driven_ratios("equal_heating", t_ss)
+        return [f"species      driven steady state T_i / T: {listed(ratios)} (Garzó & Dufty 1999 Maxwellian, Enskog "
+                "chi_ij; the driving heats every species at the same dT_i/dt)"]
+    if c.model == "constant":
+        ratios = mix.hcs_ratios()
+        out.append(f"species      homogeneous cooling state T_i / T: {listed(ratios)} (Garzó & Dufty 1999 Maxwellian, "
+                   "Enskog chi_ij), reached from equal temperatures within a few collisions per particle")
+        return out
+    temps = mix.temperature_history(np.array([0.0, t_end]), np.full(len(names), t0))[-1]
+    ratios = temps / float(np.sum(mix.fractions * temps))
+    out.append(f"species      T_i / T at t = {t_end:.4g}: {listed(ratios)} (from equal temperatures; Maxwellian "
+               "balance of each species with eps_ij(g) per pair, Garzó & Dufty 1999)")
+    return out
+
+
 def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     """Advice on the collision rule for a config (module doc)."""
     gas = V.gas_from_config(config)
@@ -396,6 +446,16 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         raise ConfigError(table)
     t_end, T_end = V.run_temperature_range(gas)
     adv = Advice(gas.model, tolerance, t_end, T_end / gas.temperature, box=_box(config))
+    if config.species:
+        if gas.model == "viscoelastic" and gas.pair_constant > 0:
+            t_end, T_end = V.run_temperature_range(gas, V.viscoelastic_cooling(gas))
+            adv.t_end, adv.T_end = t_end, T_end / gas.temperature
+        adv.species = tuple(species_advice(config, adv.t_end))
+        adv.instability_length = gas.instability_length() if gas.model != "elastic" else math.nan
+        adv.notes = ("a mixture: the constant-versus-viscoelastic comparison is one of one kind of particle and is "
+                     "not made; the run and clustering lines are those of the mean particle",)
+        _set_method(adv, config)
+        return adv
     notes = []
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = V.viscoelastic_cooling(gas)
@@ -473,6 +533,8 @@ def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
 
     Returns None for elastic and driven runs (the advice compares cooling curves).
     """
+    if config.species:  # a mixture: the temperatures of its species
+        return "advice       " + advise(config, tolerance).species[0].split(None, 1)[1]
     driving = getattr(config, "driving", None)
     if driving is not None and driving.heating_rate > 0.0:
         return None

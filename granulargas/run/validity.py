@@ -69,17 +69,17 @@ Runner API (one line each, for the run summary)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from granulargas import theory
 from granulargas.contact import restitution_table
-from granulargas.contact.material import damping_from_prefactor, rho_from_material
+from granulargas.contact.material import damping_from_prefactor, effective_modulus, rho_from_material
 from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX
 from granulargas.theory.moments import speed_quadrature
-from granulargas.run.prepare import mean_particle, mean_restitution, reduced_prefactor
+from granulargas.run.prepare import mean_particle, mean_restitution, pair_weights, reduced_prefactor
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -154,8 +154,22 @@ def gas_from_config(config) -> RunGas:
         restitution=mean_restitution(config) if c.model == "constant" else c.restitution,
         prefactor=k, end=c.contact_end, end_time=config.run.end_time,
         collisions_per_particle=config.run.collisions_per_particle,
-        tc_time=c.tc_time, material=c.material, source=config.source, duration=c.duration,
+        tc_time=c.tc_time, material=_mean_material(config), source=config.source, duration=c.duration,
     )
+
+
+def _mean_material(config):
+    """``[collision.material]``; a mixture's: the contact stiffness of its mean pair, Y / (1 - nu^2)
+    = sum_ij w_ij 2 Y*_ij (weights :func:`granulargas.run.prepare.pair_weights`, Y* the pair's
+    effective modulus; nu = 0), for the collision times of the mean particle."""
+    m = config.collision.material
+    if m is None or not config.species:
+        return m
+    consts = [(sp.young_modulus or m.young_modulus, sp.poisson_ratio if sp.poisson_ratio is not None
+               else m.poisson_ratio) for sp in config.species]
+    w = pair_weights(config)
+    stiffness = sum(w[i, j] * 2.0 * effective_modulus(*a, *b) for i, a in enumerate(consts) for j, b in enumerate(consts))
+    return replace(m, young_modulus=float(stiffness), poisson_ratio=0.0)
 
 
 # ---------------------------------------------------------------- t_c / t_free
