@@ -132,7 +132,8 @@ class SpeciesConfig:
     ``count`` (given, or from ``fraction`` of ``system.particles``), ``diameter``, and
     ``mass`` or ``density`` (reduced, as in ``[particles]``); for the material route
     (``[collision.material]``) its Young modulus, Poisson ratio and dissipative constant
-    (SI; None: those of ``[collision.material]``)."""
+    (SI; None: those of ``[collision.material]``), and instead of a mass its material density
+    ``material_density`` (SI; the mass is then set from it when the config is read)."""
 
     name: str
     count: int
@@ -140,6 +141,7 @@ class SpeciesConfig:
     diameter: float = 1.0
     mass: float | None = None
     density: float | None = None
+    material_density: float | None = None
     young_modulus: float | None = None
     poisson_ratio: float | None = None
     dissipation_time: float | None = None
@@ -576,10 +578,14 @@ SCHEMA: tuple[Key, ...] = (
         default_text="1.0 when `density` is not given", unit="reference mass", low=SCALE_RANGE[0],
         high=SCALE_RANGE[1], reason=_SPEED, per_species=True),
     Key("species", "density", "number",
-        "Instead of `mass`: mass = density × π d³/6 (3D) or π d²/4 (2D); on the material route the "
-        "species' material density over that of `[collision.material]`.",
+        "Instead of `mass`: mass = density × π d³/6 (3D) or π d²/4 (2D), as `particles.density`.",
         unit="reference mass per reference volume", low=0.0, low_open=True, high=1e250,
         reason="finite; the mass it gives is checked like `mass`", per_species=True),
+    Key("species", "material_density", "number",
+        "The material route, instead of `mass` or `density`: the species' material density; a particle "
+        "of diameter d (reduced) has mass (material_density / `collision.material.density`) d³ (spheres, "
+        "also in 2D, as the reference mass).", unit="kg/m³", low=SI_RANGE[0], high=SI_RANGE[1],
+        reason="the reduced mass stays finite", per_species=True),
     Key("species", "young_modulus", "number",
         "The material route: the species' Young modulus (default: that of `[collision.material]`).",
         unit="Pa", low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite",
@@ -1143,6 +1149,19 @@ def _check_species_particles(v: Values):
             mass = rho * unit * v.get(f"species.{name}.diameter") ** dim
             if not SCALE_RANGE[0] <= mass <= SCALE_RANGE[1]:
                 v.fail(f"species.{name}.density", f"gives the mass {mass:.3g}, outside [1e-100, 1e100] ({_SPEED})")
+        if v.has(f"species.{name}.material_density"):
+            for other in ("mass", "density"):
+                if v.has(f"species.{name}.{other}"):
+                    v.fail(f"species.{name}.material_density", f"give one of mass, density, material_density "
+                                                               f"(the species gives {other})")
+            if not v.has("collision.material"):
+                v.fail(f"species.{name}.material_density", "is used with the material route: give "
+                                                           "[collision.material] (its density is the reference)")
+            mass = (v.get(f"species.{name}.material_density") / v.get("collision.material.density")
+                    * v.get(f"species.{name}.diameter") ** 3)
+            if not SCALE_RANGE[0] <= mass <= SCALE_RANGE[1]:
+                v.fail(f"species.{name}.material_density", f"gives the mass {mass:.3g}, outside [1e-100, 1e100] "
+                                                           f"({_SPEED})")
 
 
 def _check_species_material(v: Values):
@@ -1440,7 +1459,10 @@ def _assemble(values: Values, source: str, text: str) -> RunConfig:
     parts = {s: section(s) if s not in OPTIONAL_SECTIONS or s in values.sections else None
              for s in SECTIONS if s not in ARRAY_SECTIONS}
     for name in values.species:
-        if v[f"species.{name}.mass"] is None and v[f"species.{name}.density"] is None:
+        if v[f"species.{name}.material_density"] is not None:  # the reduced mass of the material route
+            v[f"species.{name}.mass"] = (v[f"species.{name}.material_density"] / v["collision.material.density"]
+                                         * v[f"species.{name}.diameter"] ** 3)
+        elif v[f"species.{name}.mass"] is None and v[f"species.{name}.density"] is None:
             v[f"species.{name}.mass"] = 1.0
     species = tuple(SpeciesConfig(name=name, **{k.attribute: v[f"species.{name}.{k.key}"] for k in SCHEMA
                                                 if k.per_species and k.key != "name"})
@@ -1501,6 +1523,8 @@ def dump_toml(config: RunConfig) -> str:
         lines.append(f"count = {sp.count}")  # resolved: the counts the run uses
         for key in SCHEMA:
             if key.per_species and key.key not in ("name", "count", "fraction"):
+                if key.key == "mass" and sp.material_density is not None:
+                    continue  # set from material_density
                 value = getattr(sp, key.attribute)
                 if value is not None:
                     lines.append(f"{key.key} = {_toml_value(value)}")
