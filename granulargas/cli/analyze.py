@@ -7,7 +7,8 @@ cooling runs against the kinetic theory of :mod:`granulargas.theory.gas`, elasti
 against the equation of state and Enskog's collision frequency, driven runs' steady
 state against :mod:`granulargas.theory.driven`; a run with walls also gets the wall
 pressure and the density across the walls, :mod:`granulargas.analysis.walls`, and
-``--plot`` a second figure of the density profile) or a sweep's output
+``--plot`` a second figure of the density profile; a mixture also gets the temperature of each
+species against :mod:`granulargas.analysis.species` and a figure of T_i/T_j) or a sweep's output
 directory (its ``index.json``: one row per parameter set, mean +- standard error over
 the seeds). ``--json`` prints one JSON object instead of the text report.
 """
@@ -334,14 +335,23 @@ def run(args) -> int:
 
         t_from = getattr(a, "t_equilibrated", getattr(a, "t_relaxed", float(a.time[0])))
         walls = wall_summary(a.info, t_from)
+    from granulargas.analysis.species import analyze_species
+
+    try:
+        species = analyze_species(args.file, a.info.box, a.info.dimension)
+    except (ValueError, ArithmeticError, KeyError) as exc:
+        raise InputFileError(f"{args.file}: cannot analyse the species ({exc or type(exc).__name__})") from None
     if args.json:
         out = a.summary()
         out["method"] = a.info.method
         if walls is not None:
             out["walls"] = walls
+        if species is not None:
+            out["species"] = species.summary()
         print(json.dumps(out, indent=1, ensure_ascii=False, default=float))
     else:
-        print(report(a, rows=args.rows) + ("\n" + walls_report(walls) if walls is not None else ""))
+        print(report(a, rows=args.rows) + ("\n" + walls_report(walls) if walls is not None else "")
+              + ("\n" + "\n".join(species.lines()) if species is not None else ""))
     if args.plot:
         from granulargas.analysis.plots import plot_analysis, plot_density_profiles  # matplotlib only when asked
 
@@ -350,6 +360,11 @@ def run(args) -> int:
         if walls is not None:
             p = Path(args.plot)
             extra.append(plot_density_profiles(a.info, walls, p.with_name(p.stem + "_profile" + p.suffix)))
+        if species is not None:
+            from granulargas.analysis.species import plot_species
+
+            p = Path(args.plot)
+            extra.append(plot_species(species, p.with_name(p.stem + "_species" + p.suffix)))
         if not args.json:
             print("  wrote " + ", ".join(str(x) for x in [args.plot] + extra))
     if args.velocity:
