@@ -56,6 +56,7 @@ class SpeciesAnalysis:
     steady: np.ndarray | None
     theory_name: str
     collisions: np.ndarray
+    counts: tuple = ()
 
     @property
     def ratios(self) -> np.ndarray:
@@ -80,9 +81,25 @@ class SpeciesAnalysis:
         half = len(self.time) // 2
         return [float(np.mean(self.theory_ratios[half:, i])) for i in range(self.ratios.shape[1])]
 
+    @property
+    def fractions(self) -> np.ndarray:
+        c = np.asarray(self.counts, dtype=float)
+        return c / c.sum()
+
+    def mixture_ratio(self) -> float:
+        """T / T_theory of the mixture temperature T = sum x_i T_i at the last sample (nan without
+        a prediction)."""
+        if self.theory_temperatures is None:
+            return math.nan
+        x = self.fractions
+        return float(self.temperatures[-1] @ x / (self.theory_temperatures[-1] @ x))
+
     def lines(self) -> list[str]:
         last = self.names[-1]
         out = [f"species      {', '.join(self.names)}; theory: {self.theory_name}"]
+        if self.theory_temperatures is not None:
+            out.append(f"  T = sum x_i T_i: T/T_theory = {self.mixture_ratio():.4f} at the last sample (the mixture's "
+                       "own Maxwellian theory; the Sonine corrections it leaves out shift it by a few per cent)")
         for i, ((m, e), th) in enumerate(zip(self.late(), self.late_theory())):
             steady = "" if self.steady is None else f", steady state {self.steady[i] / self.steady[-1]:.4f}"
             dev = "" if not math.isfinite(th) else f" ({100 * (m / th - 1):+.2f} %)"
@@ -98,7 +115,7 @@ class SpeciesAnalysis:
                 "ratios_late": [{"pair": f"{self.names[i]}/{self.names[-1]}", "value": m, "error": e, "theory": th}
                                 for i, ((m, e), th) in enumerate(zip(self.late(), self.late_theory()))],
                 "steady": None if self.steady is None else [float(x) for x in self.steady],
-                "collisions": self.collisions.tolist()}
+                "collisions": self.collisions.tolist(), "T_over_theory_final": self.mixture_ratio()}
 
 
 def _mixture(parameters: dict, box, dimension: int) -> Mixture | None:
@@ -159,7 +176,8 @@ def analyze_species(path, box, dimension: int) -> SpeciesAnalysis | None:
             steady = mix.hcs_ratios() if mix.restitution is not None else None
             name = ("Maxwellian balance dT_i/dt = -zeta_i T_i from the first sample (Garzó & Dufty 1999, Enskog "
                     "chi_ij" + ("; eps_ij(g) of the viscoelastic pairs)" if mix.prefactor is not None else ")"))
-    return SpeciesAnalysis(names, np.asarray(t), s, np.asarray(temps), predicted, steady, name, pairs)
+    return SpeciesAnalysis(names, np.asarray(t), s, np.asarray(temps), predicted, steady, name, pairs,
+                           tuple(int(c) for c in params["species"]["counts"]))
 
 
 def plot_species(sa: SpeciesAnalysis, path) -> str:

@@ -82,6 +82,10 @@ def _header(info) -> list[str]:
         lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
                      f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
                      f"same number density (packing {info.packing_fraction:.4g})")
+    if info.scene.shows("mixture_mean_particle"):
+        lines.append(f"  note: a mixture; the T(t) theory below is that of identical particles of the mean diameter "
+                     f"{info.diameter:.4g} and its mass {info.mass:.4g} with the mean law; the species section at the "
+                     "end compares each species and T = sum x_i T_i with the mixture's own theory")
     return lines
 
 

@@ -61,7 +61,7 @@ the steady state has zeta_i T_i = H_i (:func:`driven_temperature_ratios`):
   every species; then zeta_i T_i is the same for all. This is granulargas's driving
   (:mod:`granulargas.engine._drive`, eq. (1));
 * ``"equal_acceleration"`` (q = 0): the same acceleration variance for every particle:
-  zeta_i T_i / m_i equal (Henrique, Batrouni & Bideau 2000; Barrat & Trizac 2002);
+  zeta_i T_i / m_i equal (Barrat & Trizac 2002);
 * ``"equal_force"`` (q = 2): the same force variance: zeta_i T_i m_i equal.
 
 Contact values of a mixture
