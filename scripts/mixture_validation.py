@@ -98,7 +98,12 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--figure")
     ap.add_argument("--json")
+    ap.add_argument("--replot", metavar="JSON", help="only draw --figure from the table a previous --json wrote")
     args = ap.parse_args()
+    if args.replot:
+        with open(args.replot) as fh:
+            plot(json.load(fh)["rows"], args.figure)
+        return
     start = time.perf_counter()
     rows = []
     print(f"{'m1/m2':>6} {'s1/s2':>6} {'eps':>5} {'theory':>8} {'DSMC':>16} {'dev':>7} {'EDMD':>16} {'dev':>7}")
@@ -171,20 +176,19 @@ def plot(rows, path):
                         for r in hcs], rotation=60, fontsize=7)
     ax.set_xlabel("m1/m2, sigma1/sigma2, eps (equal numbers)")
     ax.set_ylabel("T1 / T2")
-    ax.set_yscale("log")
     ax.legend(fontsize=8)
     ax.set_title("homogeneous cooling and driven states", fontsize=10)
     dense = [r for r in rows if r["kind"] == "hcs-dense"]
     y = np.arange(len(dense))
-    bx.plot(y, [r["theory"] for r in dense], "k_", ms=18, mew=2, label="Enskog (BGHLM chi_ij)")
-    bx.plot(y, [r["theory_dilute"] for r in dense], "_", color="0.6", ms=18, mew=2, label="dilute")
+    bx.plot(y, [r["theory_dilute"] for r in dense], "_", color="0.6", ms=24, mew=4, label="dilute")
+    bx.plot(y, [r["theory"] for r in dense], "k_", ms=18, mew=2, label="Enskog (BGHLM chi_ij; one size: = dilute)")
     bx.errorbar(y, [r["edmd"] for r in dense], yerr=[r["edmd_error"] for r in dense], fmt="s", ms=4, color="C1",
                 label="EDMD")
     bx.set_xticks(y)
     bx.set_xticklabels([f"{r['mass_ratio']:g}, {r['size_ratio']:g}, {r['eps']:g}\nphi {r['packing']:g}"
                         for r in dense], fontsize=7)
     bx.set_ylabel("T1 / T2")
-    bx.legend(fontsize=8)
+    bx.legend(fontsize=8, loc="upper right")
     bx.set_title("finite density", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -86,7 +86,8 @@ from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX
 from granulargas.io.scene import Scene
 from granulargas.theory.moments import speed_quadrature
-from granulargas.run.prepare import mean_particle, mean_restitution, pair_weights, reduced_prefactor, species_fractions
+from granulargas.run.prepare import (mean_particle, mean_restitution, mixture_of_config, pair_weights, reduced_prefactor,
+                                     species_fractions)
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -434,6 +435,8 @@ def check_run(config) -> RunValidity:
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = viscoelastic_cooling(gas)
     t_end, ln_T_end = predicted_end(gas, curve)
+    if not isinstance(config, RunGas) and config.species and gas.model != "elastic":
+        t_end, ln_T_end = _mixture_end(config, gas)
     T_end = math.exp(ln_T_end)
     if curve is not None:
         spread = restitution_spread(gas, gas.temperature, max(T_end, 1e-300))
@@ -468,6 +471,14 @@ def check_run(config) -> RunValidity:
         if clock:
             rv.errors.append(clock)
     return rv
+
+
+def _mixture_end(config, gas) -> tuple[float, float]:
+    """(t_end, ln T_end) of a mixture: its own Maxwellian theory, every species cooling at its
+    rate (:meth:`granulargas.theory.mixture.Mixture.predicted_end`); T = sum x_i T_i."""
+    mix = mixture_of_config(config)
+    t_end, temps = mix.predicted_end(gas.temperature, gas.end_time, gas.collisions_per_particle)
+    return float(t_end), math.log(float(mix.fractions @ temps))
 
 
 def _clock_error(gas, t_end: float, ln_T_end: float, key: str) -> str | None:

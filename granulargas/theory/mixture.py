@@ -415,6 +415,53 @@ class Mixture:
         m, s, n, law, d, chi = self._args()
         return temperature_history(times, initial, m, s, n, law, d, chi)
 
+    def collision_frequencies(self, temperatures) -> np.ndarray:
+        """Collisions per unit time of a particle of each species (S,), Maxwellians at
+        ``temperatures``: nu_i = sum_j K_d chi_ij n_j sigma_ij^(d-1) ((T_i/m_i + T_j/m_j)/2)^(1/2),
+        K_d = 2 pi^((d-1)/2) / Gamma(d/2) (the mean relative speed times the cross section; one
+        species: the Enskog frequency of :func:`granulargas.theory.collision_frequency`)."""
+        m, sig, n, _, d, chi = self._args()
+        temp = np.asarray(temperatures, dtype=float)
+        chi = np.ones((m.size, m.size)) if chi is None else chi
+        k_d = 2.0 * math.pi ** ((d - 1) / 2.0) / math.gamma(d / 2.0)
+        sij = 0.5 * (sig[:, None] + sig[None, :])
+        speed = np.sqrt(0.5 * (temp / m)[:, None] + 0.5 * (temp / m)[None, :])
+        return k_d * np.sum(chi * n[None, :] * sij ** (d - 1) * speed, axis=1)
+
+    def predicted_end(self, temperature: float, end_time: float | None = None,
+                      collisions_per_particle: float | None = None) -> tuple[float, np.ndarray]:
+        """(t_end, T_i at t_end) of a cooling run from every species at ``temperature``: the
+        balance dT_i/dt = -zeta_i T_i with the collisions per particle ds/dt = sum_i x_i nu_i,
+        up to ``end_time`` or ``collisions_per_particle`` (s = 2 C / N), whichever comes first."""
+        if end_time is None and collisions_per_particle is None:
+            raise ValueError("predicted_end needs end_time or collisions_per_particle")
+        size = len(self.names)
+        t0 = np.full(size, float(temperature))
+        x = self.fractions
+        zeta0 = self.cooling_rates(t0)
+        nu0 = float(x @ self.collision_frequencies(t0))
+        scale = 1.0 / max(float(np.max(np.abs(zeta0))), nu0)
+
+        def rhs(u, y):
+            dt_du = scale * math.exp(u)
+            temps = np.exp(y[:size])
+            return np.concatenate((-self.cooling_rates(temps) * dt_du,
+                                   [float(x @ self.collision_frequencies(temps)) * dt_du]))
+
+        events = []
+        if collisions_per_particle is not None:
+            def reached(u, y):
+                return y[size] - collisions_per_particle
+            reached.terminal = True
+            events.append(reached)
+        u_end = math.log1p(end_time / scale) if end_time is not None else 200.0
+        sol = solve_ivp(rhs, (0.0, u_end), np.concatenate((np.log(t0), [0.0])), method="LSODA", rtol=1e-9,
+                        atol=1e-12, events=events or None)
+        if sol.status == -1:
+            raise ValueError(f"predicted_end: {sol.message}")
+        u = float(sol.t[-1])
+        return scale * math.expm1(u), np.exp(sol.y[:size, -1])
+
     def _balance(self, weight, guess_temperature: float) -> np.ndarray:
         """T_i / T with zeta_i T_i weight_i equal, the rates evaluated at mixture temperature
         ``guess_temperature`` (the constant-eps ratios do not depend on it)."""

@@ -211,3 +211,19 @@ def test_mixture_record_and_viscoelastic_pairs():
     assert law(0, 1, u) == pytest.approx(restitution(b * u**0.2), rel=1e-7)
     # hotter gas, faster impacts, more inelastic: the ratios move with the temperature
     assert abs(visco.hcs_ratios(1.0)[0] - visco.hcs_ratios(1e-4)[0]) > 1e-3
+
+
+def test_collision_frequencies_and_predicted_end():
+    from granulargas.theory.mixture import Mixture
+
+    # one kind of particle under two names: the Enskog collision frequency and Haff's law
+    mix = Mixture(("a", "b"), (1.0, 1.0), (1.0, 1.0), (30, 70), 3, 0.05, restitution=((0.8, 0.8), (0.8, 0.8)))
+    nu = mix.collision_frequencies([1.0, 1.0])
+    assert nu == pytest.approx([float(theory.collision_frequency(0.05, 1.0, 3, chi=1.0))] * 2, rel=1e-13)
+    zeta = float(theory.enskog_cooling_rate(0.8, 0.05, 1.0, 3, chi=1.0, a2=0.0))
+    t, T = mix.predicted_end(1.0, end_time=50.0)
+    assert t == pytest.approx(50.0, rel=1e-9)
+    assert T == pytest.approx([1.0 / (1 + zeta * 50 / 2) ** 2] * 2, rel=1e-6)
+    # Haff in collisions: T = exp(-(1 - eps^2) s / d) at a2 = 0
+    t, T = mix.predicted_end(1.0, collisions_per_particle=20.0)
+    assert T[0] == pytest.approx(math.exp(-(1 - 0.8**2) * 20 / 3), rel=1e-6)
