@@ -188,6 +188,8 @@ def plot(rows, path):
     bx.set_xticklabels([f"{r['mass_ratio']:g}, {r['size_ratio']:g}, {r['eps']:g}\nphi {r['packing']:g}"
                         for r in dense], fontsize=7)
     bx.set_ylabel("T1 / T2")
+    top = max(r["edmd"] + r["edmd_error"] for r in dense)
+    bx.set_ylim(top=1.0 + 1.3 * (top - 1.0))  # room for the legend above the points
     bx.legend(fontsize=8, loc="upper right")
     bx.set_title("finite density", fontsize=10)
     fig.tight_layout()
