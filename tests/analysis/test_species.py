@@ -75,3 +75,15 @@ def test_analyze_reports_and_draws_the_species(dsmc_file, tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["species"]["names"] == ["heavy", "light"]
     assert summary["species"]["ratios_late"][0]["pair"] == "heavy/light"
+
+
+def test_observables_table_names_the_species(dsmc_file):
+    pytest.importorskip("pandas")
+    import granulargas as gg
+
+    df = gg.load_run(dsmc_file).observables()
+    assert {"species_temperature_heavy", "species_temperature_light", "species_sonine_a2_heavy",
+            "species_collisions_heavy_light"} <= set(df.columns)
+    x = np.array([0.5, 0.5])
+    mixed = df[["species_temperature_heavy", "species_temperature_light"]].to_numpy() @ x
+    np.testing.assert_allclose(mixed, df["temperature"].to_numpy(), rtol=1e-12)
