@@ -29,6 +29,7 @@ from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
 from granulargas.engine._crossing import FRESH_SIZE, MARGIN, build_grid, particle_rows
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
+from granulargas.engine.pairs import pair_count_matrix, species_of_state
 from granulargas.engine.rules import CollisionRule
 from granulargas.engine.shear import Shear
 from granulargas.errors import (
@@ -306,6 +307,10 @@ class Simulation:
             raise ConfigError("contact_partner: particle ids in [0, N) or -1; contact_until: no NaN")
         self._contact_until, self._contact_partner = cu, cp
         self._three_body = state.three_body_contacts
+        # a mixture: the species of every particle index the rule's pair table
+        self._species_of = self._pair_counts = None
+        if rule.pairs is not None:
+            self._species_of, self._pair_counts = species_of_state(state, rule)
         # per-particle fields the engine does not use: kept as they are, returned by ``state``
         self._carried = {f.name: getattr(state, f.name).copy() for f in PARTICLE_FIELDS
                          if f.name not in OWN_FIELDS and getattr(state, f.name) is not None}
@@ -362,8 +367,9 @@ class Simulation:
             want = default_shell(self.packing_fraction, d) if shell is None else float(shell)
         if want <= 0 and self.neighbours == "lists":
             raise ConfigError(f"shell = {want}: must be > 0")
-        # at least 3 cells per side so that the 27 neighbour cells are distinct
-        fit = float(bx.min()) / 3.0 - dmax
+        # at least 3 cells per side so that the 27 neighbour cells are distinct (the margin keeps
+        # floor(L / cut) at 3 when the shell is cut to fit: L / (L / 3) can round to just below 3)
+        fit = float(bx.min()) / 3.0 * (1.0 - 1e-12) - dmax
         if float(bx.min()) < MIN_BOX_DIAMETERS * dmax:
             short = [f"{'xyz'[a]} ({self.boundary[a]})" for a in range(d)
                      if bx[a] < MIN_BOX_DIAMETERS * dmax]
@@ -519,7 +525,11 @@ class Simulation:
             _shear.stress_sums(rec, particles.mass, spc.shear, stress[0]["s"])
             stress[0]["k"] = self._stress_window[:6]
             stress[0]["w"] = self._stress_window[6:]
-        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts, stress)
+        # a rule without a pair table compiles the loop without the species (None)
+        species = None if self._species_of is None else _state.species_record(
+            self._species_of[order], self.rule.pairs, self._pair_counts)
+        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts,
+                                     stress, species)
         self._place_events(self._time)
         self._built = True
 
@@ -763,6 +773,8 @@ class Simulation:
                 self._stress_window = np.concatenate([e.stress[0]["k"], e.stress[0]["w"]])
             if self.shear is not None:
                 self._rescale_step = int(self._space.shear.rescales[0])
+            if e.species is not None:
+                self._pair_counts = e.species.pairs.copy()
             if e.contacts is not None:
                 self._contact_until = np.empty(n)
                 self._contact_until[inv] = e.contacts.until
@@ -913,6 +925,16 @@ class Simulation:
         return self._carried["species"].copy() if "species" in self._carried else None
 
     @property
+    def species_collisions(self) -> np.ndarray | None:
+        """Pair collisions so far per pair of species (S, S), symmetric: entry (a, b) counts the
+        collisions between a particle of species a and one of species b (None without a pair
+        table in the rule)."""
+        if self._species_of is None:
+            return None
+        raw = self._engine.species.pairs if self._built else self._pair_counts
+        return pair_count_matrix(raw, self.rule.pairs.count)
+
+    @property
     def state(self) -> State:
         """The public state as a record (:class:`granulargas.state.State`): a synchronised copy at
         ``time``, particles in id order, every counter; ``Simulation(sim.state, rule, ...)``
@@ -932,7 +954,7 @@ class Simulation:
             time=self.time, collisions=self.collisions, events=self.events,
             dissipated_energy=self.dissipated_energy, wall_collisions=self.wall_collisions,
             injected_energy=self.injected_energy, kick_step=None if self.driving is None else self.kick_step,
-            three_body_contacts=self.three_body_contacts,
+            three_body_contacts=self.three_body_contacts, species_collisions=self.species_collisions,
             **{name: value.copy() for name, value in self._carried.items()})
 
     # ------------------------------------------------------------ observables
@@ -1120,3 +1142,6 @@ def _check_shear(boundary, shear, rule):
     if rule.resolved:
         raise ConfigError('shear: collisions that take time (duration = "resolved") are not available '
                           'with Lees-Edwards boundaries')
+    if getattr(rule, "pairs", None) is not None:
+        raise ConfigError("shear: mixtures (a collision rule with a species table) are not available with "
+                          "Lees-Edwards boundaries")

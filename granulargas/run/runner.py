@@ -438,7 +438,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
                             driven=sim.driving is not None or (setup.shear is not None and setup.shear.thermostat),
-                            tensor=not dsmc or setup.shear is not None)
+                            tensor=not dsmc or setup.shear is not None, species=setup.rule.species)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached
