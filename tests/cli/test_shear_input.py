@@ -52,6 +52,9 @@ BAD = {
     "interval without temperature": (_with("rate = 0.114", "rate = 0.114\nthermostat_interval = 0.1"),
                                      "shear.thermostat_interval = 0.1: needs shear.thermostat_temperature"),
     "driving": (SHEARED + "\n[driving]\nheating_rate = 0.1\n", "[driving] is not available with [shear]"),
+    "species": (SHEARED + '\n[[species]]\nname = "a"\ncount = 100\ndiameter = 1.0\nmass = 1.0\n'
+                '\n[[species]]\nname = "b"\ncount = 100\ndiameter = 1.0\nmass = 2.0\n',
+                "[shear] is not available with [[species]]"),
     "dsmc polydisperse": (_with("[run]\n", '[particles]\ndiameter = { min = 0.8, max = 1.2 }\n\n[run]\nmethod = "dsmc"\n'),
                           "the DSMC of uniform shear flow takes identical particles"),
     "rate far from steady in the run time": (_with("rate = 0.114", "rate = 0.001"),
