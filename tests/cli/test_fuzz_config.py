@@ -29,6 +29,7 @@ from hypothesis import strategies as st
 from tests.cli.fuzzing import (
     BASES,
     EXTREMES,
+    SHEAR_BASES,
     MutatedConfig,
     Mutation,
     _apply,
@@ -157,6 +158,12 @@ def test_run_any_config_long(mc):
     _property_run(mc)
 
 
+@settings(parent=FAST, max_examples=60)
+@given(mutated_config(bases=SHEAR_BASES))
+def test_run_any_sheared_config(mc):
+    _property_run(mc)
+
+
 def _property_advise(mc):
     o, _, _ = _run_command(mc, ["advise", "c.toml"], output_made=False)
     assert o.code in (0, 2), o.stderr
@@ -168,6 +175,12 @@ def _property_advise(mc):
 @example(case("constant-3d", ("particles.mass", 6.666666666666668e49)))  # ValueError in the bracket
 @example(case("viscoelastic-2d", ("collision.damping!", 26.484131033112767)))  # the theory's nodes beyond the table
 def test_advise_any_config(mc):
+    _property_advise(mc)
+
+
+@settings(parent=FAST, max_examples=40)
+@given(mutated_config(bases=SHEAR_BASES))
+def test_advise_any_sheared_config(mc):
     _property_advise(mc)
 
 
