@@ -140,6 +140,8 @@ def _property_run(mc):
 @example(case("constant-3d", ("particles.mass!", 1e-50)))  # hang in the engine's calendar (pacing stops)
 @example(case("constant-3d", ("particles.mass", 6.666666666666668e49)))  # ValueError in advise's bracket
 @example(case("material-3d", ("collision.material.young_modulus", 2**63 - 1)))  # table range: exit 3, not 2
+@example(case("constant-3d", ("sytem.particle!", 0)))  # misspelt section and key: suggested only `system`
+@example(case("constant-3d", ("extra.particle!", 0)))  # an unknown section nothing is near: the key as given
 # the cases
 @example(case("constant-3d", ("particles.mass", 1e-300)))
 @example(case("constant-3d", ("system.packing_fraction", 1e-300)))
