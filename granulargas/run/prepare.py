@@ -444,9 +444,17 @@ def make_driving(config: RunConfig, prefactor: float | None, state: InitialState
     return WhiteNoise(h, interval, seed=s.seed), params
 
 
+def check_rough_supported(config: RunConfig) -> None:
+    """Refuse rough particles (``[collision.tangential]``) where the engine does not simulate them."""
+    if config.collision.rough:
+        raise ConfigError(f"{config.source}: collision.tangential = {{...}}: rough particles have a theory "
+                          "(granulargas.theory.rough) but the engine and the DSMC do not simulate spins yet")
+
+
 def initial_state(config: RunConfig) -> InitialState:
     """The state a run of ``config`` starts from: the restart file's last snapshot
     (``initial.from``) or a fresh random state."""
+    check_rough_supported(config)
     if config.initial.from_file:
         return restart_state(config)
     return fresh_velocities(config) if config.run.method == "dsmc" else fresh_state(config)
