@@ -60,6 +60,11 @@ Record layout
   contact's partner (-1: none); work space ``work`` (3,) and ``out`` (5,) f8 of
   the table lookup. None for the other rules, whose loop then compiles without
   any of this (:func:`granulargas.engine._loop.in_contact`).
+* ``spins`` :class:`Spins` -- rough particles (:mod:`granulargas.engine._spin`):
+  ``w`` (N, 3) f8 angular velocities (2D: the z column), ``kappa`` (N,) f8 = I / (m R^2),
+  and the tangential law (``model``, ``beta``, ``mu``, ``wall_beta``, ``wall_mu``) and the
+  spin-kick scale of the driving (``kick_scale``). None for smooth particles, whose
+  loop then compiles without any of this.
 """
 
 from __future__ import annotations
@@ -77,8 +82,9 @@ Grid = namedtuple("Grid", ["head", "cell", "width", "pair_t", "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
+Spins = namedtuple("Spins", ["w", "kappa", "model", "beta", "mu", "wall_beta", "wall_mu", "kick_scale"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
-                               "walls", "contacts"])
+                               "walls", "contacts", "spins"])
 
 # Read-only parameters.
 #: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
@@ -149,6 +155,14 @@ def contacts(n: int, until=None, partner=None) -> Contacts:
     return Contacts(u, q, np.zeros(3), np.zeros(5))
 
 
+def spins(w, kappa, model: int, beta: float, mu: float, wall_beta: float, wall_mu: float,
+          kick_scale: float = 0.0) -> Spins:
+    """A :class:`Spins` record with the dtypes the kernels are compiled for (``w`` (N, 3),
+    ``kappa`` (N,), both in memory order)."""
+    return Spins(np.ascontiguousarray(w, dtype=np.float64), np.ascontiguousarray(kappa, dtype=np.float64),
+                 int(model), float(beta), float(mu), float(wall_beta), float(wall_mu), float(kick_scale))
+
+
 def space(box3, period3, ncell, wall_axes, dims) -> Space:
     """A :class:`Space` with the dtypes the kernels are compiled for."""
     return Space(np.ascontiguousarray(box3, dtype=np.float64),
@@ -171,5 +185,5 @@ def nbytes(engine: Engine) -> int:
     total = 0
     for group in engine:
         for a in (group if isinstance(group, tuple) else (group,)):
-            total += getattr(a, "nbytes", 0)
+            total += getattr(a, "nbytes", 0) if not isinstance(a, (int, float)) else 0
     return total

@@ -495,7 +495,7 @@ class Simulation:
         c["three_body"] = self._three_body
         c["err_i"] = c["err_j"] = -1
         walls = _state.Walls(impulse=self._wall_impulse.copy())
-        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts)
+        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts, None)
         self._place_events(self._time)
         self._built = True
 
