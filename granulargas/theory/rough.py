@@ -111,6 +111,7 @@ __all__ = [
     "driven_state",
     "two_temperature_curve",
     "mpemba_crossing_time",
+    "smooth_deviation",
 ]
 
 #: uniform sphere (3D) and uniform disk (2D): kappa = 4 I / (m sigma^2)
@@ -575,3 +576,23 @@ def mpemba_crossing_time(first: TwoTemperatureCurve, second: TwoTemperatureCurve
         return float(np.log(first.translational_at(s)) - np.log(second.translational_at(s)))
 
     return float(brentq(f, t[k], t[k + 1], xtol=1e-14, rtol=1e-13))
+
+
+def smooth_deviation(rough: RoughGas, t_end: float, points: int = 400) -> dict:
+    """How far T_tr(t) of the rough gas lies from that of the same gas made smooth.
+
+    The smooth gas has beta_t = -1 (the spins decouple) and the whole driving power on the
+    translation; both start at the same T_tr and follow eq. (R5) (Maxwellian). Returns
+    ``max_deviation`` = max over [0, t_end] of |T_smooth / T_rough - 1|, ``end_deviation``
+    (the same at t_end), ``t_max`` where the largest deviation occurs, and both curves.
+    """
+    smooth = RoughGas(rough.gas, rough.inertia, tangential="constant", tangential_restitution=-1.0,
+                      rotational_temperature=rough.initial_rotational_temperature,
+                      heating_rate=rough.heating_rate, rotational_fraction=0.0)
+    a = two_temperature_curve(rough, t_end, points)
+    b = two_temperature_curve(smooth, t_end, points)
+    t = a.time
+    dev = np.abs(b.translational_at(t) / a.translational - 1.0)
+    k = int(np.argmax(dev))
+    return {"max_deviation": float(dev[k]), "end_deviation": float(dev[-1]), "t_max": float(t[k]),
+            "rough": a, "smooth": b}

@@ -265,3 +265,15 @@ def test_mpemba_crossing():
     assert hot.translational_at(t) == pytest.approx(cold.translational_at(t), rel=1e-9)
     assert hot.translational_at(0.5 * t) > cold.translational_at(0.5 * t)
     assert R.mpemba_crossing_time(cold, cold) is None
+
+
+def test_smooth_deviation():
+    """A smooth gas (beta_t = -1) has no deviation; a rough one cools differently, most where its
+    spins take the translational energy."""
+    assert R.smooth_deviation(_rough(3, 0.9, -1.0), 100.0)["max_deviation"] == pytest.approx(0.0, abs=1e-9)
+    rough = R.smooth_deviation(_rough(3, 0.9, 0.5, rotational_temperature=0.0), 100.0)
+    assert rough["max_deviation"] > 0.1
+    assert rough["max_deviation"] >= rough["end_deviation"]
+    t = rough["t_max"]
+    assert abs(rough["smooth"].translational_at(t) / rough["rough"].translational_at(t) - 1) == pytest.approx(
+        rough["max_deviation"], rel=1e-6)
