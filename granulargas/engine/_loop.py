@@ -273,7 +273,7 @@ def _collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
         i, j, te, dx, dy, dz, p, contacts, c, rule, period)
 
 
-def collide_rough(i, j, nx, ny, nz, eps, rec, mass, spins, elastic):
+def collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
     """:func:`granulargas.engine._spin.rough_pair` (``spins`` None: never called)."""
 
 
@@ -286,11 +286,11 @@ def kick_rough(rec, mass, ident, dims, spins, seed, step):
 
 
 @overload(collide_rough)
-def _collide_rough(i, j, nx, ny, nz, eps, rec, mass, spins, elastic):
+def _collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
     if isinstance(spins, types.NoneType):
-        return lambda i, j, nx, ny, nz, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
-    return lambda i, j, nx, ny, nz, eps, rec, mass, spins, elastic: rough_pair(
-        i, j, nx, ny, nz, eps, rec, mass, spins, elastic)
+        return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
+    return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: rough_pair(
+        i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic)
 
 
 @overload(bounce_rough)
@@ -491,7 +491,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
                 return TABLE_RANGE
         if spins is not None:
             elastic = rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time)
-            loss, impulse, drot = collide_rough(i, j, nx, ny, nz, eps, rec, p.mass, spins, elastic)
+            loss, impulse, drot = collide_rough(i, j, nx, ny, nz, un, eps, rec, p.mass, spins, elastic)
             c.sum_mv2 -= 2.0 * drot
         else:
             fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)

@@ -49,9 +49,11 @@ def _spin_energy(w, k, i, m, r):
 
 
 @inlined
-def rough_pair(i, j, nx, ny, nz, eps, rec, mass, spins, elastic):
+def rough_pair(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
     """Rough collision of slots i and j (streamed, touching, approaching; n the unit vector
-    from j to i) with normal restitution eps, in place. Returns (loss, impulse, drot):
+    from j to i, ``un`` < 0 the normal relative velocity as the smooth law gets it, so that
+    beta_t = -1 reproduces it bit for bit) with normal restitution eps, in place. Returns
+    (loss, impulse, drot):
     the energy lost, the normal impulse (1 + eps) m_eff u_n (virial) and the change of the
     pair's rotational energy. ``elastic`` (the TC model's collisions): frictionless as well."""
     w = spins.w
@@ -61,9 +63,9 @@ def rough_pair(i, j, nx, ny, nz, eps, rec, mass, spins, elastic):
     ri = rec[i, 7]
     rj = rec[j, 7]
     e0 = _spin_energy(w, kap, i, mi, ri) + _spin_energy(w, kap, j, mj, rj)
-    un, gx, gy, gz = contact_slip(rec[i, 3] - rec[j, 3], rec[i, 4] - rec[j, 4], rec[i, 5] - rec[j, 5], nx, ny, nz,
-                                  ri * w[i, 0] + rj * w[j, 0], ri * w[i, 1] + rj * w[j, 1],
-                                  ri * w[i, 2] + rj * w[j, 2])
+    _, gx, gy, gz = contact_slip(rec[i, 3] - rec[j, 3], rec[i, 4] - rec[j, 4], rec[i, 5] - rec[j, 5], nx, ny, nz,
+                                 ri * w[i, 0] + rj * w[j, 0], ri * w[i, 1] + rj * w[j, 1],
+                                 ri * w[i, 2] + rj * w[j, 2])
     model = TANGENTIAL_CONSTANT if elastic else spins.model
     beta = -1.0 if elastic else spins.beta
     fi, fj, ti, tj, si, sj, loss, impulse = rough_pair_collision(

@@ -14,8 +14,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from granulargas.engine._rough import TANGENTIAL_CONSTANT, TANGENTIAL_COULOMB
 from granulargas.errors import ConfigError
+from granulargas.theory.rough import DEFAULT_INERTIA, MAX_INERTIA
 
 #: ``TangentialRule.model``: a constant beta_t, or Walton's Coulomb model
 MODELS = ("constant", "coulomb")
@@ -102,3 +105,42 @@ class TangentialRule:
         """The rule as the H5MD ``parameters/`` group stores it."""
         return {"model": self.model, "restitution": self.restitution, "friction": self.friction,
                 "wall_restitution": self.wall_beta, "wall_friction": self.wall_mu}
+
+
+def spins_of(state) -> tuple:
+    """(w, kappa) of a state for a rough simulation: the angular velocities as (N, 3) rows
+    (2D: the spin about z in the last column; default 0) and kappa (N,) (default: a uniform
+    sphere or disk), both in particle-id order, checked."""
+    n, d = state.n, state.dimension
+    kappa = state.array("inertia") if state.inertia is not None else np.full(n, DEFAULT_INERTIA[d])
+    if not np.all((kappa > 0.0) & (kappa <= MAX_INERTIA[d] * (1.0 + 1e-12))):
+        raise ConfigError(f"inertia: every kappa = I / (m R^2) must be in (0, {MAX_INERTIA[d]:.4g}] in {d}D "
+                          "(no mass outside the surface)")
+    w = state.array("angular_velocities")
+    if not np.all(np.isfinite(w)):
+        raise ConfigError("angular_velocities: non-finite values")
+    w3 = np.zeros((n, 3))
+    if d == 3:
+        w3[:] = w
+    else:
+        w3[:, 2] = w[:, 0]
+    return w3, kappa
+
+
+def public_spins(w3, dimension: int) -> np.ndarray:
+    """The angular velocities as the state holds them: (N, 3) in 3D, (N, 1) in 2D (a copy)."""
+    return w3.copy() if dimension == 3 else w3[:, 2:3].copy()
+
+
+def rotational_temperature(w3, kappa, masses, radii, dimension: int) -> float:
+    """T_rot = sum I_i |w_i|^2 / (d_r N), I_i = kappa_i m_i R_i^2 (d_r = 3 in 3D, 1 in 2D)."""
+    inertia = kappa * masses * radii**2
+    return float(np.sum(inertia * np.sum(w3 * w3, axis=1)) / ((3 if dimension == 3 else 1) * len(kappa)))
+
+
+def spin_kick_scale(driving, dimension: int) -> float:
+    """Standard deviation of a spin kick for unit moment of inertia, sqrt(dT_rot/dt x interval)
+    (:mod:`granulargas.engine._spin`); 0 without driving."""
+    if driving is None:
+        return 0.0
+    return math.sqrt(driving.rotational_rate(dimension) * driving.interval)

@@ -317,7 +317,8 @@ class H5MDWriter:
         groups.append(e)
         self._frame_groups = groups
         for fld in PARTICLE_FIELDS:
-            if not fld.per_frame:  # time-independent: written once
+            # time-independent: written once (a field without a default only when the state has it)
+            if not fld.per_frame and (fld.default is not None or getattr(state, fld.name) is not None):
                 part.create_dataset(fld.element, data=state.array(fld.name))
                 part[fld.element].attrs["description"] = _describe(fld)
 
@@ -522,6 +523,8 @@ class Snapshot:
     contact_until: np.ndarray | None = None  # (N,) collisions that take time only
     contact_partner: np.ndarray | None = None  # (N,) int64, collisions that take time only
     boundary: tuple = ()  # "periodic" or "wall" per axis
+    angular_velocities: np.ndarray | None = None  # (N, 3) / (N, 1) in 2D, rough particles only
+    inertia: np.ndarray | None = None  # (N,) kappa = I / (m R^2), rough particles only
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
@@ -637,6 +640,12 @@ def _check_layout(f, path):
             if not isinstance(value, h5py.Dataset) or value.shape[1:] != want:
                 raise InputFileError(f"{path}: damaged H5MD file: particles/all/{fld.element}/value is missing "
                                      f"or not (frames{''.join(f', {x}' for x in want)})")
+    for fld in PARTICLE_FIELDS:  # time-independent fields a file may hold (e.g. inertia)
+        if not fld.per_frame and fld.element in part and fld.element not in expect:
+            value = part[fld.element]
+            if not isinstance(value, h5py.Dataset) or value.shape != (n,) + fld.shape(d):
+                raise InputFileError(f"{path}: damaged H5MD file: particles/all/{fld.element} is not an array "
+                                     f"of shape ({n},)")
     if not isinstance(f.get("observables"), h5py.Group):
         raise InputFileError(f"{path}: damaged H5MD file: observables/ is missing")
     if not isinstance(f.get("parameters"), h5py.Group):
@@ -674,6 +683,9 @@ def _snapshot(f, k, static) -> Snapshot:
     if "contact_until" in part and "contact_partner" in part:
         snap = dataclasses.replace(snap, contact_until=part["contact_until/value"][k],
                                    contact_partner=part["contact_partner/value"][k])
+    if "angular_velocity" in part:
+        snap = dataclasses.replace(snap, angular_velocities=part["angular_velocity/value"][k],
+                                   inertia=part["inertia"][()] if "inertia" in part else None)
     for name in ("positions", "velocities", "box") if snap.positions is not None else ("velocities", "box"):
         if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")
