@@ -123,24 +123,40 @@ def rough_wall(i, a, side, eps, rec, mass, spins, elastic):
     return loss, momentum, drot
 
 
+@inlined
+def spin_kick(w, i, inertia, key, step, ident, dims, scale):
+    """Kick row i of the spins ``w`` (moment of inertia ``inertia``); returns the energy added."""
+    g1, g2, g3 = kick_normals(key, step, ident)
+    s = scale / math.sqrt(inertia)
+    e0 = w[i, 0] * w[i, 0] + w[i, 1] * w[i, 1] + w[i, 2] * w[i, 2]
+    if dims == 3:
+        w[i, 0] += s * g1
+        w[i, 1] += s * g2
+        w[i, 2] += s * g3
+    else:
+        w[i, 2] += s * g1
+    return 0.5 * inertia * (w[i, 0] * w[i, 0] + w[i, 1] * w[i, 1] + w[i, 2] * w[i, 2] - e0)
+
+
 @kernel
 def kick_spins(rec, mass, ident, dims, spins, seed, step):
-    """One driving step of the spins (module docstring), in place; returns the energy added."""
+    """One driving step of the engine's spins (module docstring), in place; returns the energy added."""
     w = spins.w
     kap = spins.kappa
     key = np.uint64(seed) ^ SPIN_KEY
-    scale = spins.kick_scale
     gained = 0.0
     for i in range(w.shape[0]):
-        g1, g2, g3 = kick_normals(key, step, ident[i])
         inertia = kap[i] * mass[i] * rec[i, 7] * rec[i, 7]
-        s = scale / math.sqrt(inertia)
-        e0 = _spin_energy(w, kap, i, mass[i], rec[i, 7])
-        if dims == 3:
-            w[i, 0] += s * g1
-            w[i, 1] += s * g2
-            w[i, 2] += s * g3
-        else:
-            w[i, 2] += s * g1
-        gained += 0.5 * (_spin_energy(w, kap, i, mass[i], rec[i, 7]) - e0)
+        gained += spin_kick(w, i, inertia, key, step, ident[i], dims, spins.kick_scale)
+    return gained
+
+
+@kernel
+def kick_spin_rows(w, inertia, dims, seed, step, scale):
+    """One driving step of spins ``w`` (N, 3) in particle-id order with moments of inertia
+    ``inertia`` (N,) (the DSMC's), the same numbers as :func:`kick_spins`; returns the energy added."""
+    key = np.uint64(seed) ^ SPIN_KEY
+    gained = 0.0
+    for i in range(w.shape[0]):
+        gained += spin_kick(w, i, inertia[i], key, step, i, dims, scale)
     return gained
