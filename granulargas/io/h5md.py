@@ -113,6 +113,8 @@ DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_p
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
 RESOLVED_OBSERVABLES = ("three_body_contacts",)
+#: observables of runs of rough particles (those that store angular velocities)
+ROUGH_OBSERVABLES = ("rotational_temperature", "cumulant_a20", "cumulant_a02", "cumulant_a11")
 #: per-frame fields every frame of an EDMD / a DSMC file holds; the other per-frame fields of
 #: granulargas.state.PARTICLE_FIELDS are stored when a run asks for them (``fields``)
 CORE_FIELDS = ("positions", "velocities", "images")
@@ -185,7 +187,8 @@ class H5MDWriter:
         self.file = f
         self.boundary = state.boundary
         extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
-                 + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ()))
+                 + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ())
+                 + (ROUGH_OBSERVABLES if "angular_velocities" in self.fields else ()))
         names = SCALAR_OBSERVABLES + ("momentum",) + extra
         if not self.positions:  # DSMC: no pair virial, no pressure
             names = tuple(x for x in names if x != "pressure")
@@ -348,6 +351,15 @@ class H5MDWriter:
             "(mass-weighted; granulargas.observables)")
         obs["sonine_a3"].attrs["description"] = (
             "third Sonine coefficient of the peculiar velocities (granulargas.observables)")
+        if "rotational_temperature" in obs:
+            obs["rotational_temperature"].attrs["description"] = (
+                "rotational temperature sum I |w|^2 / (d_r N) of rough particles (d_r = 3 for spheres, 1 for "
+                "disks); temperature is the translational one")
+            for name, what in (("cumulant_a20", "d_t/(d_t+2) <c^4>/<c^2>^2 - 1 of the peculiar velocities"),
+                               ("cumulant_a02", "d_r/(d_r+2) <w^4>/<w^2>^2 - 1 of the spins"),
+                               ("cumulant_a11", "<c^2 w^2>/(<c^2><w^2>) - 1")):
+                obs[name].attrs["description"] = (
+                    f"{what} (c weighted by m, w by I: granulargas.observables.rough_moments)")
         if "wall_pressure" in obs:
             obs["wall_pressure"].attrs["description"] = (
                 "normal momentum delivered to the walls per unit wall area per unit time over the sampling "

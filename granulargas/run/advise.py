@@ -69,8 +69,8 @@ from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import ConfigError
 from granulargas.run import validity as V
-from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, check_rough_supported, mean_particle,
-                                     oblique_bounds, reduced_compression, reduced_prefactor)
+from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds,
+                                     reduced_compression, reduced_prefactor)
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
@@ -390,7 +390,6 @@ def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.Cooling
 
 def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     """Advice on the collision rule for a config (module doc)."""
-    check_rough_supported(config)
     gas = V.gas_from_config(config)
     table = V.table_range_error(gas)
     if table:

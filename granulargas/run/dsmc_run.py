@@ -20,6 +20,7 @@ import numpy as np
 
 from granulargas.dsmc import DSMC
 from granulargas.observables import kinetic_energy_momentum
+from granulargas.run.rough import rotational_observables
 
 
 class DSMCRun(DSMC):
@@ -57,6 +58,7 @@ class DSMCRun(DSMC):
             "momentum": np.array(p[:self.dimension], dtype=np.float64),
             "sonine_a2": float(a2),
             "sonine_a3": float(a3),
+            **(rotational_observables(self) if self.tangential is not None else {}),
         }
 
 
@@ -64,4 +66,4 @@ def make_dsmc(config, setup) -> DSMCRun:
     """The DSMC of a prepared config (module docstring): the volume of the state's box, the
     restart file's continuation if the state has one."""
     return DSMCRun(setup.state, setup.rule, chi=setup.parameters["dsmc"]["chi"], seed=config.system.seed,
-                   driving=setup.driving)
+                   driving=setup.driving, tangential=setup.tangential)
