@@ -245,8 +245,10 @@ def _mean_particle_mass(radii, masses, dim) -> float:
 
 
 def run_kind(info: RunInfo) -> str:
-    """``"driven"`` (white-noise driving), ``"elastic"`` (energy conserved: eps = 1 or
-    damping 0) or ``"cooling"``."""
+    """``"rough"`` (rough particles, cooling or driven), ``"driven"`` (white-noise driving),
+    ``"elastic"`` (energy conserved: eps = 1 or damping 0) or ``"cooling"``."""
+    if isinstance(info.parameters.get("tangential"), dict):
+        return "rough"
     drv = info.parameters.get("driving")
     if isinstance(drv, dict) and float(drv.get("heating_rate", 0.0)) > 0.0:
         return "driven"
