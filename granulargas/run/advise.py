@@ -72,6 +72,7 @@ from granulargas.run import validity as V
 from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds,
                                      reduced_compression, reduced_prefactor)
 from granulargas.theory.gas import cooling_curve
+from granulargas.theory.rough import smooth_deviation
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
            "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line", "choose_duration",
@@ -293,9 +294,20 @@ class Advice:
     duration: str | None = None
     duration_reason: str = ""
     notes: tuple = ()
+    #: rough particles: the largest relative change of T_tr(t) over the run if the particles
+    #: were smooth (beta_t = -1; :func:`granulargas.theory.rough.smooth_deviation`), and whether
+    #: that is within the tolerance
+    rough_deviation: float | None = None
+    smooth_ok: bool | None = None
 
     def lines(self) -> list[str]:
-        out = [f"run          T {1:g} -> {self.T_end:.3g} T0 by t = {self.t_end:.4g} (kinetic theory)"]
+        theory_name = "two-temperature theory" if self.rough_deviation is not None else "kinetic theory"
+        out = [f"run          T {1:g} -> {self.T_end:.3g} T0 by t = {self.t_end:.4g} ({theory_name})"]
+        if self.rough_deviation is not None:
+            verdict = "a smooth model will do" if self.smooth_ok else "keep the rough particles"
+            out.append(f"rough        smooth particles (beta_t = -1) would move T_tr(t) by up to "
+                       f"{100 * self.rough_deviation:.3g} % over this run (tolerance {100 * self.tolerance:g} %) "
+                       f"-> {verdict}")
         if self.model == "elastic":
             out.append("advice       elastic collisions: nothing to choose")
         if self.spread is not None:
@@ -445,7 +457,25 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
                          "rule (scripts/collapse_demo.py)")
     adv.notes = tuple(notes)
     _set_method(adv, config)
+    _set_rough(adv, config, tolerance)
     return adv
+
+
+def _set_rough(adv: Advice, config, tolerance: float):
+    """Rough particles: the run's T_tr range by the two-temperature theory and how far smooth
+    particles would take T_tr(t) (:func:`granulargas.theory.rough.smooth_deviation`)."""
+    rough = V.rough_gas_from_config(config)
+    if rough is None:
+        return
+    t_end, ln_T = V.rough_end(rough, config.run.end_time, config.run.collisions_per_particle)
+    adv.t_end, adv.T_end = t_end, math.exp(ln_T) / rough.translational_temperature
+    adv.rough_deviation = smooth_deviation(rough, t_end)["max_deviation"]
+    adv.smooth_ok = adv.rough_deviation <= tolerance
+    if adv.smooth_ok:
+        adv.notes = adv.notes + ("leave out [collision.tangential]: the spins change T_tr(t) by less than the "
+                                 "tolerance (the comparisons above are of smooth particles)",)
+    else:
+        adv.notes = adv.notes + ("the constant/viscoelastic comparisons above are those of smooth particles",)
 
 
 def _set_method(adv: Advice, config):
@@ -471,8 +501,14 @@ def method_line(config) -> str | None:
 def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
     """One line for the run summary: the eps spread and whether a constant eps would do.
 
-    Returns None for elastic and driven runs (the advice compares cooling curves).
+    Returns None for elastic and driven runs (the advice compares cooling curves); for rough
+    particles the line says how far smooth particles would take T_tr(t).
     """
+    if getattr(config.collision, "tangential", None) is not None:
+        adv = advise(config, tolerance)
+        verdict = "would do" if adv.smooth_ok else "would not do"
+        return (f"advice       smooth particles (beta_t = -1) {verdict}: T_tr(t) off by up to "
+                f"{100 * adv.rough_deviation:.3g} % over the run (tolerance {100 * tolerance:g} %)")
     driving = getattr(config, "driving", None)
     if driving is not None and driving.heating_rate > 0.0:
         return None

@@ -48,6 +48,13 @@ same float (zero-time events). For an elastic gas this bounds the run to about
 ``1e-6 2^52 = 4.5e9`` mean free times; a cooling gas, whose event spacing grows
 with t, stays resolved much longer.
 
+Rough particles
+---------------
+With ``[collision.tangential]`` the predicted translational temperature is that of the
+two-temperature theory (:mod:`granulargas.theory.rough`, Maxwellian energy balances):
+T_tr(t) from (T0, T_rot0) to the run's end (a stop in collisions per particle: where
+the theory's collision count reaches it), or the driven steady state.
+
 Centre-of-mass drift
 --------------------
 Zero total momentum holds only to round-off: the centre-of-mass velocity stays
@@ -78,6 +85,7 @@ from granulargas.contact import restitution_table
 from granulargas.contact.material import damping_from_prefactor, rho_from_material
 from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX
+from granulargas.theory import rough as rough_theory
 from granulargas.theory.moments import speed_quadrature
 from granulargas.run.prepare import mean_particle, reduced_prefactor
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
@@ -153,6 +161,40 @@ def gas_from_config(config) -> RunGas:
     )
 
 
+def rough_gas_from_config(config):
+    """The config's rough gas (:class:`granulargas.theory.rough.RoughGas`; None for smooth particles)."""
+    t = config.collision.tangential
+    if t is None:
+        return None
+    drv = config.driving
+    return rough_theory.RoughGas(
+        gas_from_config(config), config.particles.inertia, tangential=t.model, tangential_restitution=t.restitution,
+        friction=t.friction or 0.0, rotational_temperature=config.initial.rotational_temperature,
+        heating_rate=0.0 if drv is None else drv.heating_rate,
+        rotational_fraction=0.0 if drv is None else drv.spin_fraction)
+
+
+def rough_end(rough, t_end: float | None, collisions: float | None):
+    """(t_end, ln T_tr at t_end) of a rough gas by the two-temperature theory: the first of
+    ``t_end`` and the time its collisions per particle reach ``collisions``."""
+    t = t_end if t_end is not None else 1.0 / rough.gas.collision_frequency
+    for _ in range(200):
+        curve = rough_theory.two_temperature_curve(rough, t, points=50)
+        if collisions is None or curve.collisions[-1] >= collisions:
+            break
+        if t_end is not None:
+            break
+        t *= 2.0
+    if collisions is not None and curve.collisions[-1] >= collisions:
+        k = int(np.searchsorted(curve.collisions, collisions))
+        lo, hi = curve.time[max(k - 1, 0)], curve.time[k]
+        for _ in range(60):  # bisection on the dense solution
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if curve.collisions_at(mid) < collisions else (lo, mid)
+        t = hi
+    return float(t), float(np.log(curve.translational_at(t)))
+
+
 # ---------------------------------------------------------------- t_c / t_free
 
 
@@ -220,12 +262,13 @@ class RunValidity:
     warnings: list = field(default_factory=list)
     errors: list = field(default_factory=list)
     driven: bool = False
+    rough: bool = False
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
         if self.driven:
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady state of the driving, "
-                   "Enskog theory)"]
+                   f"{'two-temperature ' if self.rough else 'Enskog '}theory)"]
         else:
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (predicted by t = {self.t_end:.4g})"]
         if self.spread is not None:
@@ -263,7 +306,10 @@ def _check_driven(config, gas) -> RunValidity:
     """Checks of a driven run: it heads for the steady temperature of the driving
     (:mod:`granulargas.theory.driven`) instead of cooling."""
     h = config.driving.heating_rate
-    if gas.model == "elastic":  # no steady state: T grows as T0 + H t
+    rough = rough_gas_from_config(config)
+    if rough is not None and (gas.model != "elastic" or rough.sticking_factor > 0.0):
+        t_end = rough_theory.driven_state(rough)[0]
+    elif gas.model == "elastic":  # no steady state: T grows as T0 + H t
         t_end = gas.temperature + h * (gas.end_time if gas.end_time is not None else 0.0)
     elif gas.model == "constant":
         t_end = float(theory.driven_temperature(h, gas.restitution, gas.density, gas.dimension, gas.sigma,
@@ -275,7 +321,7 @@ def _check_driven(config, gas) -> RunValidity:
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         spread = restitution_spread(gas, max(gas.temperature, t_end), min(gas.temperature, t_end))
     rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, float(t_end), spread,
-                     driven=True)
+                     driven=True, rough=rough is not None)
     rv.tc_ratio = contact_time_ratio(gas, max(gas.temperature, t_end))
     _warn_contact(rv, gas, spread)
     return rv
@@ -317,10 +363,13 @@ def check_run(config) -> RunValidity:
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = viscoelastic_cooling(gas)
     t_end, ln_T_end = predicted_end(gas, curve)
+    rough = rough_gas_from_config(config) if not isinstance(config, RunGas) else None
+    if rough is not None:
+        t_end, ln_T_end = rough_end(rough, gas.end_time, gas.collisions_per_particle)
     T_end = math.exp(ln_T_end)
     if curve is not None:
         spread = restitution_spread(gas, gas.temperature, max(T_end, 1e-300))
-    rv = RunValidity(gas, float(t_end), gas.temperature, float(T_end), spread)
+    rv = RunValidity(gas, float(t_end), gas.temperature, float(T_end), spread, rough=rough is not None)
     rv.tc_ratio = contact_time_ratio(gas)
     _warn_contact(rv, gas, spread)
     if ln_T_end - math.log(gas.temperature) < math.log(DRIFT_T_RATIO) and not (
