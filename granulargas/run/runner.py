@@ -56,13 +56,12 @@ from granulargas._numba import CompileWatch, announcement
 from granulargas.engine import Simulation
 from granulargas.errors import ConfigError, InelasticCollapseError, InputFileError, SimulationError, UserError
 from granulargas.io.config import RunConfig, parse_config
-from granulargas.io.h5md import H5MDWriter, read_parameters
+from granulargas.io.h5md import H5MDWriter, read_parameters, read_text
 from granulargas.io.paths import existing_directory, output_file
-from granulargas.observables import sonine_coefficients
 from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
 from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
-from granulargas.run.rough import rotational_observables
+from granulargas.run.record import observables as _observables  # one sample, as RunWriter takes it
 from granulargas.run.variants import describe, variants_for
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
@@ -327,34 +326,6 @@ def stored_fields(config: RunConfig, sim) -> tuple:
             + rough)
 
 
-def _observables(sim, pressure: bool) -> dict:
-    if hasattr(sim, "observables"):  # a DSMC run (run.dsmc_run.DSMCRun)
-        return sim.observables()
-    a2, a3 = sonine_coefficients(sim.velocities, sim.masses)
-    out = {
-        "temperature": float(sim.temperature),
-        "kinetic_energy": float(sim.kinetic_energy),
-        "collisions": int(sim.collisions),
-        "events": int(sim.events),
-        "dissipated_energy": float(sim.dissipated_energy),
-        "momentum": np.asarray(sim.momentum, dtype=np.float64),
-        "pressure": float(sim.pressure_window()) if pressure else math.nan,
-        "sonine_a2": float(a2),
-        "sonine_a3": float(a3),
-    }
-    if "wall" in sim.boundary:
-        out["wall_collisions"] = int(sim.wall_collisions)
-        out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
-    if sim.driving is not None:
-        out["injected_energy"] = float(sim.injected_energy)
-        out["kick_step"] = int(sim.kick_step)
-    if sim.rule.resolved:
-        out["three_body_contacts"] = int(sim.three_body_contacts)
-    if sim.tangential is not None:
-        out.update(rotational_observables(sim))
-    return out
-
-
 def collapse_message(config: RunConfig, where: str) -> str:
     """The inelastic-collapse error of a config run: the cure named by the config's keys
     (the TC model's ``collision.tc_time``, with a value that changed T(t) by 0.03 % in the
@@ -613,8 +584,7 @@ def _continuation_record(writer, config: RunConfig, setup, st) -> dict:
     (``config``) and, under ``continuations/<k>``, where it started and the config it replaced."""
     g = writer.file["parameters"]
     k = len(g["continuations"]) if "continuations" in g else 0
-    previous = g["config"][()] if "config" in g else b""
-    previous = previous.decode() if isinstance(previous, bytes) else str(previous)
+    previous = read_text(g["config"]) if "config" in g else ""
     return {
         "config": setup.parameters["config"],
         "config_source": setup.parameters["config_source"],
