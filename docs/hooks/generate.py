@@ -66,6 +66,9 @@ SECTION_TEXT = {
                             "of the contact points becomes −β_t times itself, so β_t = −1 is smooth and "
                             "+1 perfectly rough.",
     "driving": "Optional: white-noise driving (a heated granular gas in a steady state).",
+    "species": "Optional, in place of `[particles]`: an array of tables `[[species]]`, one per species of "
+               "a mixture ([Mixtures](mixtures.md)). Each key below is checked per species and named "
+               "`species.<name>.<key>` in messages and overrides.",
     "run": "When to stop (at least one key).",
     "output": "The output file and its schedule.",
 }
@@ -117,7 +120,8 @@ def config_reference_markdown() -> str:
     lines = []
     for section in dict.fromkeys(e.section for e in entries):
         anchor = section.replace(".", "-")
-        lines += [f"## `[{section}]` {{ #{anchor} }}", ""]
+        shown = f"[[{section}]]" if section == "species" else f"[{section}]"  # an array of tables
+        lines += [f"## `{shown}` {{ #{anchor} }}", ""]
         if section in SECTION_TEXT:
             lines += [SECTION_TEXT[section], ""]
         lines += ["| key | type | default | unit | allowed | meaning |", "|---|---|---|---|---|---|"]

@@ -69,6 +69,12 @@ Record layout
   and the tangential law (``model``, ``beta``, ``mu``, ``wall_beta``, ``wall_mu``) and the
   spin-kick scale of the driving (``kick_scale``). None for smooth particles, whose
   loop then compiles without any of this.
+* ``species`` :class:`Species` -- the collision law per pair of species
+  (:mod:`granulargas.engine._species`): ``of`` i4 the species of each slot, ``count``
+  the number S of species, ``eps`` and ``prefactor`` (S*S,) f8 the pair table,
+  ``wall_eps`` and ``wall_prefactor`` (S,) f8 per species, ``weight`` (S*S,) f8 the DSMC's
+  acceptance weights (ones in the engine), ``pairs`` (S*S,) i8 the pair collision counts. None for a rule without a pair table, whose loop then compiles
+  without any of this.
 """
 
 from __future__ import annotations
@@ -87,8 +93,10 @@ Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", 
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
 Spins = namedtuple("Spins", ["w", "kappa", "model", "beta", "mu", "wall_beta", "wall_mu", "kick_scale"])
+Species = namedtuple("Species", ["of", "count", "eps", "prefactor", "wall_eps", "wall_prefactor", "weight",
+                                 "pairs"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
-                               "walls", "contacts", "spins"])
+                               "walls", "contacts", "spins", "species"])
 
 # Read-only parameters.
 #: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
@@ -165,6 +173,17 @@ def spins(w, kappa, model: int, beta: float, mu: float, wall_beta: float, wall_m
     ``kappa`` (N,), both in memory order)."""
     return Spins(np.ascontiguousarray(w, dtype=np.float64), np.ascontiguousarray(kappa, dtype=np.float64),
                  int(model), float(beta), float(mu), float(wall_beta), float(wall_mu), float(kick_scale))
+def species_record(of, table, pairs=None, weight=None) -> Species:
+    """A :class:`Species` record for the slots' species ``of`` and a
+    :class:`granulargas.engine.pairs.PairTable` (``pairs``: the counts to continue from;
+    ``weight`` (S, S): the DSMC's acceptance weights, default ones)."""
+    size = table.count
+    flat = lambda a: np.ascontiguousarray(np.asarray(a, dtype=np.float64).reshape(-1))  # noqa: E731
+    counts = np.zeros(size * size, dtype=np.int64) if pairs is None else \
+        np.ascontiguousarray(np.asarray(pairs, dtype=np.int64).reshape(-1))
+    return Species(np.ascontiguousarray(of, dtype=np.int32), int(size), flat(table.restitution),
+                   flat(table.prefactor), flat(table.wall_restitution), flat(table.wall_prefactor),
+                   flat(np.ones((size, size)) if weight is None else weight), counts)
 
 
 def space(box3, period3, ncell, wall_axes, dims) -> Space:

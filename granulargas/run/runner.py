@@ -439,7 +439,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None)
+                            driven=sim.driving is not None, species=setup.rule.species)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached

@@ -10,7 +10,8 @@ line a run prints before it compiles it), the tiny run that compiles it, and
 which runs use it. What does *not* make a variant: the dimension (2D runs use the
 3D kernels with z = 0), the collision rule (elastic, constant, viscoelastic and
 the TC model share one loop), walls and polydispersity (run-time data), the
-numbers of particles and of snapshots.
+numbers of particles and of snapshots. Species do (``[[species]]``: the loops with the
+law per pair of species).
 
 A feature that adds a compiled variant adds one entry here: its tiny config (the
 keys that select it, on top of :data:`TINY`), the variants it builds on
@@ -47,6 +48,9 @@ _DSMC = {"run.method": "dsmc", "system.particles": 256}
 #: rough particles (spins and a tangential restitution): a loop of their own
 _ROUGH = {"collision.tangential.restitution": 0.0}
 _ROUGH_DRIVEN = {**_DRIVEN, "driving.rotational_fraction": 0.5}
+#: a mixture: two species, the law per pair of species (the loops compiled with the species record)
+_MIXTURE = {"species": [{"name": "a", "fraction": 0.5}, {"name": "b", "fraction": 0.5, "diameter": 0.8}],
+            "collision.damping": {"a-a": 0.1, "a-b": 0.1, "b-b": 0.1}}
 
 
 def _placement(config: RunConfig) -> bool:
@@ -54,20 +58,22 @@ def _placement(config: RunConfig) -> bool:
 
 
 def _engine(mode: str, resolved: bool = False, driven: bool = False,
-            rough: bool = False) -> Callable[[RunConfig, str], bool]:
+            rough: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
     """Runs of the event-driven engine in neighbour mode ``mode`` (with collisions that take
-    time: ``resolved``; ``driven``: the driven ones only; ``rough``: rough particles)."""
+    time: ``resolved``; ``driven``: the driven ones only; ``rough``: rough particles;
+    ``mixture``: those with species)."""
     def uses(config: RunConfig, neighbours: str) -> bool:
         return (config.run.method == "edmd" and neighbours == mode
                 and (config.collision.duration == "resolved") == resolved
                 and config.collision.rough == rough
-                and (config.driving is not None or not driven))
+                and (config.driving is not None or not driven) and bool(config.species) == mixture)
     return uses
 
 
-def _dsmc(driven: bool = False, rough: bool = False) -> Callable[[RunConfig, str], bool]:
+def _dsmc(driven: bool = False, rough: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
     return lambda config, neighbours: (config.run.method == "dsmc" and config.collision.rough == rough
-                                       and (config.driving is not None or not driven))
+                                       and (config.driving is not None or not driven)
+                                       and bool(config.species) == mixture)
 
 
 @dataclass(frozen=True)
@@ -137,6 +143,17 @@ VARIANTS = (
     Variant("dsmc-rough", "the DSMC of rough particles", {**_DSMC, **_ROUGH}, _dsmc(rough=True), after=("dsmc",)),
     Variant("dsmc-rough-driven", "its driving step", {**_DSMC, **_ROUGH, **_ROUGH_DRIVEN},
             _dsmc(driven=True, rough=True), after=("dsmc-rough",)),
+    Variant("lists-mixture", "the neighbour-list engine of mixtures", {"run.neighbours": "lists", **_MIXTURE},
+            _engine("lists", mixture=True), after=("placement", "lists")),
+    Variant("cells-mixture", "the cell-crossing engine of mixtures", {"run.neighbours": "cells", **_MIXTURE},
+            _engine("cells", mixture=True), after=("placement", "cells")),
+    Variant("lists-mixture-driven", "its driving step", {"run.neighbours": "lists", **_MIXTURE, **_DRIVEN},
+            _engine("lists", driven=True, mixture=True), after=("lists-mixture",)),
+    Variant("cells-mixture-driven", "its driving step", {"run.neighbours": "cells", **_MIXTURE, **_DRIVEN},
+            _engine("cells", driven=True, mixture=True), after=("cells-mixture",)),
+    Variant("dsmc-mixture", "the DSMC of mixtures", {**_DSMC, **_MIXTURE}, _dsmc(mixture=True), after=("dsmc",)),
+    Variant("dsmc-mixture-driven", "its driving step", {**_DSMC, **_MIXTURE, **_DRIVEN},
+            _dsmc(driven=True, mixture=True), after=("dsmc-mixture",)),
 )
 BY_NAME = {v.name: v for v in VARIANTS}
 
@@ -169,6 +186,7 @@ def describe(variants) -> str:
 def tiny_config(variant: Variant, directory) -> RunConfig:
     """The tiny run that compiles ``variant`` (its output file in ``directory``)."""
     keys = {**TINY, **variant.config, "output.file": str(Path(directory) / f"{variant.name}.h5")}
+    species = keys.pop("species", [])
     sections: dict[str, dict] = {}
     for key, value in keys.items():
         if value is None:
@@ -178,5 +196,15 @@ def tiny_config(variant: Variant, directory) -> RunConfig:
     text = []
     for section, values in sections.items():
         text.append(f"[{section}]")
-        text += [f"{name} = {json.dumps(value)}" for name, value in values.items()]
+        text += [f"{name} = {_toml(value)}" for name, value in values.items()]
+    for table in species:
+        text.append("[[species]]")
+        text += [f"{name} = {_toml(value)}" for name, value in table.items()]
     return parse_config("\n".join(text) + "\n", source=f"<{variant.name}>")
+
+
+def _toml(value) -> str:
+    """A value of a tiny config as TOML (inline tables for dicts)."""
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{json.dumps(k)} = {_toml(v)}" for k, v in value.items()) + " }"
+    return json.dumps(value)
