@@ -1090,6 +1090,9 @@ def _check_tangential(v: Values):
     if v.get("collision.duration") == "resolved":
         v.fail("collision.tangential", 'rough particles need instantaneous collisions: the resolved contact '
                                        '(collision.duration = "resolved") is frictionless', _Shown("{...}"))
+    if v.species:
+        v.fail("collision.tangential", "a config takes rough particles of one kind, not a mixture ([[species]]): "
+                                       "rough mixtures run from Python (docs/rough.md)", _Shown("{...}"))
 # ------------------------------------------------------------------ [[species]]
 
 
@@ -1338,7 +1341,8 @@ RULES: tuple[Rule, ...] = (
          "`[collision.tangential]`.", _check_rough_keys_need_tangential),
     Rule('`[collision.tangential]`: `model = "coulomb"` needs `friction`; `friction` and `wall_friction` '
          'are only used with `"coulomb"`, `wall_restitution` and `wall_friction` only with walls; rough '
-         'particles need `duration = "instantaneous"`.', _check_tangential),
+         'particles need `duration = "instantaneous"` and one kind of particle (no `[[species]]`).',
+         _check_tangential),
 )
 
 

@@ -280,3 +280,15 @@ def test_inertia_bounds_are_the_theorys():
     from granulargas.theory import rough
 
     assert config.MAX_INERTIA == rough.MAX_INERTIA and config.DEFAULT_INERTIA == rough.DEFAULT_INERTIA
+
+
+def test_rough_mixture_is_refused_in_one_line():
+    """[collision.tangential] with [[species]]: one line naming the table (rough mixtures run
+    from Python only)."""
+    text = ROUGH.replace("[particles]\ndiameter = 1.0\nmass = 1.0\n", "") + (
+        '\n[[species]]\nname = "a"\nfraction = 0.5\n\n[[species]]\nname = "b"\nfraction = 0.5\nmass = 2.0\n')
+    parse_config(text.replace("[collision.tangential]\nrestitution = 0.2\n", ""), "m.toml")  # smooth: fine
+    with pytest.raises(ConfigError) as err:
+        parse_config(text, "m.toml")
+    msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("m.toml: collision.tangential = {...}: ") and "[[species]]" in msg
