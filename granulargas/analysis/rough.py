@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from granulargas.analysis.cooling import block_mean, collisions_per_particle
-from granulargas.analysis.run import RunInfo, _clean
+from granulargas.analysis.run import RunInfo, _clean, run_identity
 from granulargas.errors import InputFileError
 from granulargas.io.h5md import read_observables
 from granulargas.theory import rough as R
@@ -130,6 +130,7 @@ class RoughAnalysis:
         h = self.history
         theta, theta_err = self.mean(h.ratio)
         out = {
+            **run_identity(self.info, self.kind),
             "kind": self.kind,
             "model": self.info.model,
             "tangential": self.gas.tangential,
@@ -143,6 +144,7 @@ class RoughAnalysis:
             "t_final": float(h.time[-1]),
             "T_tr_final": float(h.translational[-1]),
             "T_rot_final": float(h.rotational[-1]),
+            "T_final": float(h.translational[-1]),  # the temperature: the translational one
             "T_tr_final_theory": float(self.curve.translational_at(h.time[-1])),
             "T_rot_final_theory": float(self.curve.rotational_at(h.time[-1])),
             "relaxed_from": self.t_relaxed,
