@@ -131,7 +131,7 @@ class DSMC:
         rad, mas = state.radii.copy(), state.masses.copy()
         if tangential is not None and not isinstance(tangential, TangentialRule):
             raise TypeError("tangential must be a granulargas.engine.TangentialRule or None")
-        if driving is not None and driving.rotational_fraction > 0.0 and tangential is None:
+        if isinstance(driving, WhiteNoise) and driving.rotational_fraction > 0.0 and tangential is None:
             raise ConfigError(f"driving: rotational_fraction = {driving.rotational_fraction}: smooth particles "
                               "have no spins to drive (give a tangential rule)")
         self.tangential = tangential
