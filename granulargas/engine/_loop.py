@@ -126,6 +126,7 @@ from granulargas.engine._shear import (
     stress_virial,
 )
 from granulargas.engine._species import count_pair, pair_law, wall_law
+from granulargas.engine._spin import kick_spins, rough_pair, rough_wall
 from granulargas.engine._probe import (
     COLLIDE,
     PEEK,
@@ -290,6 +291,41 @@ def _collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
         return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: 0
     return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: resolved_pair(
         i, j, te, dx, dy, dz, p, contacts, c, rule, period)
+
+
+def collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
+    """:func:`granulargas.engine._spin.rough_pair` (``spins`` None: never called)."""
+
+
+def bounce_rough(i, a, side, eps, rec, mass, spins, elastic):
+    """:func:`granulargas.engine._spin.rough_wall` (``spins`` None: never called)."""
+
+
+def kick_rough(rec, mass, ident, dims, spins, seed, step):
+    """:func:`granulargas.engine._spin.kick_spins` (``spins`` None: never called)."""
+
+
+@overload(collide_rough)
+def _collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
+    if isinstance(spins, types.NoneType):
+        return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
+    return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: rough_pair(
+        i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic)
+
+
+@overload(bounce_rough)
+def _bounce_rough(i, a, side, eps, rec, mass, spins, elastic):
+    if isinstance(spins, types.NoneType):
+        return lambda i, a, side, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
+    return lambda i, a, side, eps, rec, mass, spins, elastic: rough_wall(i, a, side, eps, rec, mass, spins,
+                                                                         elastic)
+
+
+@overload(kick_rough)
+def _kick_rough(rec, mass, ident, dims, spins, seed, step):
+    if isinstance(spins, types.NoneType):
+        return lambda rec, mass, ident, dims, spins, seed, step: 0.0
+    return lambda rec, mass, ident, dims, spins, seed, step: kick_spins(rec, mass, ident, dims, spins, seed, step)
 
 
 @inlined
@@ -457,15 +493,18 @@ def _collapse_watch(i, te, p, prm):
 
 
 @inlined_ir
-def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress, species):
+def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress, spins, species):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
     Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
     ``c.err_j`` set). With ``contacts`` (the resolved rule; None otherwise) the pair collides by
-    :func:`granulargas.engine._resolved.resolved_pair`. ``shear``: the pair through its
-    nearest Lees-Edwards image; ``stress``: the pressure tensor's sums take the collision.
-    With ``species`` (a mixture; None otherwise) the pair's law comes from the species table
-    and the collision is counted per pair of species (:mod:`granulargas.engine._species`).
+    :func:`granulargas.engine._resolved.resolved_pair`; with ``spins`` (rough particles; None
+    otherwise) by :func:`granulargas.engine._spin.rough_pair`, except the TC model's elastic
+    collisions, which are also frictionless. With ``species`` (a mixture; None otherwise) the
+    pair's normal law comes from the species table and the collision is counted per pair of
+    species (:mod:`granulargas.engine._species`); the tangential law is the same for every pair.
+    ``shear``: the pair through its nearest Lees-Edwards image; ``stress``: the pressure tensor's
+    sums take the collision (smooth particles only).
     """
     rec = p.rec
     period = prm.space.period
@@ -509,17 +548,22 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
                 c.err_i = i
                 c.err_j = j
                 return TABLE_RANGE
-        fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
-        if stress is not None:
-            stress_jump(stress, mi, peculiar_x(i, rec, shear), rec[i, 4], rec[i, 5], -fi * nx, -fi * ny, -fi * nz)
-            stress_jump(stress, mj, peculiar_x(j, rec, shear), rec[j, 4], rec[j, 5], fj * nx, fj * ny, fj * nz)
-            stress_virial(stress, -impulse * dist, nx, ny, nz)
-        rec[i, 3] -= fi * nx
-        rec[i, 4] -= fi * ny
-        rec[i, 5] -= fi * nz
-        rec[j, 3] += fj * nx
-        rec[j, 4] += fj * ny
-        rec[j, 5] += fj * nz
+        if spins is not None:
+            elastic = rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time)
+            loss, impulse, drot = collide_rough(i, j, nx, ny, nz, un, eps, rec, p.mass, spins, elastic)
+            c.sum_mv2 -= 2.0 * drot
+        else:
+            fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
+            if stress is not None:
+                stress_jump(stress, mi, peculiar_x(i, rec, shear), rec[i, 4], rec[i, 5], -fi * nx, -fi * ny, -fi * nz)
+                stress_jump(stress, mj, peculiar_x(j, rec, shear), rec[j, 4], rec[j, 5], fj * nx, fj * ny, fj * nz)
+                stress_virial(stress, -impulse * dist, nx, ny, nz)
+            rec[i, 3] -= fi * nx
+            rec[i, 4] -= fi * ny
+            rec[i, 5] -= fi * nz
+            rec[j, 3] += fj * nx
+            rec[j, 4] += fj * ny
+            rec[j, 5] += fj * nz
         c.dissipated += loss
         c.sum_mv2 -= 2.0 * loss
         c.virial -= impulse * dist
@@ -583,9 +627,11 @@ def execute_crossing(i, face, te, p, grid, c, prm, shear):
 
 
 @kernel(python=False)
-def execute_wall(i, wall, te, p, c, walls, prm, shear, stress, species):
+def execute_wall(i, wall, te, p, c, walls, prm, shear, stress, spins, species):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
-    m_eff = m_i (a mixture: the law of i's species). Returns DONE or TABLE_RANGE."""
+    m_eff = m_i (rough particles: :func:`granulargas.engine._spin.rough_wall`, except the TC
+    model's elastic collisions; a mixture: the normal law of i's species). Returns DONE or
+    TABLE_RANGE."""
     rec = p.rec
     rule = prm.rule
     stream(i, te, rec, p.img, prm.space.period)
@@ -604,12 +650,17 @@ def execute_wall(i, wall, te, p, c, walls, prm, shear, stress, species):
                 c.err_i = i
                 c.err_j = -1
                 return TABLE_RANGE
-        v_new, loss, impulse = wall_collision(vn, mi, eps)
-        if stress is not None:
-            dv = v_new - vn
-            stress_jump(stress, mi, peculiar_x(i, rec, shear), rec[i, 4], rec[i, 5], dv if a == 0 else 0.0,
-                        dv if a == 1 else 0.0, dv if a == 2 else 0.0)
-        rec[i, 3 + a] = v_new
+        if spins is not None:
+            elastic = rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time
+            loss, impulse, drot = bounce_rough(i, a, side, eps, rec, p.mass, spins, elastic)
+            c.sum_mv2 -= 2.0 * drot
+        else:
+            v_new, loss, impulse = wall_collision(vn, mi, eps)
+            if stress is not None:
+                dv = v_new - vn
+                stress_jump(stress, mi, peculiar_x(i, rec, shear), rec[i, 4], rec[i, 5], dv if a == 0 else 0.0,
+                            dv if a == 1 else 0.0, dv if a == 2 else 0.0)
+            rec[i, 3 + a] = v_new
         c.dissipated += loss
         c.sum_mv2 -= 2.0 * loss
         walls.impulse[a, side] += impulse
@@ -624,15 +675,18 @@ def execute_wall(i, wall, te, p, c, walls, prm, shear, stress, species):
 
 
 @kernel(python=False)
-def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress):
-    """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1);
-    every event predicted anew and the calendar rebuilt (O(N))."""
+def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress, spins):
+    """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1; rough
+    particles' spins too, :func:`granulargas.engine._spin.kick_spins`); every event predicted
+    anew and the calendar rebuilt (O(N))."""
     rec = p.rec
     n = rec.shape[0]
     for i in range(n):
         stream(i, t, rec, p.img, prm.space.period)
     c.injected += kick_velocities(rec, 3, p.mass, p.ident, prm.space.dims, prm.kick_seed,
                                   c.kick_step, prm.kick_scale)
+    if spins is not None:
+        c.injected += kick_rough(rec, p.mass, p.ident, prm.space.dims, spins, prm.kick_seed, c.kick_step)
     s = 0.0
     for i in range(n):
         s += p.mass[i] * (rec[i, 3] * rec[i, 3] + rec[i, 4] * rec[i, 4] + rec[i, 5] * rec[i, 5])
@@ -808,6 +862,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
     c = engine.counters[0]
     walls = engine.walls
     contacts = engine.contacts
+    spins = engine.spins
     species = engine.species
     rec = p.rec
     time = c.time
@@ -858,7 +913,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
                 for k in range(lists.nbn[j]):
                     prefetch(rec, lists.nbl[j, k])
             status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress,
-                                  species)
+                                  spins, species)
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
@@ -871,7 +926,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if status != DONE:
                 break
         elif j == WALL:
-            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, shear, stress, species)
+            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, shear, stress, spins, species)
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:
@@ -942,7 +997,7 @@ def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisi
         if status != DONE or t_kick > until:
             return status
         status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
-                              engine.calendar, c, prm, engine.contacts, shear, stress)
+                              engine.calendar, c, prm, engine.contacts, shear, stress, engine.spins)
         c.events += 1
         if status != DONE or c.time >= until:
             return status
@@ -980,7 +1035,8 @@ def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collis
                                      engine.calendar, c, prm, sh, stress)
         else:
             status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
-                                  engine.calendar, c, prm, engine.contacts, sh, stress)
+                                  engine.calendar, c, prm, engine.contacts, sh, stress,
+                                  engine.spins)
         c.events += 1
         if status != DONE or c.time >= until:
             return status

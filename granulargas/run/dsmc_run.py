@@ -20,6 +20,7 @@ import numpy as np
 
 from granulargas.dsmc import DSMC
 from granulargas.observables import kinetic_energy_momentum, species_moments
+from granulargas.run.rough import rotational_observables
 
 
 class DSMCRun(DSMC):
@@ -63,6 +64,7 @@ class DSMCRun(DSMC):
             "momentum": np.array(p[:self.dimension], dtype=np.float64),
             "sonine_a2": float(a2),
             "sonine_a3": float(a3),
+            **(rotational_observables(self) if self.tangential is not None else {}),
         }
 
 
@@ -83,4 +85,4 @@ def make_dsmc(config, setup) -> DSMCRun:
     dsmc = setup.parameters["dsmc"]
     chi = dsmc.get("chi_pairs", dsmc["chi"])
     return DSMCRun(setup.state, setup.rule, chi=chi, seed=config.system.seed, driving=setup.driving,
-                   shear=setup.shear)
+                   shear=setup.shear, tangential=setup.tangential)
