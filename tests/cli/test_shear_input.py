@@ -52,6 +52,8 @@ BAD = {
     "interval without temperature": (_with("rate = 0.114", "rate = 0.114\nthermostat_interval = 0.1"),
                                      "shear.thermostat_interval = 0.1: needs shear.thermostat_temperature"),
     "driving": (SHEARED + "\n[driving]\nheating_rate = 0.1\n", "[driving] is not available with [shear]"),
+    "rough grains": (_with("[shear]", '[collision.tangential]\nmodel = "constant"\nrestitution = 0.0\n\n[shear]'),
+                     "rough particles are not available with [shear]"),
     "species": (SHEARED + '\n[[species]]\nname = "a"\ncount = 100\ndiameter = 1.0\nmass = 1.0\n'
                 '\n[[species]]\nname = "b"\ncount = 100\ndiameter = 1.0\nmass = 2.0\n',
                 "[shear] is not available with [[species]]"),

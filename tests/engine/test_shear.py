@@ -277,3 +277,11 @@ def test_two_spheres_at_rest_in_sliding_rows_collide(mode, dim):
     sim.run(np.inf, max_collisions=1)
     dx0, dy = 4.0, 0.8
     assert sim.time == pytest.approx((dx0 - np.sqrt(1 - dy**2)) / abs(u[0] - u[1]), rel=1e-9)
+
+
+def test_shear_refuses_rough_particles():
+    from granulargas.engine import TangentialRule
+
+    st = random_state(60, 0.1, 3, seed=1, boundary=LE3, shear=0.5)
+    with pytest.raises(ConfigError, match="rough particles"):
+        Simulation(st, CollisionRule.elastic(), shear=Shear(0.5), tangential=TangentialRule.constant(0.0))
