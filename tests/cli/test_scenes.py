@@ -56,7 +56,7 @@ EXAMPLES = {
                         ("edmd", "driven")),
     "rough_mpemba_hot": ({"system.particles": 1000}, ("edmd", "driven")),
     "rough_mpemba_cold": ({"system.particles": 1000}, ("edmd", "driven")),
-    "shear_3d": ({"system.particles": 500, "run.end_time": 300.0}, ("edmd", "shear")),
+    "shear_3d": ({"system.particles": 1000, "run.end_time": 600.0}, ("edmd", "shear")),
     "shear_2d": ({"system.particles": 400, "run.end_time": 300.0}, ("edmd", "shear")),
     "shear_dsmc_3d": ({"system.particles": 10000, "run.end_time": 300.0}, ("dsmc", "shear")),
     "shear_elastic_3d": ({"system.particles": 500, "run.end_time": 60.0}, ("edmd", "shear")),
