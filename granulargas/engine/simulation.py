@@ -236,6 +236,10 @@ class Simulation:
     the public state.
     """
 
+    #: uniform acceleration (d,) or None; wall kinds (a ``_state.WallSpec``) or None (hard walls at rest)
+    _gravity = None
+    _wallkinds = None
+
     #: the centre-of-mass velocity is removed once V^2 exceeds this fraction of <c^2> ...
     DRIFT_LIMIT = 1e-8
     #: ... if its kinetic energy is below this fraction of the energy that has passed
@@ -478,7 +482,8 @@ class Simulation:
                                    np.where(cp >= 0, slot[np.maximum(cp, 0)], -1).astype(np.int32)
                                    ) if self.rule.resolved else None
         _loop.predict_all(self._time, rec, particles.count, events, lists, *_loop.mode_flags(cells), spc,
-                          0.5 * self.shell * (1.0 - 1e-9), contacts, calendar.qt)
+                          0.5 * self.shell * (1.0 - 1e-9), contacts, self._flight(), self._wallkinds,
+                          calendar.qt)
         counters = np.zeros(1, dtype=_state.COUNTERS)
         c = counters[0]
         with np.errstate(over="ignore", under="ignore"):
@@ -494,7 +499,7 @@ class Simulation:
         c["kick_step"] = self._kick_step
         c["three_body"] = self._three_body
         c["err_i"] = c["err_j"] = -1
-        walls = _state.Walls(impulse=self._wall_impulse.copy())
+        walls = _state.walls(impulse=self._wall_impulse)
         self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts)
         self._place_events(self._time)
         self._built = True
@@ -545,7 +550,16 @@ class Simulation:
             kick_interval=drv.interval, kick_scale=kick_scale(drv.heating_rate, drv.interval, self.n),
             kick_seed=drv.seed)
         return _state.params(self.rule.compiled(), self._space, self.shell, float(self._radii.max()),
-                             1e-10 * scale, self.collapse_count, **kick)
+                             1e-10 * scale, self.collapse_count, **kick, gravity=self._flight(),
+                             wallkinds=self._wallkinds)
+
+    def _flight(self):
+        """The flight the kernels take: None (straight) or the (3,) gravity vector."""
+        if self._gravity is None:
+            return None
+        g = np.zeros(3)
+        g[: self.dimension] = self._gravity
+        return g
 
     # -------------------------------------------------------------------- run
     def run(self, until: float, max_collisions: int | None = None, progress=None) -> "Simulation":
@@ -696,6 +710,13 @@ class Simulation:
         ids = [int(self._order[k]) for k in (i, j) if k >= 0]
         where = f"at t = {float(c['time']):.12g} after {int(c['collisions'])} collisions (particles {ids})"
         if status == _loop.COLLAPSE:
+            if self._gravity is not None or "wall" in self.boundary:
+                # a grain at rest on a wall or a cluster on a shaken plate: a Zeno trap of bounces
+                raise InelasticCollapseError(
+                    f"inelastic collapse {where}: ever faster collisions (a grain coming to rest on a wall, "
+                    f"or a cluster on a shaken plate); set collision.elastic_below (collisions below that normal "
+                    f"speed are elastic: CollisionRule.constant(eps, elastic_below=v)) or the TC model "
+                    f"(collision.tc_time)")
             if self.rule.kind == "constant":
                 raise InelasticCollapseError(
                     f"inelastic collapse {where}: the collision rate diverges; use the TC model "
