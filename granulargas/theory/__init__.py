@@ -13,12 +13,15 @@ import theory; theory.haff_tau0(...)``):
   impact speeds, the spread of eps, the cooling curve, the instability length of
   a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there);
 * :mod:`~granulargas.theory.driven` -- the white-noise driven steady state
-  (temperature, a2, kick interval; viscoelastic: effective restitution).
+  (temperature, a2, kick interval; viscoelastic: effective restitution);
+* :mod:`~granulargas.theory.vibrated` -- gases under gravity and on vibrating walls:
+  hydrostatic and barometric profiles, the bouncing ball, the dilute vibrofluidized bed.
 """
 
-from granulargas.theory import driven, enskog, gas, viscoelastic  # noqa: F401
+from granulargas.theory import driven, enskog, gas, vibrated, viscoelastic  # noqa: F401
 from granulargas.theory.driven import *  # noqa: F401,F403
 from granulargas.theory.enskog import *  # noqa: F401,F403
+from granulargas.theory.vibrated import *  # noqa: F401,F403
 from granulargas.theory.viscoelastic import *  # noqa: F401,F403
 
-__all__ = enskog.__all__ + viscoelastic.__all__ + driven.__all__
+__all__ = enskog.__all__ + viscoelastic.__all__ + driven.__all__ + vibrated.__all__
