@@ -62,6 +62,11 @@ SECTION_TEXT = {
                           "(SI; all keys required), converted once to the reduced pair prefactor "
                           "k = (3/2) A (2Y / (3(1 − ν²)))^(2/5) (σ u / m²)^(1/5).",
     "driving": "Optional: white-noise driving (a heated granular gas in a steady state).",
+    "gravity": "Optional: a uniform acceleration (see [Gravity and vibrating walls](gravity-and-vibrating-walls.md)).",
+    "walls": "Optional: the kind of each wall (`system.boundary` axes with `\"wall\"`); a side left out "
+             "is a hard wall at rest.",
+    "walls.<side>": "The keys of each side's table in `[walls]` (`x_low`, ..., `z_high`), e.g. "
+                    "`walls.z_low.amplitude`.",
     "run": "When to stop (at least one key).",
     "output": "The output file and its schedule.",
 }
@@ -105,7 +110,7 @@ def config_reference_markdown() -> str:
     entries = config_entries()
     lines = []
     for section in dict.fromkeys(e.section for e in entries):
-        anchor = section.replace(".", "-")
+        anchor = section.replace(".", "-").replace("<", "").replace(">", "")
         lines += [f"## `[{section}]` {{ #{anchor} }}", ""]
         if section in SECTION_TEXT:
             lines += [SECTION_TEXT[section], ""]
