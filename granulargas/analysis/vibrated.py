@@ -1,0 +1,187 @@
+"""A gas under gravity or on vibrating walls: profiles along an axis, centre of mass, energy balance.
+
+A vibrated bed is homogeneous along the floor and not across it: the number density, the
+granular temperature and the shape of the velocity distribution depend on the height.
+What a run shows:
+
+* **layer profiles** along an axis (the axis of gravity, or the one a wall vibrates on),
+  accumulated over snapshots (:class:`LayerAccumulator`): the number density n(z), the
+  temperature T(z) = m <|c|^2> / d with c the velocity less the layer's mean (and its
+  components along and across the axis), and the central moments of each velocity
+  component, whose excess kurtosis <c^4>/<c^2>^2 - 3 is 0 for a Maxwellian (standard
+  error sqrt(24 / n) from n samples);
+* the **centre of mass** along the axis against time, and its mean in the steady state;
+* the **energy balance** of the steady state: the power the walls put in (the slope of
+  the cumulative ``wall_work``) against the power dissipated in collisions (the slope of
+  ``dissipated_energy``), each the mean over blocks of the second half of the run with
+  its standard error (:func:`energy_balance`);
+* for an elastic gas on a thermal wall, the **hydrostatic profile** of the same column
+  (:func:`granulargas.theory.vibrated.hydrostatic_density`) beside the measured n(z).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from granulargas.analysis.elastic import block_mean
+
+__all__ = ["LayerAccumulator", "LayerProfile", "centre_of_mass", "energy_balance", "EnergyBalance"]
+
+
+@dataclass(frozen=True)
+class LayerProfile:
+    """Profiles along ``axis`` in the layers between ``edges`` (arrays (B,)), from ``frames`` snapshots.
+
+    ``density``: particles per unit volume (area in 2D); ``temperature``: m <|c|^2> / d;
+    ``t_along``, ``t_across``: m <c_a^2> along the axis and the mean over the other axes;
+    ``kurtosis``: the excess kurtosis of each velocity component (B, d); ``counts``:
+    samples per layer (particle-frames).
+    """
+
+    axis: int
+    edges: np.ndarray
+    density: np.ndarray
+    temperature: np.ndarray
+    t_along: np.ndarray
+    t_across: np.ndarray
+    kurtosis: np.ndarray
+    counts: np.ndarray
+    frames: int
+
+    @property
+    def centres(self) -> np.ndarray:
+        return 0.5 * (self.edges[1:] + self.edges[:-1])
+
+    @property
+    def kurtosis_error(self) -> np.ndarray:
+        """Standard error of the excess kurtosis of a Gaussian sample of the layer's size."""
+        with np.errstate(divide="ignore"):
+            return np.sqrt(24.0 / self.counts)
+
+
+class LayerAccumulator:
+    """Sums of the layers along ``axis`` over snapshots; :meth:`profile` gives the :class:`LayerProfile`.
+
+    ``edges`` (B + 1,) bin edges along the axis; ``box`` (d,) the box sides (the layers'
+    cross-section is the product of the other sides). Particles outside the edges are
+    left out.
+    """
+
+    def __init__(self, axis: int, edges, box):
+        self.axis = int(axis)
+        self.edges = np.asarray(edges, dtype=float)
+        self.box = np.asarray(box, dtype=float)
+        d = self.box.shape[0]
+        b = self.edges.shape[0] - 1
+        self.frames = 0
+        self.n = np.zeros(b)
+        self.m = np.zeros(b)
+        self.s1 = np.zeros((b, d))  # sum v
+        self.s2 = np.zeros((b, d))  # sum v^2
+        self.s3 = np.zeros((b, d))
+        self.s4 = np.zeros((b, d))
+        self.mv = np.zeros((b, d))  # sum m v
+        self.mv2 = np.zeros((b, d))  # sum m v^2
+
+    def add(self, positions, velocities, masses):
+        """Add one snapshot (positions (N, d), velocities (N, d), masses (N,))."""
+        z = np.asarray(positions, dtype=float)[:, self.axis]
+        v = np.asarray(velocities, dtype=float)
+        m = np.broadcast_to(np.asarray(masses, dtype=float), z.shape)
+        k = np.searchsorted(self.edges, z, side="right") - 1
+        ok = (k >= 0) & (k < self.n.shape[0])
+        k, v, m = k[ok], v[ok], m[ok]
+        np.add.at(self.n, k, 1.0)
+        np.add.at(self.m, k, m)
+        for p, arr in ((1, self.s1), (2, self.s2), (3, self.s3), (4, self.s4)):
+            np.add.at(arr, k, v**p)
+        np.add.at(self.mv, k, m[:, None] * v)
+        np.add.at(self.mv2, k, m[:, None] * v * v)
+        self.frames += 1
+        return self
+
+    def profile(self) -> LayerProfile:
+        d = self.box.shape[0]
+        width = np.diff(self.edges)
+        section = float(np.prod(np.delete(self.box, self.axis)))
+        frames = max(self.frames, 1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            density = self.n / (frames * width * section)
+            # m <c_a^2> per component: (sum m v^2 - (sum m v)^2 / sum m) / n
+            comp = (self.mv2 - self.mv**2 / self.m[:, None]) / self.n[:, None]
+            mean = self.s1 / self.n[:, None]
+            mu2 = self.s2 / self.n[:, None] - mean**2
+            mu4 = (self.s4 / self.n[:, None] - 4 * mean * self.s3 / self.n[:, None]
+                   + 6 * mean**2 * self.s2 / self.n[:, None] - 3 * mean**4)
+            kurt = mu4 / mu2**2 - 3.0
+        others = [a for a in range(d) if a != self.axis]
+        return LayerProfile(self.axis, self.edges.copy(), density, comp.sum(axis=1) / d, comp[:, self.axis],
+                            comp[:, others].mean(axis=1), kurt, self.n.copy(), self.frames)
+
+
+def centre_of_mass(positions, masses, axis: int) -> float:
+    """Height of the centre of mass along ``axis``."""
+    z = np.asarray(positions, dtype=float)[:, axis]
+    m = np.broadcast_to(np.asarray(masses, dtype=float), z.shape)
+    return float(np.sum(m * z) / np.sum(m))
+
+
+@dataclass(frozen=True)
+class EnergyBalance:
+    """Power put in by the walls and dissipated in collisions in the steady state (mean, standard
+    error), from ``t_from`` on."""
+
+    power_in: float
+    power_in_error: float
+    dissipation: float
+    dissipation_error: float
+    t_from: float
+
+    @property
+    def ratio(self) -> float:
+        """Power dissipated / power put in (1 in a steady state)."""
+        return self.dissipation / self.power_in if self.power_in else math.nan
+
+    @property
+    def ratio_error(self) -> float:
+        r = self.ratio
+        return abs(r) * math.hypot(self.power_in_error / self.power_in, self.dissipation_error / self.dissipation) \
+            if self.power_in and self.dissipation else math.nan
+
+
+def energy_balance(time, wall_work, dissipated, t_from: float | None = None, blocks: int = 10) -> EnergyBalance:
+    """Mean powers from the cumulative ``wall_work`` and ``dissipated`` energy sampled at ``time``:
+    the increments over ``blocks`` equal blocks of samples from ``t_from`` (default: the second
+    half of the run) divided by their durations; the standard error from the spread of the
+    blocks (the mean power is the total increment over the total time)."""
+    t = np.asarray(time, dtype=float)
+    w = np.asarray(wall_work, dtype=float)
+    q = np.asarray(dissipated, dtype=float)
+    t_from = 0.5 * (t[0] + t[-1]) if t_from is None else float(t_from)
+    sel = np.flatnonzero(t >= t_from)
+    if sel.size < 3:
+        return EnergyBalance(math.nan, math.nan, math.nan, math.nan, t_from)
+    k = min(blocks, sel.size - 1)
+    cuts = np.linspace(sel[0], sel[-1], k + 1).round().astype(int)
+    dt = np.diff(t[cuts])
+    pin = np.diff(w[cuts]) / dt
+    pout = np.diff(q[cuts]) / dt
+    span = t[cuts[-1]] - t[cuts[0]]
+
+    def mean_err(p, total):
+        return total / span, (float(np.std(p, ddof=1) / math.sqrt(k)) if k > 1 else math.nan)
+
+    a, ea = mean_err(pin, w[cuts[-1]] - w[cuts[0]])
+    b, eb = mean_err(pout, q[cuts[-1]] - q[cuts[0]])
+    return EnergyBalance(a, ea, b, eb, t_from)
+
+
+def steady_mean(time, values, t_from: float | None = None):
+    """(mean, standard error) of a sampled series from ``t_from`` on (default: the second half),
+    by block means."""
+    t = np.asarray(time, dtype=float)
+    t_from = 0.5 * (t[0] + t[-1]) if t_from is None else float(t_from)
+    return block_mean(np.asarray(values, dtype=float)[t >= t_from])
