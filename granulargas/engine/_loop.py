@@ -907,18 +907,25 @@ def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisi
 
 
 @kernel
-def synchronised(rec, img, period, t, out_r, out_img):
-    """Positions and images of all particles streamed to time t (no side effect).
+def synchronised(rec, img, period, t, flight, out_r, out_img, out_v):
+    """Positions, images and velocities of all particles streamed to time t on their flight
+    (no side effect).
 
     Positions land in [0, L) on periodic axes: one wrap suffices because no
     particle is more than shell/2 from its list centre, which lies in the box
     (cell-crossing mode: no particle is beyond its cell by more than round-off).
-    Wall axes (period inf) are not wrapped.
+    Wall axes (period inf) are not wrapped. Straight flights keep the velocities.
     """
     for i in range(rec.shape[0]):
         dt = t - rec[i, 6]
         for a in range(3):
-            x = rec[i, a] + rec[i, 3 + a] * dt
+            if flight is None:
+                x = rec[i, a] + rec[i, 3 + a] * dt
+                out_v[i, a] = rec[i, 3 + a]
+            else:
+                w = rec[i, 3 + a] + flight[a] * dt
+                x = rec[i, a] + 0.5 * (rec[i, 3 + a] + w) * dt
+                out_v[i, a] = w
             k = img[i, a]
             if x >= period[a]:
                 x -= period[a]

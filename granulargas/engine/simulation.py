@@ -737,12 +737,9 @@ class Simulation:
         """Stream all particles to ``time`` and wrap; the next run rebuilds the queue."""
         if self._built:
             e = self._engine
-            self._positions, self._images = self._synchronised()
+            self._positions, self._images, self._velocities = self._synchronised()
             n, d = self._positions.shape
             inv = self._order
-            vel = np.empty((n, d))
-            vel[inv] = e.particles.rec[:, 3 : 3 + d]
-            self._velocities = vel
             lc = np.empty(n)
             lc[inv] = e.particles.lastcoll
             self._last_collision = lc
@@ -771,12 +768,15 @@ class Simulation:
         n, d = self._positions.shape
         r = np.empty((n, 3))
         img = np.empty((n, 3), dtype=np.int32)
-        _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, r, img)
+        v = np.empty((n, 3))
+        _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, self._flight(), r, img, v)
         pos = np.empty((n, d))
         pos[self._order] = r[:, :d]
         im = np.empty((n, d), dtype=np.int64)
         im[self._order] = img[:, :d]
-        return pos, im
+        vel = np.empty((n, d))
+        vel[self._order] = v[:, :d]
+        return pos, im, vel
 
     # ----------------------------------------------------------- public state
     @property
@@ -843,7 +843,7 @@ class Simulation:
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
-        pos, img = self._synchronised() if self._built else (self._positions, self._images)
+        pos, img = self._synchronised()[:2] if self._built else (self._positions, self._images)
         return pos + img * self._box
 
     @property
