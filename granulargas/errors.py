@@ -29,7 +29,15 @@ class SimulationError(UserError):
 
 
 class InelasticCollapseError(SimulationError):
-    """The event rate diverges: constant restitution collapse."""
+    """The event rate diverges: constant restitution collapse.
+
+    ``where`` says when and between which particles, without the cure, so that a
+    caller can name the cure in its user's terms (a config run: the config key).
+    """
+
+    def __init__(self, message: str, where: str = ""):
+        super().__init__(message)
+        self.where = where
 
 
 class TableRangeError(SimulationError):

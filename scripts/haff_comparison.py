@@ -265,7 +265,7 @@ def main(argv=None):
                                       span * tau_v, tau_v / 20, 30, 0.02 * tau_v, args.reuse)) for s in seeds]
     summarize(f"constant restitution {eps}, 3D (Haff)", const)
     summarize(f"viscoelastic, damping {k}, 3D", visco)
-    figure_cooling({"const": (f"$\\epsilon$ = {eps}", const), "visco": (f"viscoelastic, k = {k}", visco)},
+    figure_cooling({"const": (f"$\\epsilon$ = {eps}", const), "visco": (f"viscoelastic, damping {k}", visco)},
                    Path(args.figdir) / "cooling_haff.png")
 
     # 3. 2D below / above the instability length (same eps and density). Late-time T of a

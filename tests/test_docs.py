@@ -6,6 +6,7 @@ import re
 import subprocess
 import sys
 import tomllib
+from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
@@ -34,24 +35,144 @@ def _pyproject():
     return tomllib.loads((ROOT / "pyproject.toml").read_text())
 
 
-def test_docs_build_strict(tmp_path):
-    """mkdocs build --strict: no warning (broken link or anchor, missing image, page
-    outside the navigation, unparsable docstring, failing generator)."""
+@pytest.fixture(scope="module")
+def built_site(tmp_path_factory):
+    """``mkdocs build --strict`` into a temporary directory, once for the tests below:
+    (the finished process, the site directory, the docs/ tree before and after, whether
+    site/ existed in the source tree before)."""
     missing = _missing_docs_extra()
     if missing:
         pytest.skip(f"docs extra not installed (pip install '.[docs]'): missing {', '.join(missing)}")
+    site = tmp_path_factory.mktemp("docs") / "site"
     before = sorted(p.relative_to(ROOT) for p in (ROOT / "docs").rglob("*") if "__pycache__" not in p.parts)
     site_existed = (ROOT / "site").exists()
     env = dict(os.environ, NO_MKDOCS_2_WARNING="1")
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), env.get("PYTHONPATH")]))
-    out = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
+    out = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(site)],
                          cwd=ROOT, env=env, capture_output=True, text=True)
-    assert out.returncode == 0, out.stdout + out.stderr
-    assert (tmp_path / "site" / "index.html").is_file()
-    assert (tmp_path / "site" / "configuration" / "index.html").is_file()
     after = sorted(p.relative_to(ROOT) for p in (ROOT / "docs").rglob("*") if "__pycache__" not in p.parts)
+    return out, site, before, after, site_existed
+
+
+def test_docs_build_strict(built_site):
+    """mkdocs build --strict: no warning (broken link or anchor, missing image, page
+    outside the navigation, unparsable docstring, failing generator)."""
+    out, site, before, after, site_existed = built_site
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert (site / "index.html").is_file()
+    assert (site / "configuration" / "index.html").is_file()
     assert after == before, "the build wrote into docs/"
     assert (ROOT / "site").exists() == site_existed, "the build wrote site/ into the source tree"
+
+
+class _Loads(HTMLParser):
+    """Every resource a page makes the browser fetch: script/img/iframe/audio/video/source/
+    track/embed src and srcset, object data, link href (stylesheets, fonts, icons, preconnect,
+    preload), inline style url() and @import."""
+
+    ATTRIBUTES = {"script": ("src",), "img": ("src", "srcset"), "iframe": ("src",), "audio": ("src",),
+                  "video": ("src", "poster"), "source": ("src", "srcset"), "track": ("src",), "embed": ("src",),
+                  "object": ("data",), "link": ("href",), "input": ("src",)}
+    #: <link rel> values that name another page rather than load a resource
+    NAVIGATION = {"canonical", "alternate", "next", "prev", "author", "license", "help", "search"}
+
+    def __init__(self):
+        super().__init__()
+        self.urls = []
+        self._style = False
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if tag == "link" and set((attrs.get("rel") or "").split()) <= self.NAVIGATION:
+            return  # a relation to another page (canonical, next, ...), not a resource
+        for name in self.ATTRIBUTES.get(tag, ()):
+            value = attrs.get(name) or ""
+            self.urls += [part.strip().split()[0] for part in value.split(",") if part.strip()] if "srcset" in name \
+                else [value]
+        if attrs.get("style"):
+            self.urls += _css_urls(attrs["style"])
+        self._style = tag == "style"
+
+    def handle_data(self, data):
+        if self._style:
+            self.urls += _css_urls(data)
+
+    def handle_endtag(self, tag):
+        self._style = False
+
+
+def _css_urls(css: str) -> list:
+    return [m.strip("'\" ") for m in re.findall(r"url\(([^)]*)\)", css)] + re.findall(r"@import\s+[\"']([^\"']+)", css)
+
+
+def _remote(url: str) -> bool:
+    return bool(re.match(r"(?i)^(https?:)?//", url.strip()))
+
+
+def test_built_pages_load_nothing_from_the_network(built_site):
+    """Offline (a cluster without internet) the site must look as online: no page and no
+    stylesheet of the site fetches anything from another host (fonts, maths, scripts, images).
+    Links to other sites (<a href>) are not loads. The theme's own script reaches out only for
+    features the site does not use (repository facts for repo_url, mermaid diagrams)."""
+    out, site, *_ = built_site
+    assert out.returncode == 0, out.stdout + out.stderr
+    remote = {}
+    pages = sorted(site.rglob("*.html"))
+    assert len(pages) > 20
+    for page in pages:
+        parser = _Loads()
+        parser.feed(page.read_text(encoding="utf-8"))
+        remote.update({(str(page.relative_to(site)), u): None for u in parser.urls if _remote(u)})
+    for sheet in site.rglob("*.css"):
+        urls = [u for u in _css_urls(sheet.read_text(encoding="utf-8")) if not u.startswith("data:")]
+        remote.update({(str(sheet.relative_to(site)), u): None for u in urls if _remote(u)})
+    assert list(remote) == []
+    config = (ROOT / "mkdocs.yml").read_text()
+    assert "repo_url" not in config and "mermaid" not in config
+
+
+def test_maths_is_rendered_when_the_site_is_built(built_site):
+    """Every formula is MathML in the built page (no script renders it in the browser)."""
+    out, site, *_ = built_site
+    assert out.returncode == 0, out.stdout + out.stderr
+    theory = (site / "theory" / "index.html").read_text(encoding="utf-8")
+    assert theory.count("<math") > 50 and '<math display="block">' in theory
+    for page in site.rglob("*.html"):
+        text = page.read_text(encoding="utf-8")
+        assert 'class="arithmatex"' not in text, page
+        assert not re.search(r"\\\(\\(?:varepsilon|beta|tau|sigma)", text), page  # no raw \(\varepsilon ...
+    # a heading with maths: its table-of-contents entry is rendered too
+    toc = re.search(r'<nav class="md-nav md-nav--secondary".*?</nav>', theory, re.S).group(0)
+    assert "<math" in toc and "\\varepsilon" not in toc
+
+
+def test_configuration_keys_break_only_between_words(built_site):
+    """A narrow column of the configuration reference breaks packing_fraction after the
+    underscore, never inside a word (the theme's code spans break anywhere)."""
+    out, site, *_ = built_site
+    assert out.returncode == 0, out.stdout + out.stderr
+    page = (site / "configuration" / "index.html").read_text(encoding="utf-8")
+    assert '<code class="config-key">packing_<wbr>fraction</code>' in page
+    assert '<code class="config-key">observables_<wbr>interval</code>' in page
+    css = (site / "stylesheets" / "extra.css").read_text()
+    rule = re.search(r"code\.config-key\s*{([^}]*)}", css).group(1)
+    assert "word-break: normal" in rule and "overflow-wrap: normal" in rule
+    assert "stylesheets/extra.css" in page
+
+
+def test_a_formula_the_converter_cannot_read_fails_the_build():
+    spec = importlib.util.find_spec("math_core")
+    if spec is None:
+        pytest.skip("docs extra not installed (math-core)")
+    maths = importlib.util.spec_from_file_location("granulargas_docs_maths", ROOT / "docs/hooks/maths.py")
+    module = importlib.util.module_from_spec(maths)
+    maths.loader.exec_module(module)
+    good = module.render('<p>x <span class="arithmatex">\\(\\beta = \\tfrac32 A\\)</span></p>', "p.md")
+    assert "<math>" in good and "<mi>β</mi>" in good and "arithmatex" not in good
+    block = module.render('<div class="arithmatex">\\[\\mathbf v_i\\]</div>', "p.md")
+    assert block.startswith('<math display="block">') and "𝐯" in block  # bold as MathML Core renders it
+    with pytest.raises(ValueError, match=r"p\.md: cannot render the formula"):
+        module.render('<span class="arithmatex">\\(\\frac{1}{\\)</span>', "p.md")
 
 
 def _documented_keys():
@@ -137,9 +258,9 @@ def test_every_key_the_validator_accepts_is_in_the_reference():
         m = re.match(r"## `\[(.+)\]`", line)
         if m:
             section = m.group(1)
-        m = re.match(r"\| `([^`]+)` \|", line)
+        m = re.match(r'\| <code class="config-key">([^<]+(?:<wbr>[^<]*)*)</code> \|', line)
         if m:
-            rows.setdefault(section, set()).add(m.group(1))
+            rows.setdefault(section, set()).add(m.group(1).replace("<wbr>", ""))
     toml_name = {"from_file": "from", "diameter_min": "diameter.min", "diameter_max": "diameter.max"}
     for name, cls in c.SECTION_CLASSES.items():
         for f in dataclasses.fields(cls):
@@ -156,6 +277,19 @@ def test_every_key_the_validator_accepts_is_in_the_reference():
     # the rules across keys are rendered too
     for rule in c.config_rules():
         assert rule.text in markdown
+
+
+def test_home_page_links_every_guide_and_method_page():
+    """The home page describes the whole package: it links each page of the navigation's
+    "User guide" and "Physics and methods" (walls and driving, DSMC, ... as they arrive)."""
+    yaml = pytest.importorskip("yaml", reason="PyYAML (a dependency of the docs extra) not installed")
+    config = yaml.load((ROOT / "mkdocs.yml").read_text(), Loader=yaml.BaseLoader)
+    sections = {k: v for entry in config["nav"] for k, v in entry.items()}
+    pages = [p for name in ("User guide", "Physics and methods") for entry in sections[name] for p in entry.values()]
+    home = (ROOT / "docs" / "index.md").read_text()
+    assert len(pages) >= 12
+    assert [p for p in pages if f"]({p}" not in home] == []
+    assert "periodic box" not in home  # walls close a box too
 
 
 def test_citation_cff_matches_the_package():

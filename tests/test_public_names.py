@@ -1,5 +1,4 @@
-"""Names users rely on keep working: the package root, the CLI table, and the
-deprecated aliases at the paths modules moved from."""
+"""Names users rely on: the package root (the front door ``import granulargas as gg``) and the CLI table."""
 
 import importlib
 import subprocess
@@ -32,53 +31,67 @@ def test_every_command_module_has_parser_and_run(name):
     assert callable(module.configure_parser) and callable(module.run)
 
 
-@pytest.mark.parametrize("old, new, names", [
-    ("granulargas.io.runner", "granulargas.run.runner", ["run_config", "output_schedule", "mean_free_time"]),
-    ("granulargas.io.setup", "granulargas.run.prepare", ["prepare", "fresh_state", "reduced_prefactor"]),
-    ("granulargas.io.lammps", "granulargas.dem.lammps", ["DemContact", "write_lammps_gas", "find_lmp"]),
-    ("granulargas.engine.initial", "granulargas.initial.lattice_gas", ["random_state", "InitialState"]),
-    ("granulargas.advise", "granulargas.run.advise", ["advise", "summary_line"]),
-    ("granulargas.validity", "granulargas.run.validity", ["check_run", "raise_if_invalid"]),
-    ("granulargas.sweep", "granulargas.run.sweep", ["load_sweep", "run_sweep"]),
-    ("granulargas.io.run_command", "granulargas.cli.run", ["configure_parser", "run"]),
-    ("granulargas.analysis.cli", "granulargas.cli.analyze", ["report", "run"]),
-    ("granulargas.contact.cli", "granulargas.cli.epsilon", ["configure_parser", "run"]),
-    ("granulargas.contact.seed_route", "granulargas.contact.perturbation", ["perturbation_solution", "puiseux_x"]),
-])
-def test_moved_modules_keep_their_old_name(old, new, names):
-    sys.modules.pop(old, None)
-    with pytest.warns(DeprecationWarning, match=new.replace(".", r"\.")):
-        module = importlib.import_module(old)
-    moved = importlib.import_module(new)
-    assert module is moved
-    for name in names:
-        assert getattr(module, name) is getattr(moved, name)
+#: the names a notebook starts with (``import granulargas as gg``) and where each is defined
+FRONT_DOOR = {
+    "load_config": "granulargas.io.config", "simulate": "granulargas.api", "load_run": "granulargas.api",
+    "Result": "granulargas.api", "analyze": "granulargas.api",
+    "Simulation": "granulargas.engine", "CollisionRule": "granulargas.engine", "WhiteNoise": "granulargas.engine",
+    "DSMC": "granulargas.dsmc", "random_state": "granulargas.initial", "InitialState": "granulargas.initial",
+    "restitution": "granulargas.contact",
+}
 
 
-def test_export_names_keep_working():
-    sys.modules.pop("granulargas.io.export", None)
-    with pytest.warns(DeprecationWarning):
-        from granulargas.io.export import GSD_TIME_KEY, export_gsd, export_lammps
-    from granulargas.dem import export
-    from granulargas.io import gsd
+def test_dir_lists_the_front_door():
+    """dir(gg) shows every public name (loaded or not) and nothing of the package's machinery."""
+    out = subprocess.run([sys.executable, "-c", "import granulargas, sys; print(sorted(dir(granulargas))); "
+                          "print(sorted(granulargas.__all__)); print('numba' in sys.modules)"],
+                         capture_output=True, text=True, check=True)
+    shown, listed, numba = out.stdout.splitlines()
+    assert set(FRONT_DOOR) <= set(eval(shown)) and sorted(FRONT_DOOR) == eval(listed)
+    assert numba == "False"  # listing the names imports none of them
+    assert not [n for n in eval(shown) if "Moved" in n or n in ("sys", "importlib")]
 
-    assert export_lammps is export.export_lammps and export_gsd is gsd.export_gsd
-    assert GSD_TIME_KEY == gsd.GSD_TIME_KEY
+
+@pytest.mark.parametrize("name", sorted(FRONT_DOOR))
+def test_each_front_door_name_is_the_object_of_its_module(name):
+    assert getattr(granulargas, name) is getattr(importlib.import_module(FRONT_DOOR[name]), name)
+    assert getattr(granulargas, name).__doc__
 
 
-def test_old_paths_hold_no_file():
-    """The old names are resolved by granulargas._moved, so no old file shadows a moved module."""
-    from pathlib import Path
+def test_no_front_door_name_is_a_subpackage():
+    """Importing granulargas.X sets the package attribute X: a public name X would be replaced."""
+    import pkgutil
 
-    from granulargas._moved import MOVED
+    modules = {m.name for m in pkgutil.iter_modules(granulargas.__path__)}
+    assert "run" in modules and not modules & set(granulargas.__all__)
+    importlib.import_module("granulargas.run.runner")
+    assert callable(granulargas.simulate) and granulargas.Result.__module__ == "granulargas.api"
 
-    root = Path(granulargas.__file__).parent.parent
-    for old in MOVED:
-        path = root / Path(*old.split("."))
-        assert not path.with_suffix(".py").exists() and not path.is_dir(), old
+
+def test_opening_a_result_does_not_import_numba():
+    code = ("import sys, granulargas as gg; gg.load_config, gg.load_run, gg.Result; "
+            "print('numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_no_module_answers_for_a_retired_path():
+    """Modules live at one path each: the old paths of moved modules are gone."""
+    for old in ("granulargas.io.runner", "granulargas.engine.initial", "granulargas.advise"):
+        sys.modules.pop(old, None)
+        with pytest.raises(ModuleNotFoundError):
+            importlib.import_module(old)
 
 
 def test_config_and_readers_stay_in_io():
     from granulargas.io import config, h5md
 
     assert callable(config.load_config) and callable(h5md.read_observables) and callable(h5md.iter_snapshots)
+
+
+def test_api_docs_list_every_front_door_name():
+    from pathlib import Path
+
+    page = (Path(__file__).resolve().parents[1] / "docs" / "api" / "granulargas.md").read_text()
+    assert [n for n in granulargas.__all__ if f"`gg.{n}" not in page] == []
+    assert "::: granulargas.api" in page

@@ -34,3 +34,23 @@ def test_ci_runs_the_readme_test_command():
 def test_main_job_config_exists():
     config = readme_commands()[0].split("granulargas run ")[1].split()[0]
     assert (ROOT / config).is_file()
+
+
+def test_readme_python_block_runs(tmp_path, monkeypatch, capsys):
+    """The README's "From Python" block, run in a fresh directory with the quickstart config."""
+    import shutil
+
+    import matplotlib
+    import pytest
+
+    pytest.importorskip("pandas", reason="the [pandas] extra")
+    matplotlib.use("Agg")
+    block = re.search(r"## From Python\n\n```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S).group(1)
+    (tmp_path / "configs").mkdir()
+    (tmp_path / "runs").mkdir()
+    shutil.copy(ROOT / "configs" / "quickstart.toml", tmp_path / "configs")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(block, "README.md", "exec"), {})
+    collisions, temperature, eps = capsys.readouterr().out.split()
+    assert int(collisions) > 0 and 0 < float(temperature) < 1
+    assert float(eps) == pytest.approx(0.8921, abs=1e-4) and (tmp_path / "runs" / "nb.h5").is_file()

@@ -105,6 +105,13 @@ def _cell(text: str) -> str:
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
+def key_cell(key: str) -> str:
+    """A key as the reference shows it: code that a narrow column breaks only after ``_`` or
+    ``.`` (``<wbr>``), never inside a word (``config-key`` in docs/stylesheets/extra.css)."""
+    breakable = re.sub(r"([_.])", r"\1<wbr>", key)
+    return f'<code class="config-key">{breakable}</code>'
+
+
 def config_reference_markdown() -> str:
     """The configuration reference: one table per section, then the rules across keys."""
     entries = config_entries()
@@ -116,7 +123,7 @@ def config_reference_markdown() -> str:
             lines += [SECTION_TEXT[section], ""]
         lines += ["| key | type | default | unit | allowed | meaning |", "|---|---|---|---|---|---|"]
         for e in (e for e in entries if e.section == section):
-            lines.append(f"| `{e.key}` | {e.type} | {_cell(_show_default(e.default))} | {_cell(e.unit or '—')} | "
+            lines.append(f"| {key_cell(e.key)} | {e.type} | {_cell(_show_default(e.default))} | {_cell(e.unit or '—')} | "
                          f"{_cell(e.allowed)} | {_cell(e.meaning)} |")
         lines.append("")
     lines += ["## Rules across keys { #rules }", ""]

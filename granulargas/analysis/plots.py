@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-__all__ = ["PLOTS", "plot_analysis", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic", "plot_sweep"]
+__all__ = ["PLOTS", "plot_analysis", "ratio_limits", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic", "plot_sweep"]
 
 
 def _plt():
@@ -38,12 +38,25 @@ def _title(info, what):
     extra = ""
     if info.model == "constant" and info.restitution is not None:
         extra = f", $\\varepsilon$ = {info.restitution:g}"
-    elif info.model == "viscoelastic" and info.prefactor is not None:
-        extra = f", k = {info.prefactor:.3g}"
+    elif info.damping is not None:
+        extra = f", damping {info.damping:.3g}"
     eta = info.solid_fraction if math.isfinite(info.solid_fraction) else info.packing_fraction
     method = "DSMC, " if getattr(info, "method", "edmd") == "dsmc" else ""
     return (f"{what}\n{name}: {method}{info.model}{extra}, {info.dimension}D, N = {info.particles}, $\\eta$ = {eta:.3g}"
             + ("" if info.monodisperse else "; polydisperse, theory for particles of the mean diameter"))
+
+
+def ratio_limits(ratio) -> tuple[str, float, float]:
+    """(scale, low, high) of a T/T_theory axis: linear and symmetric about 1 (at least +-3 %)
+    while the ratio stays within a factor 1.5 of 1; beyond, logarithmic from below the
+    smallest to above the largest ratio. A ratio is positive: the axis never goes below 0."""
+    r = np.asarray(ratio, dtype=float)
+    r = r[np.isfinite(r) & (r > 0)]
+    lo, hi = (float(r.min()), float(r.max())) if r.size else (1.0, 1.0)
+    if hi <= 1.5 and lo >= 1 / 1.5:
+        span = max(hi - 1.0, 1.0 - lo, 0.03) * 1.15
+        return "linear", 1.0 - span, 1.0 + span
+    return "log", min(lo, 1.0) / 1.15, max(hi, 1.0) * 1.15
 
 
 def plot_cooling(analysis, path):
@@ -84,9 +97,15 @@ def plot_cooling(analysis, path):
     ax.axhspan(0.98, 1.02, color="0.9", label="$\\pm$2 %")
     ax.semilogx(t[pos], r[pos], ".", ms=3, color="C0")
     ax.axhline(1.0, color="k", lw=0.8)
-    lo, hi = np.nanmin(r[pos]) if np.any(pos) else 1.0, np.nanmax(r[pos]) if np.any(pos) else 1.0
-    span = max(hi - 1.0, 1.0 - lo, 0.03) * 1.15
-    ax.set_ylim(1.0 - span, 1.0 + span)
+    scale, low, high = ratio_limits(r[pos])
+    ax.set_yscale(scale)
+    ax.set_ylim(low, high)
+    if scale == "log":  # plain numbers (0.9, 1, 2, 5) on a ratio axis, not powers of ten
+        from matplotlib.ticker import FuncFormatter
+
+        plain = FuncFormatter(lambda v, _: f"{v:g}")
+        ax.yaxis.set_major_formatter(plain)
+        ax.yaxis.set_minor_formatter(plain)
     _no_offset(ax)
     ax.set_ylabel("$T/T_\\mathrm{theory}$")
     ax.text(0.01, 0.95, f"last 10 % of t: {a.T_ratio_final:.4f};  last decade: {a.T_ratio_last_decade:.4f}",

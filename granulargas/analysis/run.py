@@ -39,6 +39,7 @@ from granulargas.analysis.cooling import (
     fit_cooling_law,
     sonine_coefficients,
 )
+from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import InputFileError
 from granulargas.io.h5md import iter_snapshots, load_snapshot, read_observables, read_parameters
 from granulargas.theory.gas import CoolingCurve, Gas, cooling_curve, pressure_factor
@@ -142,6 +143,15 @@ class RunInfo:
             boundary=tuple(snap.boundary) or ("periodic",) * int(snap.box.shape[0]),
             method=str(params.get("method", "edmd")),
         )
+
+    @property
+    def damping(self) -> float | None:
+        """The run's ``damping`` (a viscoelastic run): beta at unit impact speed for two
+        reference particles, the one name every output gives the parameter (the
+        ``[collision.material]`` route's equivalent); None for other models."""
+        if self.model != "viscoelastic" or self.prefactor is None:
+            return None
+        return float(damping_from_prefactor(self.prefactor))
 
     @property
     def walls(self) -> bool:
@@ -455,7 +465,7 @@ class CoolingAnalysis:
         return _clean({
             **run_identity(info, self.kind),
             "restitution": info.restitution,
-            "prefactor": info.prefactor,
+            "damping": info.damping,
             **history_span(h),
             "theory": self.theory_name,
             "T_theory_final": float(T_th[-1]),
@@ -463,6 +473,8 @@ class CoolingAnalysis:
             "T_ratio_last_decade": self.T_ratio_last_decade,
             "tau0_fit": self.fit.tau0 if self.fit else None,
             "tau0_fit_error": self.fit.tau0_err if self.fit else None,
+            "tau0_fit_free": self.fit_free.tau0 if self.fit_free else None,
+            "tau0_fit_free_error": self.fit_free.tau0_err if self.fit_free else None,
             "tau0_theory": self.theory_fit.tau0 if self.theory_fit else p.tau0,
             "tau0_closed_form": p.tau0,
             "exponent_fit": -self.fit_free.exponent if self.fit_free else None,

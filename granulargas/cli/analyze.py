@@ -1,6 +1,6 @@
 """Report on a run's H5MD file, or on a sweep directory, against kinetic theory.
 
-``granulargas analyze PATH [--plot PNG] [--json] [--fit-range TMIN TMAX] [--no-snapshots]``
+``granulargas analyze PATH [--plot [PNG]] [--json] [--fit-range TMIN TMAX] [--no-snapshots]``
 
 PATH is a run's H5MD file (the analysis of its kind, :mod:`granulargas.analysis.kinds`:
 cooling runs against the kinetic theory of :mod:`granulargas.theory.gas`, elastic runs
@@ -20,16 +20,22 @@ from pathlib import Path
 
 import numpy as np
 
-from granulargas.errors import InputFileError
+from granulargas.errors import InputFileError, UserError
 from granulargas.io.paths import existing_directory
 
 INDEX_NAME = "index.json"
+#: ``--plot`` given without a path: the figure goes beside the input (:func:`plot_path`)
+DEFAULT_PLOT = "<beside the input>"
+#: figure formats matplotlib writes (a path with another suffix is refused: no run file is overwritten)
+FIGURE_SUFFIXES = ("png", "pdf", "svg", "jpg", "jpeg", "webp", "eps", "tif", "tiff")
 
 
 def configure_parser(parser):
     parser.add_argument("file", metavar="PATH",
                         help="H5MD file written by 'granulargas run', or a sweep's output directory (index.json)")
-    parser.add_argument("--plot", metavar="PNG", help="write the figure of the analysis here")
+    parser.add_argument("--plot", metavar="PNG", nargs="?", const=DEFAULT_PLOT,
+                        help="write the figure of the analysis to PNG; without PNG beside the input: PATH with the "
+                             "suffix .png (runs/x.h5 -> runs/x.png; a sweep directory DIR -> DIR/sweep.png)")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of the report")
     parser.add_argument("--fit-range", nargs=2, type=float, metavar=("TMIN", "TMAX"),
                         help="fit window in time since the first sample (default: all samples)")
@@ -62,7 +68,7 @@ def _header(info) -> list[str]:
         f"  {info.dimension}D, N = {info.particles}, box = {' x '.join(_fmt(float(L)) for L in info.box)}, "
         f"packing fraction = {info.packing_fraction:.4g}, model = {info.model}"
         + (f" (restitution {info.restitution:g})" if info.restitution is not None and info.model == "constant" else "")
-        + (f" (prefactor k = {info.prefactor:.4g})" if info.prefactor is not None and info.model == "viscoelastic" else ""),
+        + (f" (damping {info.damping:.4g})" if info.damping is not None else ""),
     ]
     if info.method == "dsmc":
         lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; the pressure is not "
@@ -108,8 +114,9 @@ def cooling_report(a, rows: int = 10) -> str:
         lines.append(f"  fit T0 (1 + t/tau0)^-{f.exponent:.4g}: tau0 = {f.tau0:.5g} +- {f.tau0_err:.2g}, theory "
                      f"{ref:.5g}{_dev(f.tau0, ref)}; closed form {p.tau0:.5g}{_dev(f.tau0, p.tau0)}")
         ref_e = tg.exponent if tg is not None else p.exponent
-        lines.append(f"  fit with free exponent: exponent = -{g.exponent:.4f} +- {g.exponent_err:.2g}, theory "
-                     f"-{ref_e:.4f} (the same fit of the theory curve), closed form -{p.exponent:.4g}")
+        lines.append(f"  fit T0 (1 + t/tau0)^-p with free exponent (the figure's fit): tau0 = {g.tau0:.5g} +- "
+                     f"{g.tau0_err:.2g}, p = {g.exponent:.4f} +- {g.exponent_err:.2g}; theory p = {ref_e:.4f} "
+                     f"(the same fit of the theory curve), closed form {p.exponent:.4g}")
     ts, a2, _ = a.sonine
     if ts.size:
         k = np.unique(np.linspace(0, ts.size - 1, min(ts.size, 6)).astype(int))
@@ -245,12 +252,27 @@ def _run_sweep(args) -> int:
     return 0
 
 
+def plot_path(path: Path) -> Path:
+    """Where ``--plot`` without a value writes: beside a run's file with the suffix .png, inside a
+    sweep's directory as sweep.png."""
+    return path / "sweep.png" if path.is_dir() else path.with_suffix(".png")
+
+
+def _check_figure_path(value: str, option: str):
+    """A figure path: an image suffix (never a run's .h5 or a config), in a directory that exists."""
+    if Path(value).suffix.lower().lstrip(".") not in FIGURE_SUFFIXES:
+        raise UserError(f"{option} {value}: give a figure file ({', '.join('.' + s for s in FIGURE_SUFFIXES)})")
+    existing_directory(value, f"{option} {value}")
+
+
 def run(args) -> int:
     path = Path(args.file)
+    if args.plot == DEFAULT_PLOT:
+        args.plot = str(plot_path(path))
     if args.plot:  # before any work: a typo in the directory is refused, never created
-        existing_directory(args.plot, f"--plot {args.plot}")
+        _check_figure_path(args.plot, "--plot")
     if args.velocity:
-        existing_directory(args.velocity, f"--velocity {args.velocity}")
+        _check_figure_path(args.velocity, "--velocity")
     if path.is_dir():
         if not _is_sweep(path):
             raise InputFileError(f"{path}: is a directory without {INDEX_NAME} (give a run's .h5 file or a "

@@ -14,7 +14,11 @@ from granulargas.run.sweep import format_value, load_sweep, make_executor, run_s
 
 
 def configure_parser(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("sweep_file", metavar="SWEEP.toml", help="sweep file (see `granulargas.run.sweep`)")
+    parser.add_argument("sweep_file", metavar="SWEEP.toml",
+                        help="sweep file: base config, [set] overrides, [vary] values as lists, "
+                             "{ range = [first, last] } (integers, both ends included: [1, 4] is 1, 2, 3, 4; "
+                             "[first, last, step]), { linspace = [a, b, n] } or { logspace = [a, b, n] } "
+                             "(docs/sweeps.md)")
     parser.add_argument("--workers", type=int, default=None, help="local worker processes (default: all cores)")
     parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
                         help="run on a Dask cluster, e.g. tcp://host:8786 (needs the 'dask' extra)")

@@ -720,7 +720,7 @@ class Simulation:
             if self.rule.kind == "constant":
                 raise InelasticCollapseError(
                     f"inelastic collapse {where}: the collision rate diverges; use the TC model "
-                    f"(CollisionRule.constant(eps, tc_time=...)) or a viscoelastic rule")
+                    f"(CollisionRule.constant(eps, tc_time=...)) or a viscoelastic rule", where=where)
             raise SimulationError(f"endless rapid re-collisions {where} (round-off loop)")
         if status == _loop.TABLE_RANGE:
             raise TableRangeError(f"impact beyond the restitution table {where}: build the table "

@@ -494,9 +494,9 @@ SCHEMA: tuple[Key, ...] = (
     Key("collision", "restitution", "number", '`model = "constant"` only: the constant ε.',
         low=0.0, low_open=True, high=1.0),
     Key("collision", "damping", "number",
-        '`model = "viscoelastic"` only: β at normal impact speed 1 for two reference particles '
-        "(diameter 1, mass 1); other pairs scale with R_eff and m_eff, β = k (R_eff g / m_eff²)^(1/5). "
-        "Give `damping` or `[collision.material]`.",
+        '`model = "viscoelastic"` only: the [damping](contact.md#damping), β of an impact at normal '
+        "speed 1 between two reference particles (diameter 1, mass 1); an impact at speed g between "
+        "particles i, j has β = damping (R_eff g / m_eff²)^(1/5). Give `damping` or `[collision.material]`.",
         low=0.0, high=TABLE_BETA_MAX, reason="the restitution table covers beta <= 40; the model holds "
                                              "for beta well below 3",
         run_check="beta of the fastest impact the run's energy allows must stay <= 40"),

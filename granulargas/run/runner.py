@@ -53,7 +53,7 @@ import numpy as np
 from tqdm import tqdm
 
 from granulargas.engine import Simulation
-from granulargas.errors import ConfigError, InputFileError, SimulationError, UserError
+from granulargas.errors import ConfigError, InelasticCollapseError, InputFileError, SimulationError, UserError
 from granulargas.io.config import RunConfig, parse_config
 from granulargas.io.h5md import H5MDWriter, read_parameters
 from granulargas.io.paths import existing_directory, output_file
@@ -329,6 +329,20 @@ def _observables(sim, pressure: bool) -> dict:
     return out
 
 
+def collapse_message(config: RunConfig, where: str) -> str:
+    """The inelastic-collapse error of a config run: the cure named by the config's keys
+    (the TC model's ``collision.tc_time``, with a value that changed T(t) by 0.03 % in the
+    collapse demonstration of docs/choosing-a-model.md, or the viscoelastic model)."""
+    tc = TC_TIME_FRACTION * mean_free_time(config)
+    return (f"inelastic collapse {where}: the collision rate diverges; set collision.tc_time in {config.source} "
+            f"(the TC model, e.g. tc_time = {tc:.2g}: {TC_TIME_FRACTION:.0e} of the initial mean free time) "
+            f"or use collision.model = \"viscoelastic\"")
+
+
+#: tc_time the collapse error proposes, in mean free times at the initial temperature
+TC_TIME_FRACTION = 1e-6
+
+
 def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True, progress=None,
                log=None, append: bool = False, stop: StopRequest | None = None) -> RunSummary:
     """Run a validated config to the end and write its H5MD file.
@@ -514,6 +528,9 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
             writer.close()
             if bar is not None:
                 bar.close()
+        if isinstance(exc, InelasticCollapseError):
+            raise InelasticCollapseError(f"{collapse_message(config, exc.where)} ({path} keeps {kept} snapshots)",
+                                         where=exc.where) from None
         if isinstance(exc, SimulationError) and type(exc).__init__ is Exception.__init__:
             raise type(exc)(f"{exc} ({path} keeps {kept} snapshots)") from None
         if isinstance(exc, KeyboardInterrupt):  # a second signal: stopped at once

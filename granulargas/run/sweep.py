@@ -11,7 +11,7 @@ A sweep file names a base config and the parameters to vary::
 
     [vary]                               # lists, ranges, linspaces, seeds
     collision.restitution = [0.9, 0.8, 0.7]
-    system.seed = { range = [1, 5] }     # 1, 2, 3, 4 (Python range semantics)
+    system.seed = { range = [1, 4] }     # 1, 2, 3, 4 (both ends included)
     # system.packing_fraction = { linspace = [0.05, 0.2, 4] }
     # collision.damping = { logspace = [-3, -1, 3] }
 
@@ -113,9 +113,11 @@ def _count(path: Path, key: str, spec) -> int:
         if not numbers or not all(math.isfinite(a) for a in args):
             raise ConfigError(f"{where}.{kind} = {args!r}: expected a list of finite numbers")
         if kind == "range":
-            if not all(isinstance(a, int) for a in args) or not 1 <= len(args) <= 3 or (len(args) == 3 and args[2] == 0):
-                raise ConfigError(f"{where}.range = {args!r}: expected 1 to 3 integers [start, stop, step], step != 0")
-            count = len(range(*args))
+            if not all(isinstance(a, int) for a in args) or len(args) not in (2, 3) or (len(args) == 3 and args[2] == 0):
+                raise ConfigError(f"{where}.range = {args!r}: expected integers [first, last] or [first, last, step] "
+                                  "(both ends included: [1, 4] gives 1, 2, 3, 4), step != 0")
+            first, last, step = (*args, 1)[:3]
+            count = max(0, (last - first) // step + 1)  # len(inclusive_range(...)) without its ssize_t bound
         else:
             if len(args) != 3 or not isinstance(args[2], int) or args[2] < 1:
                 raise ConfigError(f"{where}.{kind} = {args!r}: expected [start, stop, count] with count >= 1")
@@ -130,6 +132,13 @@ def _count(path: Path, key: str, spec) -> int:
     raise ConfigError(f"{where} = {spec!r}: expected a list, a value, or range/linspace/logspace")
 
 
+def inclusive_range(first: int, last: int, step: int = 1) -> range:
+    """``{ range = [first, last, step] }``: first, first + step, ... up to and including ``last``
+    when a step lands on it (``[1, 4]``: 1, 2, 3, 4; ``[1, 10, 4]``: 1, 5, 9; ``[4, 1, -1]``: 4, 3, 2, 1),
+    as ``linspace`` includes both ends."""
+    return range(first, last + (1 if step > 0 else -1), step)
+
+
 def _expand_values(path: Path, key: str, spec) -> list:
     """A list of values from a list, a scalar, or {range|linspace|logspace = [...]}."""
     _count(path, key, spec)
@@ -138,7 +147,7 @@ def _expand_values(path: Path, key: str, spec) -> list:
     if isinstance(spec, dict):
         (kind, args), = spec.items()
         if kind == "range":
-            return list(range(*args))
+            return list(inclusive_range(*args))
         a, b, n = args
         step = (b - a) / (n - 1) if n > 1 else 0.0
         values = [a + i * step for i in range(n)]

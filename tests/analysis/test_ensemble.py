@@ -97,6 +97,9 @@ def test_sweep_summaries_repr_and_cli(sweep_dir, capsys, tmp_path):
     assert g["seeds"] == 3 and g["quantity"] == "tau0" and "first Sonine" in g["theory"]
     assert g["value"] == pytest.approx(groups[0].value) and g["theory_value"] == pytest.approx(groups[0].theory)
     assert (tmp_path / "s.png").stat().st_size > 10_000
+    assert main(["analyze", str(sweep_dir), "--plot"]) == 0  # without a path: inside the sweep's directory
+    assert f"wrote {sweep_dir / 'sweep.png'}" in capsys.readouterr().out
+    assert (sweep_dir / "sweep.png").stat().st_size > 10_000
     assert main(["analyze", str(sweep_dir)]) == 0
     table = capsys.readouterr().out
     assert "seeds" in table and "T_theory" in table and "0.95" in table

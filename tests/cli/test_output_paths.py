@@ -56,6 +56,19 @@ def test_analyze_plot(run_file, here, capsys):
              "--plot nodir/x.png: directory nodir does not exist")
 
 
+def test_analyze_plot_without_a_path_writes_beside_the_file(run_file, here, capsys):
+    assert main(["analyze", "run.h5", "--no-snapshots", "--plot"]) == 0
+    assert "wrote run.png" in capsys.readouterr().out
+    assert (here / "run.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_analyze_plot_never_overwrites_a_run_file(run_file, here, capsys):
+    (here / "other.h5").write_bytes(b"data")
+    _refused(capsys, ["analyze", "run.h5", "--plot", "other.h5"], here, "--plot other.h5: give a figure file (.png")
+    _refused(capsys, ["analyze", "run.h5", "--velocity", "c.toml"], here, "--velocity c.toml: give a figure file")
+    assert (here / "other.h5").read_bytes() == b"data"
+
+
 def test_export_gsd(run_file, here, capsys):
     pytest.importorskip("gsd.hoomd", reason="gsd not installed (pip install 'granulargas[export]')")
     _refused(capsys, ["export", "gsd", "run.h5", "-o", "nodir/x.gsd"], here, "nodir/x.gsd: directory nodir does not exist")

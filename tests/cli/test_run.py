@@ -183,3 +183,33 @@ def test_summary_reports_validity_and_advice(case):
     assert rc == 0, err
     assert "advice" in out and "best constant eps" in out
     assert "t_c/t_free" in out
+
+
+COLLAPSING = """
+[system]
+dimension = 2
+particles = 300
+packing_fraction = 0.4
+seed = 1
+[collision]
+model = "constant"
+restitution = 0.2
+[run]
+end_time = 50.0
+[output]
+file = "{out}"
+snapshots = 30
+"""
+
+
+def test_collapse_names_the_config_key_not_the_python_call(case):
+    """A config run's user is told which key cures the collapse (the engine's own error names
+    the Python call, for Python callers: tests/engine/test_physics.py)."""
+    rc, out, err, path, _ = case(COLLAPSING)
+    assert rc == 3 and path.exists()
+    line, = err.strip().splitlines()
+    assert line.startswith("error: inelastic collapse at t = ")
+    assert "set collision.tc_time in " in line and "c.toml" in line and 'collision.model = "viscoelastic"' in line
+    assert "CollisionRule" not in line and "keeps" in line
+    tc = float(line.split("tc_time = ")[1].split(":")[0])
+    assert 1e-8 < tc < 1e-5  # 1e-6 of the initial mean free time (about 0.3 here)

@@ -55,12 +55,24 @@ def final_state(file):
 
 
 def test_expansion_product_and_generators(tmp_path):
-    path = write_sweep(tmp_path, 'collision.restitution = [0.9, 0.8]\nsystem.seed = { range = [1, 4] }')
+    path = write_sweep(tmp_path, 'collision.restitution = [0.9, 0.8]\nsystem.seed = { range = [1, 3] }')
     sweep = load_sweep(path)
     assert len(sweep.runs) == 6
     assert {r.parameters["system.seed"] for r in sweep.runs} == {1, 2, 3}
     assert len({r.file for r in sweep.runs}) == 6
     assert all(r.overrides["output.file"] == r.file for r in sweep.runs)
+
+
+@pytest.mark.parametrize("spec, values", [
+    ("[1, 4]", [1, 2, 3, 4]),          # both ends included, as linspace's
+    ("[1, 10, 4]", [1, 5, 9]),         # the last value when a step lands on it
+    ("[1, 9, 4]", [1, 5, 9]),
+    ("[4, 1, -1]", [4, 3, 2, 1]),
+    ("[3, 3]", [3]),
+])
+def test_range_includes_both_ends(tmp_path, spec, values):
+    path = write_sweep(tmp_path, f"system.seed = {{ range = {spec} }}")
+    assert [r.parameters["system.seed"] for r in load_sweep(path).runs] == values
 
 
 def test_expansion_zip_and_linspace(tmp_path):
@@ -79,6 +91,8 @@ def test_expansion_zip_and_linspace(tmp_path):
     [
         ("", "[vary] is empty"),
         ("system.seed = { range = [1.5, 3] }", "integers"),
+        ("system.seed = { range = [5] }", "[first, last] or [first, last, step]"),
+        ("system.seed = { range = [4, 1] }", "gives no values"),
         ("system.seed = []", "at least one value"),
     ],
 )
