@@ -4,22 +4,27 @@ Runs (or, with --reuse, reads) three kinds of cooling runs and compares them wit
 :mod:`granulargas.theory`:
 
 1. constant restitution eps = 0.9, 3D, packing 0.05, box below the shear-instability
-   length: Haff's law T = T0 / (1 + t/tau0)^2, Enskog tau0 with the van Noije-Ernst a2;
-2. viscoelastic particles, 3D, packing 0.1, small damping: T = T0 (1 + t/tau0)^(-5/3)
-   with tau0 from ``theory.viscoelastic_tau0``;
+   length: Haff's law T = T0 / (1 + t/tau0)^2; the theory drawn is the one
+   ``granulargas analyze`` uses (``theory.gas.cooling_curve``: the cooling rate and a2 of the
+   homogeneous cooling state from ``theory.hcs``, relaxed from the Maxwellian start);
+2. viscoelastic particles, 3D, packing 0.1, small damping: against the same theory as
+   ``granulargas analyze`` (``theory.gas.cooling_curve``: the moment equations with the exact
+   eps(g)); the leading-order law T = T0 (1 + t/tau0)^(-5/3) (``theory.viscoelastic_tau0``)
+   gives the exponent and the time axis;
 3. the same constant-restitution gas in 2D (packing 0.1, eps = 0.9) in a box below
    and in a box three times above the instability length L_c: the large box leaves
    Haff's law once shear modes and clusters grow.
 
-Writes ``docs/figures/cooling_haff.png`` (cases 1-2: T/T0 vs t/tau0 with theory,
-ratio to theory with seed-spread bands, local exponent, a2(t)) and
+Writes ``docs/figures/cooling_haff.png`` (cases 1-2: T/T0 vs t/tau0 with the theory,
+T/T_theory with seed-spread bands, local exponent, a2(t)) and
 ``docs/figures/cooling_instability.png`` (case 3), and prints measured against
 predicted tau0 and exponents.
 
     python scripts/haff_comparison.py                # ~10 min on 2 cores
     python scripts/haff_comparison.py --quick        # smaller, to check the script
     python scripts/haff_comparison.py --reuse        # re-analyse existing runs
-    python scripts/haff_comparison.py --a2-scan      # only: HCS a2 against van Noije-Ernst, eps 0.3-0.9 (~3 min)
+    python scripts/haff_comparison.py --no-instability   # only cases 1-2 (cooling_haff.png)
+    python scripts/haff_comparison.py --a2-scan      # only: HCS a2 against the references, eps 0.3-0.9 (~3 min)
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ import numpy as np
 from granulargas import theory as th
 from granulargas.analysis.cooling import local_exponent
 from granulargas.analysis.run import analyze_cooling
+from granulargas.theory.hcs import FIRST_SONINE, hcs_reference
 
 TEMPLATE = """
 [system]
@@ -74,13 +80,12 @@ def run_case(outdir, name, dim, n, eta, seed, collision, end, dt, snapshots, fir
 
 
 def seed_band(analyses, grid):
-    """T/T_theory of each seed interpolated on ``grid`` (in t/tau0_theory): mean, std."""
+    """T/T_theory (the theory of ``granulargas analyze``, ``CoolingAnalysis.ratio``) of each seed
+    interpolated on ``grid`` (in t/tau0 of the closed form): mean, std."""
     rows = []
     for a in analyses:
-        t = a.history.time - a.t_offset
-        x = t / a.prediction.tau0
-        r = a.history.temperature / a.prediction.temperature(t)
-        rows.append(np.interp(grid, x, r, left=np.nan, right=np.nan))
+        x = a.time / a.prediction.tau0
+        rows.append(np.interp(grid, x, a.ratio, left=np.nan, right=np.nan))
     rows = np.array(rows)
     return np.nanmean(rows, axis=0), np.nanstd(rows, axis=0, ddof=1) if len(rows) > 1 else np.zeros(len(grid))
 
@@ -93,7 +98,9 @@ def summarize(label, analyses):
     sem = lambda v: v.std(ddof=1) / math.sqrt(ns) if ns > 1 else float("nan")  # noqa: E731
     print(f"\n{label}  ({ns} seeds, N = {analyses[0].info.particles}, packing {analyses[0].info.packing_fraction:.3g}, "
           f"L = {analyses[0].info.box[0]:.3g}, L_c = {p.instability_length:.3g})")
-    print(f"  tau0 predicted {p.tau0:.5g}   measured {tau.mean():.5g} +- {sem(tau):.2g} (seed s.e.m.)"
+    print(f"  theory: {analyses[0].theory_name}\n  T/T_theory over the last 10 % of the time: "
+          + ", ".join(f"{a.T_ratio_final:.4f}" for a in analyses))
+    print(f"  tau0 closed form ({p.name}) {p.tau0:.5g}   measured {tau.mean():.5g} +- {sem(tau):.2g} (seed s.e.m.)"
           f"   deviation {100 * (tau.mean() / p.tau0 - 1):+.2f} %  (per seed: "
           + ", ".join(f"{100 * (x / p.tau0 - 1):+.2f}" for x in tau) + ")")
     if math.isfinite(p.tau0_second_order):
@@ -125,7 +132,11 @@ def figure_cooling(cases, path):
             ms = ts > 0
             ax[1, 1].semilogx(ts[ms] / p.tau0, a2[ms], "o", color=c, ms=2.5, alpha=0.5,
                               label=f"{label}: $a_2$ per snapshot" if i == 0 else None)
-        ax[0, 0].loglog(grid, p.temperature(grid * p.tau0) / p.T0, "k--", lw=1)
+        a0 = analyses[0]
+        name = ("Enskog-Boltzmann, DSMC-table cooling rate" if a0.hcs is not None
+                else "moment equations, exact $\\varepsilon(g)$")
+        ax[0, 0].loglog(grid, a0.theory.temperature_at(grid * p.tau0) / p.T0, "k--", lw=1)
+        ax[0, 0].plot([], [], ls="none", label=f"  theory: {name}")
         mean, std = seed_band(analyses, grid)
         ax[0, 1].semilogx(grid, mean, color=c, label=label)
         ax[0, 1].fill_between(grid, mean - std, mean + std, color=c, alpha=0.25, lw=0)
@@ -141,20 +152,20 @@ def figure_cooling(cases, path):
         a2m = np.mean([a.sonine[1][: ts0.size] for a in analyses], axis=0)
         ms = ts0 > 0
         ax[1, 1].semilogx(ts0[ms] / p.tau0, a2m[ms], "-", color=c, lw=1.5, label=f"{label}: seed mean")
-        if p.law == "haff":
-            ax[1, 1].axhline(p.a2, color=c, ls="--", lw=0.8, label="van Noije-Ernst $a_2$")
-    ax[0, 0].plot([], [], "k--", label="theory")
-    ax[0, 0].set(xlabel="$t/\\tau_0$ (theory)", ylabel="$T/T_0$", title="temperature")
+        tg = np.geomspace(1e-2, xmax, 200) * p.tau0
+        ax[1, 1].semilogx(tg / p.tau0, a0.theory.a2_at(tg), "--", color=c, lw=0.9, label=f"{label}: theory")
+    ax[0, 0].plot([], [], "k--", label="theory, as granulargas analyze")
+    ax[0, 0].set(xlabel="$t/\\tau_0$ (closed form)", ylabel="$T/T_0$", title="temperature")
     ax[0, 0].legend(fontsize=8)
     ax[0, 1].axhline(1, color="k", lw=0.8)
-    ax[0, 1].set(xlabel="$t/\\tau_0$ (theory)", ylabel="$T/T_{theory}$",
-                 title="ratio to theory (band: $\\pm 1\\sigma$ seed-to-seed)")
+    ax[0, 1].set(xlabel="$t/\\tau_0$ (closed form)", ylabel="$T/T_{theory}$",
+                 title="ratio to the theory of granulargas analyze\n(band: $\\pm 1\\sigma$ seed-to-seed)")
     ax[0, 1].legend(fontsize=8)
-    ax[1, 0].set(xlabel="$t/\\tau_0$ (theory)", ylabel="$d\\ln T/d\\ln(1+t/\\tau_0)$",
+    ax[1, 0].set(xlabel="$t/\\tau_0$ (closed form)", ylabel="$d\\ln T/d\\ln(1+t/\\tau_0)$",
                  title="local exponent (dashed: -2 and -5/3)")
     ax[1, 0].legend(fontsize=8)
     ax[1, 1].axhline(0, color="0.6", lw=0.5)
-    ax[1, 1].set(xlabel="$t/\\tau_0$ (theory)", ylabel="$a_2$", title="second Sonine coefficient")
+    ax[1, 1].set(xlabel="$t/\\tau_0$ (closed form)", ylabel="$a_2$", title="second Sonine coefficient")
     ax[1, 1].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -214,7 +225,8 @@ def a2_scan(outdir, seeds, reuse, eps_values=(0.3, 0.5, 0.7, 0.9)):
 
     eta = 0.05
     n = th.number_density(eta, 3)
-    print(f"\nHCS a2, 3D, packing {eta}, L = 0.5 L_c, {len(seeds)} seeds (error assumes independent snapshots)")
+    print(f"\nHCS a2, 3D, packing {eta}, L = 0.5 L_c, {len(seeds)} seeds (error: seed-to-seed scatter of the "
+          f"seed means / sqrt(seeds))")
     for eps in eps_values:
         N = int(n * (0.5 * th.instability_length(eps, n)) ** 3)
         tau0 = th.haff_tau0(eps, n)
@@ -230,9 +242,11 @@ def a2_scan(outdir, seeds, reuse, eps_values=(0.3, 0.5, 0.7, 0.9)):
                 run_config(parse_config(text, source="a2"), overwrite=True)
             t, a2, _ = sonine_history(path)
             vals.append(a2[t > 2 * tau0])
-        v = np.concatenate(vals)
-        print(f"  eps {eps}: N = {N}, a2 = {v.mean():+.4f} +- {v.std(ddof=1) / math.sqrt(v.size):.4f}"
-              f" ({v.size} snapshots)   van Noije-Ernst {th.sonine_a2(eps, 3):+.4f}", flush=True)
+        means = np.array([x.mean() for x in vals])
+        ref = hcs_reference(eps, 3)
+        print(f"  eps {eps}: N = {N}, a2 = {means.mean():+.4f} +- {means.std(ddof=1) / math.sqrt(means.size):.4f}"
+              f" ({sum(x.size for x in vals)} snapshots)   {ref.name} {ref.a2:+.4f} +- {ref.a2_error:.4f}"
+              f"   {FIRST_SONINE} {th.sonine_a2(eps, 3):+.4f}", flush=True)
 
 
 def main(argv=None):
@@ -243,6 +257,7 @@ def main(argv=None):
     ap.add_argument("--reuse", action="store_true", help="analyse existing run files instead of re-running")
     ap.add_argument("--quick", action="store_true", help="small, short runs (checks the script, not the physics)")
     ap.add_argument("--a2-scan", action="store_true", help="only the HCS a2 scan over eps (20 seeds)")
+    ap.add_argument("--no-instability", action="store_true", help="only cases 1-2 (cooling_haff.png)")
     args = ap.parse_args(argv)
     if args.a2_scan:
         a2_scan(args.outdir, list(range(1, (3 if args.quick else 20) + 1)), args.reuse)
@@ -268,6 +283,8 @@ def main(argv=None):
     figure_cooling({"const": (f"$\\epsilon$ = {eps}", const), "visco": (f"viscoelastic, damping {k}", visco)},
                    Path(args.figdir) / "cooling_haff.png")
 
+    if args.no_instability:
+        return 0
     # 3. 2D below / above the instability length (same eps and density). Late-time T of a
     # small system random-walks with its collision count (a 1.5 % spread in collisions
     # per particle is a 10 % spread in T after 70 collisions), so the small box gets

@@ -21,12 +21,36 @@ all times), with ``T0`` fixed to the first sample unless asked otherwise.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import optimize, special
 
 from granulargas import observables
+
+#: blocks for the standard errors of :func:`block_mean`
+BLOCKS = 10
+
+
+def block_mean(x, blocks: int = BLOCKS):
+    """(mean, standard error) of a correlated series from the means of ``blocks`` consecutive blocks.
+
+    The one error estimate of the analysis (every mean over a run's samples or snapshots):
+    the series is cut into ``blocks`` consecutive blocks of (nearly) equal length, and the
+    error is the standard deviation of the block means over sqrt(blocks). Blocks longer than
+    the correlation time are independent, so no model of the correlations is needed; fewer
+    than 2 finite values give an error of nan.
+    """
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        return math.nan, math.nan
+    k = min(blocks, x.size)
+    if k < 2:
+        return float(x.mean()), math.nan
+    means = np.array([b.mean() for b in np.array_split(x, k)])
+    return float(x.mean()), float(means.std(ddof=1) / math.sqrt(k))
 
 __all__ = [
     "temperature",
@@ -36,6 +60,8 @@ __all__ = [
     "velocity_distribution",
     "maxwell_sonine_pdf",
     "collisions_per_particle",
+    "BLOCKS",
+    "block_mean",
     "CoolingFit",
     "fit_cooling_law",
     "local_exponent",

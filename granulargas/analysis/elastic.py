@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from granulargas import theory
+from granulargas.observables import finite_sample_sonine
 from granulargas.analysis.run import (
     CoolingHistory,
     PressureSamples,
@@ -41,6 +42,7 @@ from granulargas.analysis.run import (
     sonine_history,
     theory_name,
 )
+from granulargas.analysis.cooling import BLOCKS, block_mean  # noqa: F401 (re-exported: the one error estimate)
 from granulargas.errors import InputFileError
 
 __all__ = ["ElasticAnalysis", "analyze_elastic", "block_mean", "EQUILIBRATION", "EQUILIBRATION_FREE_TIMES", "BLOCKS"]
@@ -49,21 +51,6 @@ __all__ = ["ElasticAnalysis", "analyze_elastic", "block_mean", "EQUILIBRATION", 
 EQUILIBRATION = 0.1
 #: ... but at least this many mean free times
 EQUILIBRATION_FREE_TIMES = 5.0
-#: blocks for the standard errors
-BLOCKS = 10
-
-
-def block_mean(x, blocks: int = BLOCKS):
-    """(mean, standard error) of a correlated series from the means of ``blocks`` consecutive blocks."""
-    x = np.asarray(x, dtype=float)
-    x = x[np.isfinite(x)]
-    if x.size == 0:
-        return math.nan, math.nan
-    k = min(blocks, x.size)
-    if k < 2:
-        return float(x.mean()), math.nan
-    means = np.array([b.mean() for b in np.array_split(x, k)])
-    return float(x.mean()), float(means.std(ddof=1) / math.sqrt(k))
 
 
 @dataclass(frozen=True)
@@ -152,6 +139,8 @@ class ElasticAnalysis:
         om, om_err = self.collision_frequency
         drift = self.energy_drift
         ts, a2, _ = self.sonine
+        a2_mean, a2_err = block_mean(a2[ts >= self.t_equilibrated]) if np.any(ts >= self.t_equilibrated) else (None, None)
+        a2_theory = finite_sample_sonine(info.particles, info.dimension)[0]  # N particles on their energy shell
         return _clean({
             **run_identity(info, self.kind),
             **history_span(h),
@@ -164,7 +153,9 @@ class ElasticAnalysis:
             "exponent_theory": None,
             "energy_drift_final": float(drift[-1]),
             "energy_drift_max": float(np.max(np.abs(drift))),
-            "a2_mean": float(np.mean(a2[ts >= self.t_equilibrated])) if np.any(ts >= self.t_equilibrated) else None,
+            "a2_mean": a2_mean,
+            "a2_error": a2_err,
+            "a2_theory": a2_theory,
             "Z": z,
             "Z_error": z_err,
             "Z_theory": self.Z_theory,

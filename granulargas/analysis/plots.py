@@ -12,6 +12,10 @@ import math
 
 import numpy as np
 
+from granulargas import theory
+from granulargas.analysis.run import A2_ERROR_METHOD
+from granulargas.theory.hcs import FIRST_SONINE
+
 __all__ = ["PLOTS", "plot_analysis", "ratio_limits", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic", "plot_sweep"]
 
 
@@ -46,6 +50,13 @@ def _title(info, what):
             + ("" if info.monodisperse else "; polydisperse, theory for particles of the mean diameter"))
 
 
+def _curve_label(a) -> str:
+    """Short name of a cooling analysis's theory curve for a legend."""
+    if a.hcs is not None:
+        return f"{a.hcs.name}" + (", relaxed from the start" if a.hcs.name != FIRST_SONINE else ", moment equations")
+    return "moment equations, first Sonine, exact $\\varepsilon(g)$"
+
+
 def ratio_limits(ratio) -> tuple[str, float, float]:
     """(scale, low, high) of a T/T_theory axis: linear and symmetric about 1 (at least +-3 %)
     while the ratio stays within a factor 1.5 of 1; beyond, logarithmic from below the
@@ -77,13 +88,10 @@ def plot_cooling(analysis, path):
     ax.loglog(t[pos], h.temperature[pos] / p.T0, ".", ms=3, color="C0", label="simulation")
     ts = np.geomspace(t[pos].min(), t.max(), 300) if np.any(pos) else t
     if a.theory is not None:
-        ax.loglog(ts, a.theory.temperature_at(ts) / p.T0, "k-", lw=1.2,
-                  label="kinetic theory: Enskog-Boltzmann, " + ("exact $\\varepsilon(g)$" if a.info.model ==
-                                                                 "viscoelastic" else "constant $\\varepsilon$")
-                  + ", $a_2(t)$")
-    law = ("Haff $(1+t/\\tau_0)^{-2}$, van Noije-Ernst $a_2$" if p.law == "haff"
-           else "leading order in the damping, $(1+t/\\tau_0)^{-5/3}$")
-    ax.loglog(ts, p.temperature(ts) / p.T0, "--", color="0.55", lw=1, label=f"closed form: {law}, $\\tau_0$ = {p.tau0:.4g}")
+        ax.loglog(ts, a.theory.temperature_at(ts) / p.T0, "k-", lw=1.2, label="theory: " + _curve_label(a))
+    law = ("$(1+t/\\tau_0)^{-2}$" if p.law == "haff" else "$(1+t/\\tau_0)^{-5/3}$")
+    ax.loglog(ts, p.temperature(ts) / p.T0, "--", color="0.55", lw=1,
+              label=f"closed form {law}: {p.name}, $\\tau_0$ = {p.tau0:.4g}")
     if a.fit_free is not None:
         f = a.fit_free
         ax.loglog(ts, f(ts) / p.T0, ":", color="C3", lw=1.2,
@@ -116,20 +124,26 @@ def plot_cooling(analysis, path):
     ts_, a2, a3 = a.sonine
     if ts_.size:
         m = ts_ > 0
-        d, N = a.info.dimension, a.info.particles
-        err = math.sqrt(8.0 / (d * (d + 2) * N))
-        ax.errorbar(ts_[m], a2[m], yerr=err, fmt="o", ms=3, color="C0", capsize=2,
-                    label=f"$a_2$ of the snapshots ($\\pm$ sampling error, N = {N})")
+        ax.plot(ts_[m], a2[m], "o", ms=3, color="C0", label=f"$a_2$ of the snapshots (N = {a.info.particles})")
         ax.plot(ts_[m], a3[m], "s", ms=3, color="C2", alpha=0.6, label="$a_3$ of the snapshots")
+        mean, err, count = a.a2_late
+        if count:
+            w = ts_[a.a2_window]
+            ax.fill_between([w[0], w[-1]], mean - err, mean + err, color="C0", alpha=0.3, lw=0,
+                            label=f"mean {mean:+.4f} $\\pm$ {err:.1g} ({A2_ERROR_METHOD})")
     if a.theory is not None and np.any(pos):
-        ax.plot(ts, a.theory.a2_at(ts), "k-", lw=1.2, label="$a_2(t)$, kinetic theory")
-    if p.law == "haff":
-        ax.axhline(p.a2, color="0.55", lw=1, ls="--", label="$a_2$ van Noije-Ernst")
+        ax.plot(ts, a.theory.a2_at(ts), "k-", lw=1.2, label="$a_2(t)$, theory")
+    if a.hcs is not None:
+        ax.axhline(a.hcs.a2, color="k", lw=0.8, ls=":", label=f"$a_2$ = {a.hcs.a2:+.4f}, {a.hcs.name}")
+        if a.hcs.name != FIRST_SONINE:
+            fs = float(theory.sonine_a2(a.info.restitution, a.info.dimension))
+            ax.axhline(fs, color="0.55", lw=1, ls="--", label=f"$a_2$ = {fs:+.4f}, {FIRST_SONINE}")
     ax.axhline(0.0, color="0.7", lw=0.5)
     ax.set_xscale("log")
     _no_offset(ax)
     ax.set_ylabel("Sonine coefficients")
-    ax.margins(y=0.45)  # room above the points for the legend
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 1.2 * (hi - lo))  # room above the points for the legend
     ax.legend(fontsize=7, loc="upper center", ncol=2, framealpha=0.85)
     ax.set_xlabel("time t  [$\\sigma\\,(m/T_0)^{1/2}$]" + (f", since the first sample at {a.t_offset:.4g}"
                                                           if a.t_offset else ""))

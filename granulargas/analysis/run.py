@@ -11,13 +11,24 @@ restitution, this module's :func:`analyze_cooling`);
 :func:`granulargas.analysis.kinds.analyze_file` dispatches on it.
 
 Cooling runs are compared with the kinetic theory of
-:mod:`granulargas.theory.gas` (temperature and a2 together, with the exact
-eps(g) of the run's contact law; :attr:`CoolingAnalysis.theory`), started at the
-first sample's temperature. The closed-form laws (Haff's ``T0/(1+t/tau0)^2`` with
-the van Noije-Ernst a2, the leading-order viscoelastic ``T0 (1+t/tau0)^(-5/3)``)
+:mod:`granulargas.theory.gas` (temperature and a2 together; :attr:`CoolingAnalysis.theory`),
+started at the first sample's temperature: for a constant restitution the best
+reference of the homogeneous cooling state (:func:`granulargas.theory.hcs.hcs_reference`:
+the Enskog-Boltzmann DSMC table, first Sonine outside it), for the viscoelastic law the
+moment equations with the exact eps(g) (first Sonine). Every report names the theory
+it takes a ratio against. The closed-form laws (Haff's ``T0/(1+t/tau0)^2`` with the
+reference's cooling rate, the leading-order viscoelastic ``T0 (1+t/tau0)^(-5/3)``)
 stay as references (:class:`Prediction`) and give the exponents of the fits.
 Both the run and the theory curve are fitted with the same law on the same
 samples, so fitted tau0 and exponent compare like with like.
+
+a2 is averaged over a window of snapshots where the comparison is like with like
+(:attr:`CoolingAnalysis.a2_window`): for a constant restitution the snapshots after a2 has
+relaxed from the start (:func:`granulargas.theory.gas.relaxation_collisions`, counted in the
+run's own collisions per particle), compared with the reference's stationary a2; for the
+viscoelastic law (no stationary a2) the later half of the snapshots, compared with the
+theory's a2 averaged over the same snapshots. The error is the standard error of block means
+(:func:`granulargas.analysis.cooling.block_mean`, the one error estimate of the analysis).
 
 The theory is that of identical particles: for a polydisperse run the mean
 diameter and the mass of a particle of that diameter are used and
@@ -34,7 +45,9 @@ import numpy as np
 
 from granulargas import theory
 from granulargas.analysis.cooling import (
+    BLOCKS,
     CoolingFit,
+    block_mean,
     collisions_per_particle,
     fit_cooling_law,
     sonine_coefficients,
@@ -42,7 +55,8 @@ from granulargas.analysis.cooling import (
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import InputFileError
 from granulargas.io.h5md import iter_snapshots, load_snapshot, read_observables, read_parameters
-from granulargas.theory.gas import CoolingCurve, Gas, cooling_curve, pressure_factor
+from granulargas.theory.gas import CoolingCurve, Gas, cooling_curve, hcs_of, pressure_factor, relaxation_collisions
+from granulargas.theory.hcs import FIRST_SONINE
 
 __all__ = [
     "RunInfo",
@@ -58,10 +72,16 @@ __all__ = [
     "analyze_cooling",
     "theory_name",
     "FINAL_FRACTION",
+    "RELAXED_FRACTION",
+    "A2_ERROR_METHOD",
 ]
 
 #: T_ratio_final averages T / T_theory over this last fraction of the observation time span
 FINAL_FRACTION = 0.1
+#: a2 counts as relaxed once it has come within this fraction of the way from its start to the HCS
+RELAXED_FRACTION = 0.01
+#: how the error of a mean over snapshots is estimated (reports, JSON)
+A2_ERROR_METHOD = f"standard error of {BLOCKS} block means"
 
 
 @dataclass(frozen=True)
@@ -81,6 +101,7 @@ class Prediction:
     mean_free_path: float
     instability_length: float
     tau0_second_order: float = math.nan  # viscoelastic: 1/((3/5) zeta(T0)) with the beta^2 term
+    name: str = ""  # what the law is, with its a2 and cooling rate (reports, legends)
 
     def temperature(self, t):
         t = np.asarray(t, dtype=float)
@@ -191,17 +212,23 @@ class RunInfo:
         ell = float(theory.mean_free_path(n, d, s))
         if self.model == "constant" and self.restitution is not None:
             eps = self.restitution
-            a2 = float(theory.sonine_a2(eps, d))
-            tau0 = float(theory.haff_tau0(eps, n, T0, d, s, m, a2=a2))
-            lc = self.gas(T0).instability_length()
-            return Prediction("haff", T0, tau0, 2.0, a2, omega0, ell, lc)
+            gas = self.gas(T0)
+            ref = hcs_of(gas)
+            if eps < 1.0:
+                # Haff's law with the reference's cooling rate zeta_M c_zeta (theory.hcs, (H1))
+                tau0 = 2.0 / (float(theory.enskog_cooling_rate(eps, n, T0, d, s, m, a2=0.0)) * ref.zeta_factor)
+            else:
+                tau0 = math.inf
+            return Prediction("haff", T0, tau0, 2.0, ref.a2, omega0 * ref.omega_factor, ell, gas.instability_length(),
+                              name=f"Haff 1983 with the cooling rate of the {ref.name}")
         if self.model == "viscoelastic" and self.prefactor is not None:
             tau0 = float(theory.viscoelastic_tau0(self.prefactor, n, T0, d, s, m))
             # instability length at T0 (it grows as T falls)
             lc = self.gas(T0).instability_length()
             tau2 = float(theory.viscoelastic_tau0(self.prefactor, n, T0, d, s, m, order=2))
-            return Prediction("viscoelastic", T0, tau0, 5.0 / 3.0, 0.0, omega0, ell, lc, tau2)
-        return Prediction("elastic", T0, math.inf, 0.0, 0.0, omega0, ell, math.inf)
+            return Prediction("viscoelastic", T0, tau0, 5.0 / 3.0, 0.0, omega0, ell, lc, tau2,
+                              name="leading order in the damping (Schwager & Pöschel 1998), a2 = 0")
+        return Prediction("elastic", T0, math.inf, 0.0, 0.0, omega0, ell, math.inf, name="elastic: constant T")
 
 
 def _mean_particle_mass(radii, masses, dim) -> float:
@@ -238,8 +265,14 @@ def theory_name(info: RunInfo) -> str:
         return f"Enskog, {eos} equation of state"
     if info.kind == "driven":
         return "Enskog, driven steady state (zeta(T) T = H)"
-    law = "exact eps(g)" if info.model == "viscoelastic" else "constant eps"
-    return f"Enskog-Boltzmann, {law}, first Sonine a2(t); chi from {eos}"
+    if info.model == "viscoelastic":
+        return (f"moment equations of the Enskog-Boltzmann equation, first Sonine, exact eps(g) "
+                f"(Brilliantov & Pöschel 2000); chi from {eos}")
+    ref = hcs_of(info.gas(1.0))
+    if ref.name == FIRST_SONINE:
+        return f"Enskog-Boltzmann, constant eps: moment equations, {FIRST_SONINE}; chi from {eos}"
+    return (f"Enskog-Boltzmann, constant eps: cooling rate and a2 of the {ref.name}, relaxed from the start; "
+            f"chi from {eos}")
 
 
 def _float_or_none(v):
@@ -426,17 +459,57 @@ class CoolingAnalysis:
         return self.fit.tau0 / self.prediction.tau0 - 1.0
 
     @property
+    def hcs(self):
+        """The HCS reference of a constant-restitution run (:func:`granulargas.theory.gas.hcs_of`), else None."""
+        if self.kind != "cooling" or self.info.model != "constant":
+            return None
+        return hcs_of(self.info.gas(self.prediction.T0))
+
+    @property
+    def relaxation_collisions(self) -> float:
+        """Collisions per particle a2 needs to relax from the start (:data:`RELAXED_FRACTION` of the way;
+        :func:`granulargas.theory.gas.relaxation_collisions`); nan unless constant restitution."""
+        if self.hcs is None:
+            return math.nan
+        return relaxation_collisions(self.info.gas(self.prediction.T0), RELAXED_FRACTION)
+
+    @property
+    def a2_window(self) -> np.ndarray:
+        """Which snapshots the a2 mean uses (bool (F,), module doc): constant restitution: those at
+        or after :attr:`relaxation_collisions` (the run's own collision count); otherwise the later
+        half of the snapshots (in their order; log-spaced snapshots make that the later half in log
+        time). Never the first snapshot of a fresh run (the initial state)."""
+        ts = self.sonine[0]
+        if self.hcs is not None:
+            s = np.interp(ts, self.time, self.history.collisions_per_particle - self.history.collisions_per_particle[0])
+            sel = s >= self.relaxation_collisions
+        else:
+            sel = np.arange(ts.size) >= ts.size // 2
+        return sel & (ts > 0)
+
+    @property
     def a2_late(self):
-        """(mean, standard error, count) of a2 over the later half of the snapshots (in their order;
-        log-spaced snapshots make that the later half in log time). The error is the sampling
-        error of N particles, ``sqrt(8 / (d (d + 2) N))`` per snapshot."""
+        """(mean, standard error, count) of a2 over :attr:`a2_window` (error: :data:`A2_ERROR_METHOD`)."""
         ts, a2, _ = self.sonine
-        sel = np.arange(ts.size) >= ts.size // 2
+        sel = self.a2_window
         if not np.any(sel):
             return math.nan, math.nan, 0
-        d, N = self.info.dimension, self.info.particles
-        se = math.sqrt(8.0 / (d * (d + 2) * N)) / math.sqrt(int(sel.sum()))
-        return float(np.mean(a2[sel])), se, int(sel.sum())
+        mean, err = block_mean(a2[sel])
+        return mean, err, int(sel.sum())
+
+    @property
+    def a2_reference(self):
+        """(value, error, name) that the a2 mean is compared with: the HCS reference's a2 (constant
+        restitution), else the theory's a2 averaged over the same snapshots (:attr:`a2_window`)."""
+        ref = self.hcs
+        if ref is not None:
+            return ref.a2, ref.a2_error, ref.name
+        ts = self.sonine[0]
+        sel = self.a2_window
+        if self.theory is None or not np.any(sel):
+            return math.nan, math.nan, ""
+        # the theory's own error is that of its approximation (first Sonine), not a number here
+        return float(np.mean(self.theory.a2_at(ts[sel]))), math.nan, f"{self.theory.name}, mean over the same snapshots"
 
     @property
     def Z(self) -> float:
@@ -460,7 +533,13 @@ class CoolingAnalysis:
     def summary(self) -> dict:
         """The numbers of the analysis as a flat, JSON-ready dict (``granulargas analyze --json``)."""
         info, h, p = self.info, self.history, self.prediction
-        a2_mean, a2_err, _ = self.a2_late if self.sonine[0].size else (math.nan, math.nan, 0)
+        a2_mean, a2_err, a2_count = self.a2_late if self.sonine[0].size else (math.nan, math.nan, 0)
+        a2_ref, a2_ref_err, a2_ref_name = self.a2_reference if self.sonine[0].size else (math.nan, math.nan, "")
+        if self.hcs is not None:
+            a2_final = self.hcs.a2
+        else:
+            a2_final = float(self.theory.a2_at(self.time[-1])) if self.theory is not None else None
+        window = self.sonine[0][self.a2_window] + self.t_offset if self.sonine[0].size else np.empty(0)
         T_th = self.temperature_theory
         return _clean({
             **run_identity(info, self.kind),
@@ -483,7 +562,17 @@ class CoolingAnalysis:
             "exponent_closed_form": -p.exponent,
             "a2_mean": a2_mean,
             "a2_error": a2_err,
-            "a2_theory_final": float(self.theory.a2_at(self.time[-1])) if self.theory is not None else None,
+            "a2_error_method": A2_ERROR_METHOD,
+            "a2_snapshots": a2_count,
+            "a2_from": float(window[0]) if window.size else None,
+            "a2_to": float(window[-1]) if window.size else None,
+            "a2_theory": a2_ref,
+            "a2_theory_error": a2_ref_err,
+            "a2_theory_name": a2_ref_name,
+            "a2_theory_final": a2_final,
+            "a2_first_sonine": float(theory.sonine_a2(info.restitution, info.dimension)) if self.hcs is not None else None,
+            "relaxation_collisions": self.relaxation_collisions,
+            "closed_form": p.name,
             "Z": self.Z,
             "Z_theory": self.Z_theory,
             "instability_length": p.instability_length,

@@ -20,9 +20,11 @@ of c normalised to ``integral f(c) d^d c = 1``. References:
 
   so ``A = 2 B_d / zeta*`` with ``B_d = pi^((d-1)/2) / Gamma((d+1)/2)`` (pi in
   3D, 2 in 2D) and ``zeta* = zeta / (chi n sigma^(d-1) v_T)`` the reduced
-  cooling rate, constant in the HCS. In the first Sonine approximation
-  ``zeta* = (1 - eps^2)/d Omega_d (1 + 3 a2/16)``, ``Omega_d = sqrt(2) pi^((d-1)/2) / Gamma(d/2)``
-  (the Enskog collision frequency in units of chi n sigma^(d-1) v_T).
+  cooling rate, constant in the HCS:
+  ``zeta* = (1 - eps^2)/d Omega_d c_zeta``, ``Omega_d = sqrt(2) pi^((d-1)/2) / Gamma(d/2)``
+  (the Enskog collision frequency in units of chi n sigma^(d-1) v_T), with the cooling-rate
+  factor c_zeta of the HCS reference (:func:`granulargas.theory.hcs.hcs_reference`; in the
+  first Sonine approximation c_zeta = 1 + 3 a2/16).
   The asymptotic form holds for c >> 1; at moderate c the local slope
   ``-d ln f / dc`` is still approaching A.
 
@@ -39,7 +41,8 @@ import numpy as np
 from scipy import optimize, special
 
 from granulargas import theory
-from granulargas.analysis.cooling import peculiar_velocities, sonine_coefficients, sonine_polynomial
+from granulargas.theory.hcs import hcs_reference
+from granulargas.analysis.cooling import block_mean, peculiar_velocities, sonine_coefficients, sonine_polynomial
 from granulargas.io.h5md import iter_snapshots, load_snapshot, snapshot_count
 
 __all__ = [
@@ -137,12 +140,11 @@ class SpeedHistogram:
         return self.centres, self.counts / norm, np.sqrt(self.counts) / norm
 
     def sonine(self):
-        """(a2, a2_err, a3, a3_err): mean over snapshots and standard error of the mean
-        (snapshots taken as independent)."""
-        a2, a3 = np.asarray(self._a2), np.asarray(self._a3)
-        k = max(len(a2), 1)
-        err = (lambda x: float(x.std(ddof=1) / math.sqrt(k)) if len(x) > 1 else float("nan"))
-        return float(a2.mean()), err(a2), float(a3.mean()), err(a3)
+        """(a2, a2_err, a3, a3_err): mean over the snapshots in the order added, with the standard
+        error of block means (:func:`granulargas.analysis.cooling.block_mean`)."""
+        a2, a2e = block_mean(self._a2)
+        a3, a3e = block_mean(self._a3)
+        return a2, a2e, a3, a3e
 
 
 def maxwellian(c, dim):
@@ -169,10 +171,12 @@ def omega_reduced(dim):
     return math.sqrt(2.0) * math.pi ** ((dim - 1) / 2.0) / math.gamma(dim / 2.0)
 
 
-def sonine_cooling_rate(eps, dim, a2=0.0):
-    """Reduced cooling rate in the first Sonine approximation,
-    ``zeta* = (1 - eps^2)/d Omega_d (1 + 3 a2 / 16)`` (van Noije & Ernst 1998)."""
-    return (1.0 - eps * eps) / dim * omega_reduced(dim) * (1.0 + 3.0 * a2 / 16.0)
+def sonine_cooling_rate(eps, dim, a2=0.0, zeta_factor=None):
+    """Reduced cooling rate ``zeta* = (1 - eps^2)/d Omega_d c_zeta``: with ``zeta_factor`` = c_zeta
+    of an HCS reference (:mod:`granulargas.theory.hcs`), else first Sonine, c_zeta = 1 + 3 a2 / 16
+    (van Noije & Ernst 1998)."""
+    factor = 1.0 + 3.0 * a2 / 16.0 if zeta_factor is None else zeta_factor
+    return (1.0 - eps * eps) / dim * omega_reduced(dim) * factor
 
 
 def reduced_cooling_rate(times, temperatures, number_density, chi, dim, sigma=1.0, mass=1.0):
@@ -180,14 +184,12 @@ def reduced_cooling_rate(times, temperatures, number_density, chi, dim, sigma=1.
 
     With zeta* constant, ``d T^(-1/2) / dt = (zeta*/2) chi n sigma^(d-1) sqrt(2/m)``
     exactly, so every interval between samples gives an estimate; returns their
-    mean and its standard error (intervals taken as independent).
+    mean and the standard error of block means (:func:`granulargas.analysis.cooling.block_mean`).
     """
     t = np.asarray(times, dtype=float)
     y = np.asarray(temperatures, dtype=float) ** -0.5
     scale = 2.0 / (chi * number_density * sigma ** (dim - 1) * math.sqrt(2.0 / mass))
-    each = np.diff(y) / np.diff(t) * scale
-    err = float(each.std(ddof=1) / math.sqrt(each.size)) if each.size > 1 else float("nan")
-    return float(each.mean()), err
+    return block_mean(np.diff(y) / np.diff(t) * scale)
 
 
 def tail_constant(zeta_star, dim):
@@ -291,7 +293,8 @@ def plot_velocity_distribution(panels, path, title=None):
     ----------
     panels : list of dict
         Keys ``hist`` (SpeedHistogram), ``label`` (str), optional ``fit`` (TailFit),
-        ``A_theory`` (dict: label -> A), ``a2_theory`` (float, drawn as a first-Sonine form).
+        ``A_theory`` (dict: label -> A), ``a2_theory`` (float, drawn as a Sonine form) and
+        ``a2_theory_name`` (what it is).
     path : str or Path
         PNG to write.
     """
@@ -319,7 +322,7 @@ def plot_velocity_distribution(panels, path, title=None):
                     label=f"+ $a_3$={a3:.4f}")
         if p.get("a2_theory") is not None:
             ax.semilogy(cs, sonine_density(cs, hist.dim, p["a2_theory"]), "C4-.", lw=0.8,
-                        label=f"first Sonine, van Noije-Ernst $a_2$={p['a2_theory']:.4f}")
+                        label=f"Sonine form, $a_2$={p['a2_theory']:.4f} ({p.get('a2_theory_name', 'theory')})")
         fit = p.get("fit")
         if fit is not None:
             cf = np.linspace(fit.c_min, cmax, 100)
@@ -360,65 +363,74 @@ class FileDistribution:
 
     hist: SpeedHistogram
     t_from: float
-    a2_theory: float | None  # steady first-Sonine a2 of the run's kind (None: no steady value)
+    a2_theory: float | None  # steady a2 of the run's kind (None: no steady value)
     a_theory: float | None  # tail constant 2 B_d / zeta* of the HCS (constant eps only)
     fit: TailFit | None
+    a2_theory_name: str = ""  # what a2_theory is
 
     def lines(self) -> list[str]:
         a2, a2e, a3, a3e = self.hist.sonine()
         out = [f"  velocity distribution: {self.hist.snapshots} snapshots from t = {self.t_from:.4g}, "
-               f"{self.hist.samples} speeds; a2 = {a2:.4f} +- {a2e:.2g}, a3 = {a3:.4f} +- {a3e:.2g}"
-               + ("" if self.a2_theory is None else f" (first-Sonine theory a2 = {self.a2_theory:.4f})")]
+               f"{self.hist.samples} speeds; a2 = {a2:.5f} +- {a2e:.2g}, a3 = {a3:.5f} +- {a3e:.2g} "
+               f"(standard error of block means)"
+               + ("" if self.a2_theory is None else f"; a2 of the {self.a2_theory_name}: {self.a2_theory:.5f}")]
         if self.a_theory is not None:
             fit = (f"fit exp(-A c) for c >= {self.fit.c_min:.2f}: A = {self.fit.A:.3f} +- {self.fit.A_err:.2g} "
                    f"({self.fit.counts} speeds)" if self.fit is not None else f"fewer than 10 speeds beyond c = {self.a_theory:.2f} to fit")
             out.append(f"  high-energy tail: {fit}; HCS theory A = 2 B_d / zeta* = {self.a_theory:.3f} "
-                       "(van Noije & Ernst 1998)")
+                       f"(van Noije & Ernst 1998, zeta* of the {self.a2_theory_name})")
         return out
 
 
-def file_distribution(info, kind: str, c_max: float = 8.0) -> FileDistribution:
-    """Pool the scaled speeds of the later half of a run's snapshots (never the initial one)
-    for either method (a DSMC file has velocities only; that is all this needs).
+def file_distribution(info, kind: str, c_max: float = 8.0, t_from: float | None = None) -> FileDistribution:
+    """Pool the scaled speeds of a run's snapshots from ``t_from`` on (default: the later half of
+    the snapshots; never the initial one) for either method (a DSMC file has velocities only;
+    that is all this needs). ``granulargas analyze --velocity`` passes the window of the report's
+    a2 mean, so both give the same a2 with the same error.
 
     ``info``: :class:`granulargas.analysis.run.RunInfo`; ``kind``: ``"cooling"``,
     ``"elastic"`` or ``"driven"`` (:func:`granulargas.analysis.run.run_kind`). The theory:
-    a2 = 0 (elastic), van Noije & Ernst's HCS a2 (constant eps) or the driven a2
-    (white noise), none for the viscoelastic HCS (its a2 changes with T); the tail constant
-    for the HCS of constant eps, fitted from c = A on (the exponential overtakes the
-    Gaussian there).
+    a2 = 0 (elastic), the HCS reference (constant eps, :func:`granulargas.theory.hcs.hcs_reference`)
+    or the driven a2 (white noise, first Sonine), none for the viscoelastic HCS (its a2 changes
+    with T); the tail constant for the HCS of constant eps, fitted from c = A on (the
+    exponential overtakes the Gaussian there).
     """
     d = info.dimension
     count = snapshot_count(info.path)
     if count < 2:
         raise ValueError(f"{info.path}: no snapshot after the initial one")
-    t_from = load_snapshot(info.path, max(1, count // 2)).time
+    if t_from is None:
+        t_from = load_snapshot(info.path, max(1, count // 2)).time
     hist = SpeedHistogram(d, c_max=c_max, bins=int(round(c_max / 0.05)))
     for snap in iter_snapshots(info.path):
         if snap.time >= t_from and snap.index > 0:
             hist.add(snap.velocities, snap.masses)
     eps = info.restitution if info.model == "constant" else (1.0 if info.model == "elastic" else None)
+    if hist.snapshots == 0:
+        raise ValueError(f"{info.path}: no snapshot from t = {t_from:.4g} on")
     a2_theory = a_theory = fit = None
+    name = ""
     if kind == "elastic":
-        a2_theory = 0.0
+        a2_theory, name = 0.0, "Maxwellian"
     elif kind == "driven" and eps is not None:
-        a2_theory = float(theory.driven_sonine_a2(eps, d))
+        a2_theory, name = float(theory.driven_sonine_a2(eps, d)), "driven steady state, first Sonine"
     elif kind == "cooling" and eps is not None and eps < 1.0:
-        a2_theory = float(theory.sonine_a2(eps, d))
-        a_theory = tail_constant(sonine_cooling_rate(eps, d, a2_theory), d)
+        ref = hcs_reference(eps, d)
+        a2_theory, name = ref.a2, ref.name
+        a_theory = tail_constant(sonine_cooling_rate(eps, d, zeta_factor=ref.zeta_factor), d)
         try:
             fit = fit_exponential_tail(hist, round(a_theory / 0.05) * 0.05)
         except ValueError:
             fit = None
-    return FileDistribution(hist, t_from, a2_theory, a_theory, fit)
+    return FileDistribution(hist, t_from, a2_theory, a_theory, fit, name)
 
 
 def plot_file_distribution(dist: FileDistribution, info, path):
     """:func:`plot_velocity_distribution` of a :class:`FileDistribution`."""
     method = "DSMC" if getattr(info, "method", "edmd") == "dsmc" else "EDMD"
-    panel = {"hist": dist.hist, "fit": dist.fit, "a2_theory": dist.a2_theory,
+    panel = {"hist": dist.hist, "fit": dist.fit, "a2_theory": dist.a2_theory, "a2_theory_name": dist.a2_theory_name,
              "label": f"{info.path.rsplit('/', 1)[-1]}: {method}, {info.model}, {info.dimension}D, "
                       f"N = {info.particles},\n{dist.hist.snapshots} snapshots from t = {dist.t_from:.4g}"}
     if dist.a_theory is not None:
-        panel["A_theory"] = {"HCS theory (first Sonine)": dist.a_theory}
+        panel["A_theory"] = {f"HCS theory ({dist.a2_theory_name})": dist.a_theory}
     return plot_velocity_distribution([panel], path)

@@ -20,8 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
+from granulargas import theory
 from granulargas.errors import InputFileError, UserError
 from granulargas.io.paths import existing_directory
+from granulargas.theory.hcs import FIRST_SONINE
 
 INDEX_NAME = "index.json"
 #: ``--plot`` given without a path: the figure goes beside the input (:func:`plot_path`)
@@ -92,8 +94,8 @@ def cooling_report(a, rows: int = 10) -> str:
     info, p, h = a.info, a.prediction, a.history
     lines = _header(info)
     lines.append(f"  theory: {a.theory_name}")
-    lines.append(f"  closed form ({p.law}, reference): T0 = {p.T0:.4g}, tau0 = {_fmt(p.tau0)}, "
-                 f"exponent = -{p.exponent:.4g}, a2 = {p.a2:.4g}; mean free path = {p.mean_free_path:.4g}, "
+    lines.append(f"  closed form ({p.name}): T0 = {p.T0:.4g}, tau0 = {_fmt(p.tau0)}, "
+                 f"exponent = -{p.exponent:.4g}; mean free path = {p.mean_free_path:.4g}, "
                  f"instability length L_c = {_fmt(p.instability_length)}")
     if math.isfinite(p.instability_length):
         L = float(info.box.max())
@@ -119,20 +121,50 @@ def cooling_report(a, rows: int = 10) -> str:
                      f"(the same fit of the theory curve), closed form {p.exponent:.4g}")
     ts, a2, _ = a.sonine
     if ts.size:
-        k = np.unique(np.linspace(0, ts.size - 1, min(ts.size, 6)).astype(int))
-        th = a.theory.a2_at(ts[k]) if a.theory is not None else np.full(k.size, np.nan)
-        lines.append("  a2 (snapshots, theory): " + ", ".join(
-            f"t={ts[i] + a.t_offset:.3g}: {a2[i]:+.4f} ({th[j]:+.4f})" for j, i in enumerate(k)))
-        mean, se, count = a.a2_late
-        if count:
-            lines.append(f"  a2 mean over the later half of the snapshots ({count}) {mean:+.4f} +- {se:.2g} "
-                         f"(sampling error of N = {info.particles}); theory at the end "
-                         f"{_fmt(float(a.theory.a2_at(t[-1])) if a.theory is not None else math.nan, '+.4f')}"
-                         + (f", van Noije-Ernst {p.a2:+.4f}" if p.law == "haff" else ""))
+        lines += _a2_lines(a)
     if math.isfinite(a.Z):
         lines.append(f"  Z = P/(nT) = {a.Z:.4f} (mean over {a.pressure.Z.size} windows), Enskog "
                      f"{_fmt(a.Z_theory, '.4f')}{_dev(a.Z, a.Z_theory)}")
     return "\n".join(lines)
+
+
+def _sigmas(value, ref, error, ref_error=0.0, label="a2/reference") -> str:
+    """'label = r, +x sigma' of a measured value against a reference with their errors."""
+    if not all(x is not None and math.isfinite(x) for x in (value, ref)):
+        return ""
+    out = f"{label} = {value / ref:.4f}" if ref != 0 else ""
+    sig = math.hypot(*(x if x is not None and math.isfinite(x) else 0.0 for x in (error, ref_error)))
+    if math.isfinite(sig) and sig > 0:
+        out += (", " if out else "") + f"{(value - ref) / sig:+.1f} sigma"
+    return out
+
+
+def _a2_lines(a) -> list[str]:
+    """The a2 lines of a cooling report: snapshots against the theory curve, then the window mean
+    against the best reference, named (:attr:`CoolingAnalysis.a2_window`, ``a2_reference``)."""
+    from granulargas.analysis.run import A2_ERROR_METHOD
+
+    ts, a2, _ = a.sonine
+    k = np.unique(np.linspace(0, ts.size - 1, min(ts.size, 6)).astype(int))
+    th = a.theory.a2_at(ts[k]) if a.theory is not None else np.full(k.size, np.nan)
+    lines = ["  a2 of the snapshots (theory curve): " + ", ".join(
+        f"t={ts[i] + a.t_offset:.3g}: {a2[i]:+.4f} ({th[j]:+.4f})" for j, i in enumerate(k))]
+    mean, err, count = a.a2_late
+    if not count:
+        lines.append("  a2: no snapshot after the relaxation (" + _fmt(a.relaxation_collisions, ".3g")
+                     + " collisions per particle); no mean")
+        return lines
+    sel = ts[a.a2_window] + a.t_offset
+    where = (f"after the relaxation from the start ({a.relaxation_collisions:.3g} collisions per particle)"
+             if a.hcs is not None else "the later half of the snapshots")
+    lines.append(f"  a2 = {mean:+.5f} +- {_fmt(err, '.2g')}: mean of {count} snapshots, t = {sel[0]:.4g} .. "
+                 f"{sel[-1]:.4g}, {where}; error: {A2_ERROR_METHOD}")
+    ref, ref_err, name = a.a2_reference
+    lines.append(f"  a2 reference ({name}): {_pm(ref, ref_err, '+.5f')}; {_sigmas(mean, ref, err, ref_err)}")
+    if a.hcs is not None and a.hcs.name != FIRST_SONINE:
+        fs = float(theory.sonine_a2(a.info.restitution, a.info.dimension))
+        lines.append(f"  for comparison, {FIRST_SONINE}: {fs:+.5f}; {_sigmas(mean, fs, err, label='a2/first Sonine')}")
+    return lines
 
 
 def elastic_report(a, rows: int = 10) -> str:
@@ -154,9 +186,9 @@ def elastic_report(a, rows: int = 10) -> str:
                  f"Enskog {s['collision_frequency_theory']:.5g}"
                  f"{_dev(s['collision_frequency'], s['collision_frequency_theory'])}")
     if s.get("a2_mean") is not None:
-        d, N = a.info.dimension, a.info.particles
-        lines.append(f"  a2 mean of the snapshots {s['a2_mean']:+.4f} (Maxwellian: 0 +- "
-                     f"{math.sqrt(8 / (d * (d + 2) * N)):.2g} per snapshot)")
+        lines.append(f"  a2 = {_pm(s['a2_mean'], s.get('a2_error'), '+.5f')} (snapshots after the equilibration; "
+                     f"error: standard error of block means); equilibrium of N = {a.info.particles} particles on "
+                     f"their energy shell {s['a2_theory']:+.2g} (-2/(d(N-1)+2))")
     return "\n".join(lines)
 
 
@@ -252,6 +284,17 @@ def _run_sweep(args) -> int:
     return 0
 
 
+def _a2_window_start(a):
+    """Time of the first snapshot of the report's a2 mean (the ``--velocity`` pool starts there too),
+    or None to let the velocity distribution choose."""
+    if a.kind == "cooling" and a.sonine[0].size and np.any(a.a2_window):
+        return float(a.sonine[0][a.a2_window][0] + a.t_offset)
+    for name in ("t_relaxed", "t_equilibrated"):
+        if hasattr(a, name):
+            return float(getattr(a, name))
+    return None
+
+
 def plot_path(path: Path) -> Path:
     """Where ``--plot`` without a value writes: beside a run's file with the suffix .png, inside a
     sweep's directory as sweep.png."""
@@ -314,7 +357,7 @@ def run(args) -> int:
         from granulargas.analysis.velocity import file_distribution, plot_file_distribution  # matplotlib when drawn
 
         try:
-            dist = file_distribution(a.info, run_kind(a.info))
+            dist = file_distribution(a.info, run_kind(a.info), t_from=_a2_window_start(a))
         except ValueError as exc:
             raise InputFileError(f"{args.file}: --velocity: {exc}") from None
         plot_file_distribution(dist, a.info, args.velocity)

@@ -38,8 +38,32 @@ scipy's ``solve_ivp`` (LSODA, relative tolerance 1e-10) in the variable
 ``x = ln(1 + t/t_free)`` (t_free the mean free time at T0), which keeps the step
 count small over many decades of time.
 
+Constant restitution: the best reference
+----------------------------------------
+For a constant eps the first Sonine approximation is off at strong inelasticity (a2 by
+up to 28 %, the cooling rate by up to 1.2 %), and the homogeneous cooling state (HCS) is
+known better: :func:`granulargas.theory.hcs.hcs_reference` gives a2, the cooling-rate
+factor c_zeta = zeta/zeta_M and the collision-frequency factor c_omega = omega/omega_M
+of the HCS from a DSMC table (exact up to statistics; first Sonine where the table
+ends). With ``reference="best"`` (the default) :func:`cooling_curve` then integrates
+
+    dT/dt  = -zeta_M(T) [c_zeta + (c_zeta(0) - c_zeta) u] T,                     (G1')
+    da2/dt = -lambda (a2 - a2_HCS),   du/dt = -lambda u,   u(0) = 1,              (G2')
+    ds/dt  = omega = omega_M(T) [c_omega + (c_omega(0) - c_omega) u],             (G3')
+
+with zeta_M, omega_M the Maxwellian values of (G1), (G3) (a2 = 0), c_zeta(0) = 1 + 3 a2(0)/16,
+c_omega(0) = 1 - a2(0)/16 the first-Sonine factors at the start, and lambda = r omega: the
+factors and a2 relax from the start to the HCS as exp(-r s) in the collisions per particle
+s, with the reference's measured rate r (``HCSReference.relaxation_rate``, the rate that
+gives the DSMC's offset of ln T after the transient), or, where the table has none, the
+first-Sonine rate of (G2), r = -d(da2/dt)/da2 / omega (the DSMC relaxes up to 1.8 times
+faster). The transient lasts a few collisions per particle; after it, T(t) is Haff's law
+with the reference's cooling rate. ``reference="first_sonine"`` integrates (G1)-(G3) as
+they stand.
+
 Limits (the tests check each): for constant eps, (G1)-(G2) is Haff's law with
-the van Noije-Ernst a2 once a2 has relaxed; at small damping, zeta at a2 = 0
+the van Noije-Ernst a2 once a2 has relaxed, (G1')-(G3') Haff's law with the
+reference's c_zeta; at small damping, zeta at a2 = 0
 approaches the closed forms of :mod:`granulargas.theory.viscoelastic` (first and
 second order in the damping) and T(t) the law ``T0 (1 + t/tau0)^(-5/3)``.
 
@@ -89,7 +113,8 @@ from scipy.integrate import solve_ivp
 
 from granulargas.contact import restitution_table
 from granulargas.contact.material import pair_constant
-from granulargas.theory.enskog import collision_frequency, contact_value, haff_tau0, instability_length
+from granulargas.theory.enskog import collision_frequency, contact_value, enskog_cooling_rate, instability_length
+from granulargas.theory.hcs import FIRST_SONINE, HCSReference, first_sonine, hcs_reference
 from granulargas.theory.moments import moment_coefficients, speed_quadrature
 
 __all__ = [
@@ -104,6 +129,9 @@ __all__ = [
     "pressure_factor",
     "compressibility_factor",
     "cooling_curve",
+    "hcs_of",
+    "relaxation_collisions",
+    "REFERENCES",
     "viscoelastic_cooling",
     "predicted_end",
     "run_temperature_range",
@@ -114,6 +142,9 @@ __all__ = [
 THERMAL_QUANTILES = (0.05, 0.95)
 
 _NODES = 96
+
+#: what :func:`cooling_curve` takes for the HCS of a constant restitution
+REFERENCES = ("best", "first_sonine")
 
 
 def _kernel_nodes(power: int, nodes: int = _NODES):
@@ -366,12 +397,22 @@ class CoolingCurve:
     a2: np.ndarray | None = None
     solution: object = field(default=None, repr=False, compare=False)
     time_scale: float = 1.0
+    hcs: HCSReference | None = None  # constant eps: the HCS reference the curve relaxes to
+
+    @property
+    def name(self) -> str:
+        """What the curve is (reports, legends)."""
+        if self.hcs is None:
+            return "moment equations, first Sonine"
+        if self.hcs.name == FIRST_SONINE:
+            return f"moment equations, {FIRST_SONINE}"
+        return f"{self.hcs.name} (cooling rate, a2), relaxed from the start"
 
     def _state(self, t):
         t = np.asarray(t, dtype=float)
         x = np.log1p(np.clip(t, 0.0, None) / self.time_scale)
         y = np.asarray(self.solution(np.atleast_1d(x).ravel()))
-        y = y.reshape((3,) + t.shape)
+        y = y[:3].reshape((3,) + t.shape)
         beyond = t > self.time[-1] * (1.0 + 1e-12)
         return np.where(beyond, np.nan, y)
 
@@ -396,9 +437,60 @@ class CoolingCurve:
         return np.exp(lt)
 
 
+def hcs_of(gas: Gas, reference: str = "best") -> HCSReference | None:
+    """The HCS reference of a constant-restitution gas (None for other models; module doc).
+
+    ``reference``: ``"best"`` (:func:`granulargas.theory.hcs.hcs_reference`) or
+    ``"first_sonine"`` (van Noije & Ernst 1998).
+    """
+    if reference not in REFERENCES:
+        raise ValueError(f"reference = {reference!r}: one of {', '.join(REFERENCES)}")
+    if gas.model != "constant" or gas.restitution is None:
+        return None
+    if reference == "first_sonine":
+        return first_sonine(gas.restitution, gas.dimension)
+    return hcs_reference(gas.restitution, gas.dimension)
+
+
+def relaxation_collisions(gas: Gas, fraction: float = 0.01, a2: float = 0.0) -> float:
+    """Collisions per particle after which a2 of (G2) has come within ``fraction`` of the way to its
+    stationary value: ``ln(1/fraction) omega / lambda`` at the gas's T0 (for a constant eps a
+    number of eps and d). First Sonine: the DSMC's a2 relaxes as fast or up to 1.8 times faster,
+    so this errs on the long side, the safe side for a mean that must start after the relaxation."""
+    _, d0, omega = cooling_rates(gas, gas.temperature, a2)
+    _, d1, _ = cooling_rates(gas, gas.temperature, a2 + 1.0)
+    rate = -(float(d1) - float(d0))
+    if not rate > 0.0:
+        return math.inf
+    return math.log(1.0 / fraction) * float(omega) / rate
+
+
+def _hcs_rhs(gas: Gas, ref: HCSReference, a2_initial: float, t_free: float):
+    """Right-hand side of (G1')-(G3') in x = ln(1 + t/t_free), state (ln T, a2, s, u)."""
+    zeta_m, d0, omega_m = (float(x) for x in cooling_rates(gas, 1.0, 0.0))  # Maxwellian, T = 1
+    _, d1, _ = cooling_rates(gas, 1.0, 1.0)
+    rate = ref.relaxation_rate  # per collision per particle
+    if not (math.isfinite(rate) and rate > 0.0):
+        rate = -(float(d1) - d0) / omega_m  # first Sonine
+    c_zeta0, c_omega0 = 1.0 + 3.0 * a2_initial / 16.0, 1.0 - a2_initial / 16.0
+
+    def rhs(x, y):
+        t_plus = t_free * math.exp(x)
+        root = math.exp(0.5 * y[0])  # every rate scales as sqrt(T)
+        u = y[3]
+        zeta = zeta_m * root * (ref.zeta_factor + (c_zeta0 - ref.zeta_factor) * u)
+        omega = omega_m * root * (ref.omega_factor + (c_omega0 - ref.omega_factor) * u)
+        lam = rate * omega
+        return [-zeta * t_plus, -lam * (y[1] - ref.a2) * t_plus, omega * t_plus, -lam * u * t_plus]
+
+    return rhs
+
+
 def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | None = 1e-12, points: int = 600,
-                  a2_initial: float = 0.0, restitution=None, rtol: float = 1e-10) -> CoolingCurve:
-    """Integrate (G1)-(G3) from T0, a2 = ``a2_initial`` (module doc).
+                  a2_initial: float = 0.0, restitution=None, rtol: float = 1e-10,
+                  reference: str = "best") -> CoolingCurve:
+    """Integrate (G1)-(G3) from T0, a2 = ``a2_initial`` (module doc); for a constant restitution
+    and ``reference="best"``, (G1')-(G3') with the HCS of :func:`hcs_of`.
 
     Parameters
     ----------
@@ -411,8 +503,11 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
         Grid points of the returned arrays.
     restitution : callable, optional
         ``eps(beta)``, see :func:`restitution_at_nodes`.
+    reference : str
+        ``"best"`` or ``"first_sonine"``: the HCS of a constant restitution (:func:`hcs_of`).
     """
     T0 = gas.temperature
+    hcs = hcs_of(gas, reference)
     inelastic = not (gas.model == "elastic" or (gas.model == "constant" and gas.restitution == 1.0)
                      or (gas.model == "viscoelastic" and not gas.pair_constant))
     if t_end is None and (t_min_ratio is None or not inelastic):
@@ -429,6 +524,12 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
         zeta, da2, omega = cooling_rates(gas, T, y[1], restitution, table)
         return [-float(zeta) * t_plus, float(da2) * t_plus, float(omega) * t_plus]
 
+    y0 = [math.log(T0), float(a2_initial), 0.0]
+    atol = [1e-12, 1e-12, 1e-10]
+    if hcs is not None and hcs.name != FIRST_SONINE and restitution is None:
+        rhs = _hcs_rhs(gas, hcs, float(a2_initial), t_free)
+        y0, atol = y0 + [1.0], atol + [1e-12]
+
     x_end = math.log1p(t_end / t_free) if t_end is not None else math.inf
     events = None
     if inelastic and t_min_ratio is not None:
@@ -441,8 +542,7 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
         events = cooled
         if not math.isfinite(x_end):
             x_end = 200.0  # t = t_free e^200: the event comes first for any cooling gas
-    sol = solve_ivp(rhs, (0.0, x_end), [math.log(T0), float(a2_initial), 0.0], method="LSODA", rtol=rtol,
-                    atol=[1e-12, 1e-12, 1e-10], dense_output=True, events=events)
+    sol = solve_ivp(rhs, (0.0, x_end), y0, method="LSODA", rtol=rtol, atol=atol, dense_output=True, events=events)
     if sol.status < 0:
         raise RuntimeError(f"cooling_curve: the ODE solver failed ({sol.message})")
     x_last = float(sol.t[-1])
@@ -450,7 +550,7 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
     y = sol.sol(x)
     t = t_free * np.expm1(x)
     t[-1] = t_free * math.expm1(x_last)
-    return CoolingCurve(np.exp(y[0]), t, y[2], y[1], solution=sol.sol, time_scale=t_free)
+    return CoolingCurve(np.exp(y[0]), t, y[2], y[1], solution=sol.sol, time_scale=t_free, hcs=hcs)
 
 
 def viscoelastic_cooling(gas: Gas, t_min_ratio: float = 1e-12, points: int = 600,
@@ -463,15 +563,18 @@ def viscoelastic_cooling(gas: Gas, t_min_ratio: float = 1e-12, points: int = 600
 
 
 def _haff_end(gas: Gas):
-    """(t_end, ln T_end) of a constant-eps run: Haff's law with the van Noije-Ernst a2
-    (:func:`granulargas.theory.haff_tau0`); in logarithms so that runs cooling past
+    """(t_end, ln T_end) of a constant-eps run: Haff's law with the cooling rate and collision
+    frequency of the HCS reference (:func:`hcs_of`); in logarithms so that runs cooling past
     float64 are still reported."""
     eps, T0 = gas.restitution, gas.temperature
     t_end = gas.end_time
     omega0 = gas.collision_frequency
     if eps >= 1.0:
         return (t_end if t_end is not None else gas.collisions_per_particle / omega0), math.log(T0)
-    tau0 = float(haff_tau0(eps, gas.density, T0, gas.dimension, gas.sigma, gas.mass))
+    hcs = hcs_of(gas)
+    omega0 *= hcs.omega_factor
+    zeta0 = float(enskog_cooling_rate(eps, gas.density, T0, gas.dimension, gas.sigma, gas.mass, chi=gas.chi, a2=0.0))
+    tau0 = 2.0 / (zeta0 * hcs.zeta_factor)
     ln_ratio = math.inf if t_end is None else 2.0 * math.log1p(t_end / tau0)
     if gas.collisions_per_particle is not None:
         # s = omega0 tau0 ln(1 + t/tau0) (granulargas.theory.haff_collisions), so ln(T0/T) = 2 s / (omega0 tau0)

@@ -13,6 +13,7 @@ import pytest
 
 from granulargas import theory as th
 from granulargas.analysis.run import analyze_cooling
+from granulargas.theory.hcs import hcs_reference
 
 CONFIG = """
 [system]
@@ -52,7 +53,9 @@ def _check_homogeneous_box(a, eps):
 
 
 def _haff(tmp_path, dim, n, eta, seeds, eps=0.9, span=60.0):
-    tau0 = th.haff_tau0(eps, th.number_density(eta, dim), dim=dim)
+    # Haff's tau0 with the cooling rate of the HCS reference (theory.hcs)
+    tau0 = 2.0 / (th.enskog_cooling_rate(eps, th.number_density(eta, dim), 1.0, dim, a2=0.0)
+                  * hcs_reference(eps, dim).zeta_factor)
     out = []
     for seed in seeds:
         a = _run(tmp_path, dim, n, eta, seed, f'model = "constant"\nrestitution = {eps}', span * tau0, tau0 / 10)
@@ -134,7 +137,7 @@ def test_sonine_a2_of_the_hcs_matches_van_noije_ernst(tmp_path):
     for seed in range(1, 13):
         path = tmp_path / f"a2_{seed}.h5"
         text = CONFIG.format(dim=3, n=N, eta=eta, seed=seed, collision=f'model = "constant"\nrestitution = {eps}',
-                             end=30 * tau0, dt=tau0, file=path).replace("snapshots = 6", f"snapshot_interval = {30 * tau0 / 39}")
+                             end=30 * tau0, dt=tau0, file=path, neighbours="auto").replace("snapshots = 6", f"snapshot_interval = {30 * tau0 / 39}")
         run_config(parse_config(text, source="test"), overwrite=True)
         t, a2, _ = sonine_history(path)
         vals.append(a2[t > 2 * tau0].mean())

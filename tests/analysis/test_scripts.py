@@ -66,3 +66,28 @@ def test_models_speed_accuracy_script(tmp_path, capsys):
     assert len(rows) == 4 and all("nan" not in r for r in rows)
     last = [l for l in out.splitlines() if "T_engine/T_DSMC =" in l][-1]
     assert float(last.split("=")[-1]) > 1.05
+
+
+def test_headline_figure_draws_the_theory_of_analyze(tmp_path):
+    # scripts/haff_comparison.py (docs/figures/cooling_haff.png): T/T_theory is taken against
+    # the theory granulargas analyze uses (theory.gas.cooling_curve, exact eps(g) for the
+    # viscoelastic gas), not against the leading-order law, which is several per cent off
+    from granulargas.analysis.run import analyze_cooling
+    from granulargas.io.config import parse_config
+    from granulargas.run.runner import run_config
+
+    mod = _load("haff_comparison")
+    path = tmp_path / "v.h5"
+    text = ('[system]\ndimension = 3\nparticles = 5000\npacking_fraction = 0.05\nseed = 1\n\n[collision]\n'
+            'model = "viscoelastic"\ndamping = 0.1\n\n[run]\nmethod = "dsmc"\nend_time = 200.0\n\n'
+            f'[output]\nfile = "{path}"\nsnapshots = 8\n')
+    run_config(parse_config(text, source="v"), overwrite=True, quiet=True, log=lambda *_: None)
+    a = analyze_cooling(path)
+    grid = np.geomspace(0.1, a.time[-1] / a.prediction.tau0, 30)
+    mean, _ = mod.seed_band([a], grid)
+    np.testing.assert_allclose(mean, np.interp(grid, a.time / a.prediction.tau0, a.ratio), rtol=1e-12)
+    closed = np.interp(grid, a.time / a.prediction.tau0, a.history.temperature / a.prediction.temperature(a.time))
+    assert np.max(np.abs(closed / mean - 1)) > 0.02
+    png = tmp_path / "c.png"
+    mod.figure_cooling({"const": ("a", [a]), "visco": ("b", [a])}, png)
+    assert png.stat().st_size > 20_000

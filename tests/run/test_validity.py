@@ -11,6 +11,7 @@ from granulargas import theory
 from granulargas.run import validity as V
 from granulargas.errors import ConfigError
 from granulargas.io.config import parse_config
+from granulargas.theory.hcs import hcs_reference
 
 HERTZ_TAU = 3.2180654  # (4/5)(5/4)^(2/5) B(2/5, 1/2), the Hertz duration
 
@@ -74,13 +75,15 @@ def test_restitution_spread_brackets_thermal_eps():
 def test_haff_run_end_matches_theory():
     cfg = config('model = "constant"\nrestitution = 0.8', run="end_time = 50.0")
     gas = V.gas_from_config(cfg)
-    tau0 = theory.haff_tau0(0.8, gas.density, 1.0, 3)
+    # Haff's law with the cooling rate and collision frequency of the HCS reference (theory.hcs)
+    ref = hcs_reference(0.8, 3)
+    tau0 = 2.0 / (theory.enskog_cooling_rate(0.8, gas.density, 1.0, 3, chi=gas.chi, a2=0.0) * ref.zeta_factor)
     t_end, T_end = V.run_temperature_range(gas)
     assert t_end == 50.0
     assert T_end == pytest.approx(theory.haff_temperature(50.0, 1.0, tau0), rel=1e-12)
     cfg = config('model = "constant"\nrestitution = 0.8', run="collisions_per_particle = 30")
     _, T_end = V.run_temperature_range(V.gas_from_config(cfg))
-    assert T_end == pytest.approx(theory.temperature_vs_collisions(30, 0.8, 3), rel=1e-9)
+    assert T_end == pytest.approx(math.exp(-ref.cooling_per_collision * 30), rel=1e-9)
 
 
 def test_contact_time_ratio_elastic_limit_is_hertz():

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from granulargas import theory as th
-from granulargas.theory.gas import Gas, cooling_curve, cooling_rates, effective_inelasticity
+from granulargas.theory.gas import Gas, cooling_curve, cooling_rates, effective_inelasticity, relaxation_collisions
+from granulargas.theory.hcs import DSMC_TABLE, FIRST_SONINE, hcs_reference
 
 
 def gas(dim=3, eta=0.1, **kw):
@@ -35,7 +36,7 @@ def test_constant_eps_curve_becomes_haff(dim):
     g = gas(dim, 0.1, model="constant", restitution=eps)
     a2 = th.sonine_a2(eps, dim)
     tau0 = th.haff_tau0(eps, g.density, dim=dim, chi=g.chi, a2=a2)
-    c = cooling_curve(g, t_end=200 * tau0)
+    c = cooling_curve(g, t_end=200 * tau0, reference="first_sonine")
     t = np.geomspace(20 * tau0, 200 * tau0, 30)
     # a2 relaxes from the Maxwellian start to van Noije-Ernst's value ...
     np.testing.assert_allclose(c.a2_at(t), a2, rtol=1e-6)
@@ -47,6 +48,42 @@ def test_constant_eps_curve_becomes_haff(dim):
     dsdl = np.gradient(c.collisions_at(t), -np.log(c.temperature_at(t)))
     expected = dim * (1 - a2 / 16) / ((1 - eps**2) * (1 + 3 * a2 / 16))
     np.testing.assert_allclose(dsdl[2:-2], expected, rtol=1e-4)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_constant_eps_curve_becomes_haff_with_the_reference_cooling_rate(dim):
+    # (G1')-(G3'): after the relaxation, -d ln T/dt = zeta_M(T) c_zeta and ds/d(-ln T) = omega/zeta
+    # with the HCS reference's factors, and a2 is the reference's
+    eps = 0.3
+    g = gas(dim, 0.1, model="constant", restitution=eps)
+    ref = hcs_reference(eps, dim)
+    assert ref.name == DSMC_TABLE
+    tau0 = 2.0 / (th.enskog_cooling_rate(eps, g.density, 1.0, dim, chi=g.chi, a2=0.0) * ref.zeta_factor)
+    c = cooling_curve(g, t_end=2000 * tau0)
+    assert (c.hcs.a2, c.hcs.zeta_factor) == (ref.a2, ref.zeta_factor) and DSMC_TABLE in c.name
+    t = np.geomspace(200 * tau0, 2000 * tau0, 30)  # 20-30 collisions per particle: relaxed to 1e-4
+    np.testing.assert_allclose(c.a2_at(t), ref.a2, rtol=1e-4)
+    ratio = c.temperature_at(t) * (1 + t / tau0) ** 2
+    assert np.ptp(ratio) / ratio.mean() < 2e-3
+    dsdl = np.gradient(c.collisions_at(t), -np.log(c.temperature_at(t)))
+    np.testing.assert_allclose(dsdl[2:-2], 1.0 / ref.cooling_per_collision, rtol=1e-4)
+    # the first-Sonine curve cools faster by the ratio of the factors
+    fs = cooling_curve(g, t_end=2000 * tau0, reference="first_sonine")
+    assert fs.hcs.name == FIRST_SONINE
+    late = fs.temperature_at(t[-1]) / c.temperature_at(t[-1])
+    assert late == pytest.approx((ref.zeta_factor / fs.hcs.zeta_factor) ** 2, rel=0.01)
+
+
+def test_relaxation_collisions_is_the_first_sonine_rate():
+    # a2 of (G2) relaxes exponentially in the collisions per particle: after
+    # relaxation_collisions(fraction) it has come within that fraction of the way
+    g = gas(2, 0.1, model="constant", restitution=0.3)
+    s_relax = relaxation_collisions(g, 0.01)
+    assert 5 < s_relax < 15
+    c = cooling_curve(g, t_end=1e4, reference="first_sonine")
+    t = float(np.interp(s_relax, c.collisions, c.time))
+    a_inf = th.sonine_a2(0.3, 2)
+    assert (a_inf - c.a2_at(t)) / a_inf == pytest.approx(0.01, rel=0.05)  # omega falls by a2/16 meanwhile
 
 
 def test_elastic_gas_keeps_its_temperature_and_relaxes_a2():
