@@ -12,7 +12,7 @@ in the module that ``_PUBLIC`` below names:
   :func:`analyze`;
 * the engine and its initial states: :class:`Simulation`,
   :class:`CollisionRule`, :class:`WhiteNoise`, :class:`DSMC`,
-  :func:`random_state`, :class:`InitialState`;
+  :func:`random_state`, :class:`State` (the state a simulation takes whole);
 * the contact: :func:`restitution` (eps of one impact's damping beta).
 
 Importing the package loads none of them: each is imported on first use
@@ -38,7 +38,7 @@ _PUBLIC = {
     "WhiteNoise": "granulargas.engine:WhiteNoise",
     "DSMC": "granulargas.dsmc:DSMC",
     "random_state": "granulargas.initial:random_state",
-    "InitialState": "granulargas.initial:InitialState",
+    "State": "granulargas.state:State",
     # the contact
     "restitution": "granulargas.contact:restitution",
 }

@@ -48,14 +48,23 @@ stamp that adds :func:`source_stamp`, a hash of every Python source file of
 the package (and of the package that holds the function, if another one): any
 change to the package's sources recompiles everything once.
 An installed package never changes, so its cache stays valid.
+
+Start-up. The first run of each kind compiles its kernels (several seconds of
+CPU) and every later run loads them from the cache (milliseconds).
+:class:`CompileWatch` sees numba's compilations (numba's ``numba:compile``
+events, sent only when a function is compiled, never when it is loaded from the
+cache): it announces the first one, so that the pause is explained before it
+starts, and adds up the time they take, so that a run can count it as start-up;
+:func:`cache_location` is where the compiled code is kept.
 """
 
 import functools
 import hashlib
 import os
+import time
 
 import numba
-from numba.core import caching
+from numba.core import caching, event
 
 _CACHE = os.environ.get("GRANULARGAS_NO_CACHE", "") not in ("1", "true", "yes")
 
@@ -161,3 +170,75 @@ def inlined_ir(*args, **kwargs):
     it has no Python entry point. For a function with one call site in compiled code."""
     kwargs["inline"] = "always"
     return kernel(*args, python=False, **kwargs)
+
+
+def _located():
+    """A function of this module, whose cache locator tells where the package's code is cached."""
+
+
+def cache_location() -> str:
+    """Where numba keeps the package's compiled code: ``$NUMBA_CACHE_DIR`` when set, else the
+    ``__pycache__`` folders beside the package's sources, or numba's user-wide cache folder
+    when those are not writable (numba's choice, as for every cached function here)."""
+    for locator_class in _CacheImpl._locator_classes:
+        locator = locator_class.from_function(_located, os.path.abspath(__file__))
+        if locator is not None:
+            path = locator.get_cache_path()
+            if numba.config.CACHE_DIR:
+                return numba.config.CACHE_DIR
+            if os.path.dirname(os.path.abspath(path)) == _PACKAGE:
+                return os.path.join(_PACKAGE, "*", "__pycache__")
+            return os.path.dirname(path)
+    return "nowhere (numba's cache is not available here)"
+
+
+class CompileWatch(event.Listener):
+    """Within a ``with`` block: numba's compilations (cache misses) in this process.
+
+    ``announce``: called once, with no argument, when the first compilation after
+    :attr:`armed` is set starts (e.g. to say what is being compiled before the pause;
+    ``armed`` is True unless given); ``seconds`` and
+    ``cpu_seconds``: the wall-clock and CPU time spent compiling so far (outermost
+    compilations only: a function compiled while compiling its caller counts once);
+    ``count``: functions compiled. Numba sends no event for a function loaded from
+    its cache, so a run whose code is all cached records nothing.
+    """
+
+    def __init__(self, announce=None, armed=True):
+        self.announce = announce
+        self.armed = armed
+        self.announced = False
+        self.seconds = 0.0
+        self.cpu_seconds = 0.0
+        self.count = 0
+        self._depth = 0
+        self._start = (0.0, 0.0)
+
+    def on_start(self, ev):
+        if self._depth == 0:
+            if self.armed and not self.announced and self.announce is not None:
+                self.announced = True
+                self.announce()
+            self._start = (time.perf_counter(), time.process_time())
+        self._depth += 1
+        self.count += 1
+
+    def on_end(self, ev):
+        self._depth -= 1
+        if self._depth == 0:
+            self.seconds += time.perf_counter() - self._start[0]
+            self.cpu_seconds += time.process_time() - self._start[1]
+
+    def __enter__(self):
+        event.register("numba:compile", self)
+        return self
+
+    def __exit__(self, *exc):
+        event.unregister("numba:compile", self)
+        return False
+
+
+def announcement(what: str) -> str:
+    """The line that says what is being compiled, that it happens once, and where it is kept."""
+    return f"compiling {what} (once; cached in {cache_location()})"
+

@@ -74,7 +74,7 @@ def compile_seconds(rule, modes):
     for mode in modes:
         st = random_state(64, 0.1, 3, seed=0)
         t = time.perf_counter()
-        Simulation(**st.as_kwargs(), rule=rule, **mode_kwargs(mode)).run(0.1)
+        Simulation(st, rule, **mode_kwargs(mode)).run(0.1)
         out[mode] = time.perf_counter() - t
     return out
 
@@ -124,7 +124,7 @@ def main(argv=None):
             st = random_state(n, eta, args.dimension, seed=args.seed)
             runs = {}
             for mode in args.modes:
-                sim = Simulation(**st.as_kwargs(), rule=rule, **mode_kwargs(mode))
+                sim = Simulation(st, rule, **mode_kwargs(mode))
                 sim.run(np.inf, max_collisions=max(200_000, 5 * n // 2))
                 runs[mode] = (sim, [], [], _counts(sim))
             c_rates = {name: [] for name in c_codes}

@@ -30,6 +30,7 @@ from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
 from granulargas.io.config import parse_config
 from granulargas.io.h5md import load_snapshot, read_parameters
+from granulargas.state import State
 
 
 def _rule(path):
@@ -54,17 +55,17 @@ def main(argv=None):
     s = cfg.system
     t0 = time.perf_counter()
     warm = random_state(64, 0.2, s.dimension, seed=0)
-    Simulation(**warm.as_kwargs(), rule=rule).run(0.1)
+    Simulation(warm, rule).run(0.1)
     print(f"JIT compile and first run: {time.perf_counter() - t0:.1f} s")
 
     states = {}
     hom = random_state(s.particles, s.packing_fraction, s.dimension, seed=s.seed)
-    states["homogeneous"] = Simulation(**hom.as_kwargs(), rule=rule)
+    states["homogeneous"] = Simulation(hom, rule)
     for k in args.frames:
         snap = load_snapshot(args.file, k)
         states[f"frame {k} (t = {snap.time:.4g})"] = Simulation(
-            snap.positions, snap.velocities, snap.radii, snap.masses, snap.box, rule,
-            time=snap.time, images=snap.images, last_collision=snap.last_collision)
+            State(snap.positions, snap.velocities, snap.radii, snap.masses, snap.box, time=snap.time,
+                  images=snap.images, last_collision=snap.last_collision), rule)
     n = s.particles
     rec = {}
     for name, sim in states.items():

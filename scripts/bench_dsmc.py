@@ -61,12 +61,14 @@ def run_case(method, n, dim, packing, repeats, seed=1):
     rule = CollisionRule.constant(EPS)
     if method == "dsmc":
         from granulargas.dsmc import DSMC
+        from granulargas.state import State
 
-        DSMC(np.ones((4, dim)) * np.arange(4)[:, None], 0.5, 1.0, rule, packing_fraction=0.1).run(1.0)
+        DSMC(State(None, np.ones((4, dim)) * np.arange(4)[:, None], 0.5, 1.0, None), rule,
+             packing_fraction=0.1).run(1.0)
         rss0 = _peak_rss_bytes()
         t0 = time.perf_counter()
         v = np.random.default_rng(seed).standard_normal((n, dim))
-        sim = DSMC(v, 0.5, 1.0, rule, packing_fraction=packing, seed=seed)
+        sim = DSMC(State(None, v, 0.5, 1.0, None), rule, packing_fraction=packing, seed=seed)
         del v
         t_init = time.perf_counter() - t0
         sim.run(float("inf"), max_collisions=max(200_000, 2 * n))
@@ -79,12 +81,12 @@ def run_case(method, n, dim, packing, repeats, seed=1):
         from granulargas.initial import random_state
 
         warm = random_state(64, 0.2, dim, seed=0)
-        Simulation(**warm.as_kwargs(), rule=rule).run(0.1)
+        Simulation(warm, rule).run(0.1)
         rss0 = _peak_rss_bytes()
         t0 = time.perf_counter()
         st = random_state(n, packing, dim, seed=seed)
         t_init = time.perf_counter() - t0
-        sim = Simulation(**st.as_kwargs(), rule=rule)
+        sim = Simulation(st, rule)
         del st
         sim.run(float("inf"), max_collisions=max(200_000, 2 * n))
         rate_wall, rate_cpu = _timed(sim, max(200_000, n), repeats)
@@ -97,7 +99,8 @@ def jit_times(dim=3):
     """(first compile s, cached load s) of the DSMC, each in a fresh process."""
     code = ("import time; t=time.perf_counter(); import numpy as np; "
             "from granulargas.dsmc import DSMC; from granulargas.engine import CollisionRule; "
-            f"DSMC(np.random.default_rng(0).standard_normal((64, {dim})), 0.5, 1.0, "
+            "from granulargas.state import State; "
+            f"DSMC(State(None, np.random.default_rng(0).standard_normal((64, {dim})), 0.5, 1.0, None), "
             "CollisionRule.constant(0.9), packing_fraction=0.1).run(1.0); "
             "print(time.perf_counter()-t)")
     env = dict(os.environ, GRANULARGAS_NO_CACHE="1")

@@ -50,7 +50,7 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
 
     # compile (from cache) before measuring memory
     warm = random_state(64, 0.2, dim, seed=0)
-    Simulation(**warm.as_kwargs(), rule=CollisionRule.elastic()).run(0.1)
+    Simulation(warm, CollisionRule.elastic()).run(0.1)
     rss0 = _peak_rss_bytes()
     t0 = time.perf_counter()
     walls = {"boundary": ("periodic",) * (dim - 1) + ("wall",)} if scene == "walls" else {}
@@ -82,7 +82,7 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
         t_ss = float(theory.driven_temperature(h, eps, nd, dim))
         zeta = float(theory.enskog_cooling_rate(eps, nd, t_ss, dim, a2=theory.driven_sonine_a2(eps, dim)))
         driving = WhiteNoise(h, theory.driving_interval(zeta), seed=seed)
-    sim = Simulation(**st.as_kwargs(), rule=rule, **({"driving": driving} if driving else {}))
+    sim = Simulation(st, rule, **({"driving": driving} if driving else {}))
     t0 = time.perf_counter()
     # build + warm-up to a steady state: 5 collisions per particle, so that the timed runs
     # see aged neighbour lists and a memory order that has drifted from the initial sort
@@ -136,7 +136,7 @@ def jit_times():
             "from granulargas.engine import Simulation, CollisionRule; "
             "from granulargas.initial import random_state; "
             "st=random_state(64, 0.2, 3, seed=0); "
-            "Simulation(**st.as_kwargs(), rule=CollisionRule.elastic()).run(0.5); "
+            "Simulation(st, CollisionRule.elastic()).run(0.5); "
             "print(time.perf_counter()-t)")
     env = dict(os.environ, GRANULARGAS_NO_CACHE="1")
     first = float(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,

@@ -37,7 +37,7 @@ def main(argv=None):
     t0 = time.perf_counter()
     st = random_state(n, args.packing, 3, seed=1)
     print(f"initial state {time.perf_counter() - t0:.0f} s, peak RSS {_peak_gb():.2f} GB", flush=True)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.elastic())
+    sim = Simulation(st, CollisionRule.elastic())
     del st
     t0 = time.perf_counter()
     sim.run(np.inf, max_collisions=batch)

@@ -70,8 +70,9 @@ def worker(args):
         sims = []
         for eng, ini in mods:
             st = ini.random_state(args.n, packing, args.dim, seed=args.seed)
-            sim = eng.Simulation(**st.as_kwargs(), rule=eng.CollisionRule.elastic(),
-                                 neighbours=args.mode)
+            # a tree whose initial state is a set of keyword arguments (as_kwargs) or a state record
+            state = ((), st.as_kwargs()) if hasattr(st, "as_kwargs") else ((st,), {})
+            sim = eng.Simulation(*state[0], rule=eng.CollisionRule.elastic(), neighbours=args.mode, **state[1])
             sim.run(math.inf, max_collisions=args.n)
             sims.append(sim)
         times = [[], []]

@@ -41,7 +41,7 @@ def main(argv=None):
     share = float("nan")
     for r in range(args.rounds):
         for name, rule in rules.items():
-            sim = Simulation(**state.as_kwargs(), rule=rule)
+            sim = Simulation(state, rule)
             w = time.perf_counter()
             sim.run(np.inf, max_collisions=20000)
             warm = time.perf_counter() - w

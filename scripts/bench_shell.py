@@ -49,13 +49,13 @@ def main(argv=None):
     n = int(args.n)
     rule = make_rule(args.rule)
     warm = random_state(64, 0.2, args.dimension, seed=0)
-    Simulation(**warm.as_kwargs(), rule=rule).run(0.1)
+    Simulation(warm, rule).run(0.1)
     for eta in args.packings:
         st = random_state(n, eta, args.dimension, seed=args.seed)
         sims = {}
         for shell in args.shells:
             width = default_shell(eta, args.dimension) if shell == 0.0 else shell
-            sim = Simulation(**st.as_kwargs(), rule=rule, shell=width)
+            sim = Simulation(st, rule, shell=width)
             sim.run(np.inf, max_collisions=max(200_000, 5 * n // 2))
             sims[width] = (sim, [], [], [sim.events, sim.collisions, *_counts(sim)])
         per_run = max(200_000, n)

@@ -75,14 +75,14 @@ def main(argv=None):
     t_free = 1.0 / omega0
 
     # 1. unguarded constant eps: run until the detector fires
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps))
+    sim = Simulation(st, CollisionRule.constant(eps))
     plain, err, wall = record(sim, math.inf, 1.0, budget)
     if err is None:
         raise SystemExit("no collapse within the collision budget; lower --restitution or raise --packing")
     t_col, c_col = sim.time, sim.collisions
     print(f"constant eps = {eps}: InelasticCollapseError after {wall:.1f} s wall:\n  {err}")
     # rerun (deterministic) and count the collisions still to come before t_col
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps))
+    sim = Simulation(st, CollisionRule.constant(eps))
     deltas = np.geomspace(0.3 * t_col, 1e-9 * t_col, 40)
     remaining = []
     for d in deltas:
@@ -100,7 +100,7 @@ def main(argv=None):
     t_run = 2.0 * t_col
     tc_runs = {}
     for f in (1e-6, 1e-4, 1e-2):
-        sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps, tc_time=f * t_free))
+        sim = Simulation(st, CollisionRule.constant(eps, tc_time=f * t_free))
         rows, e2, w2 = record(sim, t_run, 1.0, budget)
         tc_runs[f] = (rows, e2, w2)
         on = plain[:, 0] <= rows[-1, 0]
@@ -121,7 +121,7 @@ def main(argv=None):
     b = math.exp(brentq(mismatch, math.log(1e-3), math.log(5.0)))
     gas = replace(gas, prefactor=b)  # reduced units: k = b = damping for unit particles
     table = restitution_table(b * (2 * math.sqrt(2 * n)) ** 0.2 * 1.01)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.viscoelastic(prefactor=b, table=table))
+    sim = Simulation(st, CollisionRule.viscoelastic(prefactor=b, table=table))
     visco, e3, w3 = record(sim, t_run, 1.0, budget)
     print(f"viscoelastic damping = {b:.4g} (same initial cooling rate): reached t = {visco[-1, 0]:.4g} "
           f"({'collapse!' if e3 else 'ok'}), {visco[-1, 1] / n * 2:.4g} collisions per particle, {w3:.1f} s wall")

@@ -56,7 +56,7 @@ def measure(args, fraction, seed):
     zeta = float(theory.enskog_cooling_rate(eps_eff, n_dens, t_th, d, a2=a2_th))
     dt_k = theory.driving_interval(zeta, fraction)
     st = random_state(args.particles, args.packing, d, temperature=t_th, seed=seed)
-    sim = Simulation(**st.as_kwargs(), rule=rule, driving=WhiteNoise(h, dt_k, seed=seed))
+    sim = Simulation(st, rule, driving=WhiteNoise(h, dt_k, seed=seed))
     spacing = max(1, round(0.25 / zeta / dt_k))  # kicks between samples
     first = max(1, round(args.relax / zeta / dt_k))
     ts, a2s = [], []

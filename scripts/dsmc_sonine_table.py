@@ -29,6 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from granulargas import theory  # noqa: E402
 from granulargas.dsmc import DSMC  # noqa: E402
 from granulargas.engine import CollisionRule  # noqa: E402
+from granulargas.state import State  # noqa: E402
 from tests.dsmc.hcs_reference import collisional_moment_ratio  # noqa: E402
 
 
@@ -64,7 +65,8 @@ def main(argv=None):
         for eps in args.eps:
             t0 = time.perf_counter()
             v = np.random.default_rng(args.seed).standard_normal((n, dim))
-            sim = DSMC(v, 0.5, 1.0, CollisionRule.constant(eps), packing_fraction=0.01, seed=args.seed)
+            sim = DSMC(State(None, v, 0.5, 1.0, None), CollisionRule.constant(eps), packing_fraction=0.01,
+                       seed=args.seed)
             sim.run(np.inf, max_collisions=int(args.relax * n / 2))
             a2, a3, q = [], [], []
             for k in range(snaps):

@@ -33,6 +33,7 @@ from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
 from granulargas.observables import energy_moments, sample_history
 from granulargas.run.prepare import beta_bound
+from granulargas.state import State
 from granulargas.theory.gas import Gas, viscoelastic_cooling
 
 
@@ -75,12 +76,11 @@ def main(argv=None):
         if table is None:
             table = restitution_table(beta_bound(k, state) * 1.5)
         rule = CollisionRule.viscoelastic(k, table)
-        sim = Simulation(**state.as_kwargs(), rule=rule)
+        sim = Simulation(state, rule)
         t0 = time.perf_counter()
         engine.append(sample_history(sim, times))
         wall["engine"] += time.perf_counter() - t0
-        small = DSMC(state.velocities, state.radii, state.masses, rule, volume=float(np.prod(state.box)),
-                     seed=100 + seed)
+        small = DSMC(state, rule, seed=100 + seed)
         dsmc_small.append(sample_history(small, times))
         print(f"  seed {seed}: engine {int(engine[-1][-1, 2])} collisions, DSMC {int(dsmc_small[-1][-1, 2])}",
               flush=True)
@@ -88,7 +88,8 @@ def main(argv=None):
     v = rng.standard_normal((ref_n, d))
     big_table = restitution_table(max(table.beta_max, beta_bound(k, random_state(2, 1e-3, d, seed=0)) * 1.5))
     v *= 1.0 / math.sqrt(observe(v - v.mean(axis=0))[0])
-    ref = DSMC(v, 0.5, 1.0, CollisionRule.viscoelastic(k, big_table), packing_fraction=eta, seed=3)
+    ref = DSMC(State(None, v, 0.5, 1.0, None), CollisionRule.viscoelastic(k, big_table), packing_fraction=eta,
+               seed=3)
     t0 = time.perf_counter()
     reference = sample_history(ref, times)
     wall["dsmc"] = time.perf_counter() - t0

@@ -176,7 +176,7 @@ def engine_runs(n, damping, table, seeds, t_end, times):
     out, cost = [], []
     for seed in range(1, seeds + 1):
         st = random_state(n=n, packing=0.1, dimension=3, temperature=1.0, seed=seed)
-        sim = Simulation(**st.as_kwargs(), rule=CollisionRule.viscoelastic(prefactor=damping, table=table))
+        sim = Simulation(st, CollisionRule.viscoelastic(prefactor=damping, table=table))
         T = []
         t0 = time.perf_counter()
         for t in times:
@@ -193,7 +193,7 @@ def time_engine(table, damping, n=4000, collisions=200_000, repeats=3):
     st = random_state(n=n, packing=0.1, dimension=3, temperature=1.0, seed=11)
     out = []
     for _ in range(repeats):
-        sim = Simulation(**st.as_kwargs(), rule=CollisionRule.viscoelastic(prefactor=damping, table=table))
+        sim = Simulation(st, CollisionRule.viscoelastic(prefactor=damping, table=table))
         sim.run(until=1e-6)  # build outside the timing
         t0 = time.perf_counter()
         sim.run(until=math.inf, max_collisions=collisions)

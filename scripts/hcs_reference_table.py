@@ -61,6 +61,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from granulargas import theory  # noqa: E402
 from granulargas.dsmc import DSMC  # noqa: E402
 from granulargas.engine import CollisionRule  # noqa: E402
+from granulargas.state import State  # noqa: E402
 from granulargas.theory import hcs  # noqa: E402
 
 DENSITY = 0.01  # number density of the DSMC gas; with chi = 1 it only sets the time unit
@@ -68,7 +69,8 @@ DENSITY = 0.01  # number density of the DSMC gas; with chi = 1 it only sets the 
 
 def make_dsmc(velocities, eps, seed):
     """A DSMC of identical unit particles (diameter 1, mass 1) at ``DENSITY``, Boltzmann (chi = 1)."""
-    return DSMC(velocities, 0.5, 1.0, CollisionRule.constant(eps), number_density=DENSITY, chi=1.0, seed=seed)
+    return DSMC(State(None, velocities, 0.5, 1.0, None), CollisionRule.constant(eps), number_density=DENSITY, chi=1.0,
+                seed=seed)
 
 
 def rescaled(sim):

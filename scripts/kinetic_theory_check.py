@@ -31,6 +31,7 @@ from granulargas.analysis.cooling import sonine_coefficients, temperature
 from granulargas.contact import prefactor_from_damping, restitution_table
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
+from granulargas.state import State
 from granulargas.theory.gas import Gas, cooling_curve
 
 
@@ -87,7 +88,7 @@ def main(argv=None):
     engine = []
     for seed in range(seeds):
         state = random_state(n, eta, d, seed=seed)
-        sim = Simulation(**state.as_kwargs(), rule=rule)
+        sim = Simulation(state, rule)
         engine.append(observe(sim, times, lambda s: s.velocities))
         print(f"  engine seed {seed}: {sim.collisions} collisions", flush=True)
     engine = np.array(engine)
@@ -105,7 +106,7 @@ def main(argv=None):
         v = rng.standard_normal((dsmc_n, d))
         v -= v.mean(axis=0)
         v /= math.sqrt(temperature(v))
-        sim = DSMC(v, 0.5, 1.0, rule, packing_fraction=eta, chi=gas.chi, seed=3)
+        sim = DSMC(State(None, v, 0.5, 1.0, None), rule, packing_fraction=eta, chi=gas.chi, seed=3)
         dsmc = observe(sim, times, lambda s: s.velocities)
         print(f"  DSMC: N = {dsmc_n}, {sim.collisions} collisions", flush=True)
 

@@ -63,7 +63,7 @@ def main(argv=None):
     if args.quick:
         total, n = 1_000_000, 2000
     st = random_state(n=n, packing=args.packing, dimension=3, temperature=1.0, seed=7)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.elastic())
+    sim = Simulation(st, CollisionRule.elastic())
     t0 = time.perf_counter()
     sim.run(until=1e-3)  # JIT compile / cache load
     print(f"compile/load + build: {time.perf_counter() - t0:.1f} s")

@@ -46,6 +46,7 @@ from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
 from granulargas.observables import energy_moments, sample_history
 from granulargas.run.prepare import beta_bound
+from granulargas.state import State
 
 
 def moments(v):
@@ -70,22 +71,21 @@ def engine_run(n, eta, d, rule, seed, times, relax=0.0):
     """
     c0 = time.process_time()
     st = random_state(n, eta, d, seed=seed)
-    kw = st.as_kwargs()
     if relax > 0.0:
-        warm = Simulation(**kw, rule=CollisionRule.elastic())
+        warm = Simulation(st, CollisionRule.elastic())
         omega0 = float(theory.collision_frequency(theory.number_density(eta, d), 1.0, d,
                                                   chi=theory.contact_value(eta, d)))
         warm.run(relax / omega0)
         v = warm.velocities - warm.velocities.mean(axis=0)
-        kw.update(positions=warm.positions, velocities=v / math.sqrt(moments(v)[0]))
-    sim = Simulation(**kw, rule=rule)
+        st = st.replace(positions=warm.positions, velocities=v / math.sqrt(moments(v)[0]))
+    sim = Simulation(st, rule)
     h = sample_history(sim, times)
     return h, time.process_time() - c0
 
 
 def dsmc_run(n, eta, d, rule, seed, times, chi):
     c0 = time.process_time()
-    sim = DSMC(maxwellian(n, d, seed), 0.5, 1.0, rule, packing_fraction=eta, chi=chi, seed=seed)
+    sim = DSMC(State(None, maxwellian(n, d, seed), 0.5, 1.0, None), rule, packing_fraction=eta, chi=chi, seed=seed)
     h = sample_history(sim, times)
     return h, time.process_time() - c0
 
@@ -176,8 +176,9 @@ def clustering(args):
     end = (100.0 if args.quick else 400.0) / omega0
     times = np.geomspace(1.0 / omega0, end, 16)
     st = random_state(n, eta, d, seed=1)
-    eng = sample_history(Simulation(**st.as_kwargs(), rule=rule_engine), times)
-    ref = sample_history(DSMC(maxwellian(100000, d, 3), 0.5, 1.0, rule_dsmc, packing_fraction=eta, chi=chi, seed=3), times)
+    eng = sample_history(Simulation(st, rule_engine), times)
+    ref = sample_history(DSMC(State(None, maxwellian(100000, d, 3), 0.5, 1.0, None), rule_dsmc, packing_fraction=eta,
+                              chi=chi, seed=3), times)
     print(f"3. clustering: 2D, constant eps = {eps}, packing {eta}, N = {n}, L = {box:.4g} = {box / lc:.1f} L_c",
           flush=True)
     for q in range(0, len(times), 3):

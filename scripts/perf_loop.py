@@ -49,7 +49,7 @@ def child(args, out):
     from granulargas.initial import random_state
 
     st = random_state(int(float(args.n)), args.packing, 3, seed=1)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.elastic(), neighbours=args.neighbours)
+    sim = Simulation(st, CollisionRule.elastic(), neighbours=args.neighbours)
     sim.run(np.inf, max_collisions=2 * sim.n)
     t0 = time.process_time()
     sim.run(np.inf, max_collisions=int(float(args.collisions)))

@@ -35,13 +35,11 @@ def profile(n, packing, walls=False, seed=1, neighbours="lists"):
     from granulargas.initial import random_state
 
     st = random_state(n, packing, 3, seed=seed)
-    kw = st.as_kwargs()
-    boundary = None
     if walls:  # the same gas between walls at z = 0 and L: the spheres touching them are moved in
-        boundary = ("periodic", "periodic", "wall")
-        r = kw["radii"]
-        kw["positions"][:, 2] = np.clip(kw["positions"][:, 2], r, kw["box"][2] - r)
-    sim = Simulation(**kw, rule=CollisionRule.elastic(), boundary=boundary, neighbours=neighbours)
+        pos = st.positions.copy()
+        pos[:, 2] = np.clip(pos[:, 2], st.radii, st.box[2] - st.radii)
+        st = st.replace(positions=pos, boundary=("periodic", "periodic", "wall"))
+    sim = Simulation(st, CollisionRule.elastic(), neighbours=neighbours)
     sim.run(np.inf, max_collisions=2 * n)
     prm = sim._params()
     probe = np.zeros(_probe.PROBE_SIZE, np.int64)

@@ -32,6 +32,7 @@ from granulargas import theory
 from granulargas.analysis import velocity as vd
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule
+from granulargas.state import State
 
 
 def parse_case(text):
@@ -49,7 +50,7 @@ def run_case(dim, eps, n, relax, snapshots, spacing, seed, c_max, log):
     """HCS of one case: (histogram, times, temperatures, dsmc)."""
     rng = np.random.default_rng(seed)
     v = rng.standard_normal((n, dim))
-    sim = DSMC(v, 0.5, 1.0, CollisionRule.constant(eps), packing_fraction=0.01, seed=seed)
+    sim = DSMC(State(None, v, 0.5, 1.0, None), CollisionRule.constant(eps), packing_fraction=0.01, seed=seed)
     start = time.perf_counter()
     sim.run(np.inf, max_collisions=int(relax * n / 2))
     hist = vd.SpeedHistogram(dim, c_max=c_max, bins=int(c_max / 0.05))

@@ -113,8 +113,8 @@ def test_sample_history_runs_and_samples_either_method():
     st = random_state(200, 0.1, 3, seed=4)
     rule = CollisionRule.constant(0.8)
     times = np.array([0.5, 1.0, 2.0])
-    for sim in (Simulation(**st.as_kwargs(), rule=rule),
-                DSMC(st.velocities, st.radii, st.masses, rule, volume=float(np.prod(st.box)), seed=1)):
+    for sim in (Simulation(st, rule),
+                DSMC(st, rule, seed=1)):
         h = sample_history(sim, times)
         assert sim.time == 2.0 and h[-1, 2] == sim.collisions
         c = sim.velocities - sim.velocities.mean(axis=0)

@@ -1,7 +1,7 @@
 """Command line: ``granulargas <command> ...`` (also ``python -m granulargas``).
 
 Each command lives in its own module of this package (``granulargas.cli.run``,
-``.epsilon``, ``.analyze``, ``.advise``, ``.sweep``, ``.export``) exposing
+``.epsilon``, ``.analyze``, ``.advise``, ``.sweep``, ``.export``, ``.compile``) exposing
 ``configure_parser(parser)`` and ``run(args) -> int``; shared argument helpers
 are in :mod:`granulargas.cli._args`. This file only wires them. The command
 modules are imported lazily (:func:`build_parser` imports only the one named on
@@ -29,6 +29,7 @@ COMMANDS = {
     "advise": ("granulargas.cli.advise", "is a constant restitution good enough for this config?"),
     "sweep": ("granulargas.cli.sweep", "run a parameter sweep / ensemble from a sweep file"),
     "export": ("granulargas.cli.export", "export a run for LAMMPS or OVITO (GSD)"),
+    "compile": ("granulargas.cli.compile", "compile every kind of run once, ahead of the first runs"),
 }
 
 

@@ -22,8 +22,11 @@ from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
 from granulargas.observables import energy_moments, kinetic_energy_momentum
+from granulargas.state import PARTICLE_FIELDS, DSMCContinuation, State
 
 _INT_MAX = np.iinfo(np.int64).max
+#: per-particle fields of granulargas.state.PARTICLE_FIELDS that the DSMC moves or uses
+OWN_FIELDS = ("velocities", "radii", "masses")
 
 
 def collision_solid_angle(dim: int) -> float:
@@ -47,41 +50,38 @@ class DSMC:
 
     Parameters
     ----------
-    velocities : array (N, d)
-        Initial velocities; the DSMC works in the centre-of-mass frame, so their
-        mass-weighted mean is subtracted (kept in :attr:`frame_velocity`) unless
-        ``state`` is given (then they are taken as they are).
-    radii, masses : float or array (N,)
-        In units of the reference diameter and mass.
+    state : granulargas.state.State
+        Velocities (N, d), radii and masses (in units of the reference diameter and
+        mass), the clock and counters (``time``, ``collisions``, ``dissipated_energy``,
+        and, when driven, ``kick_step`` and ``injected_energy``) and the DSMC's
+        continuation (``state.dsmc``: random words, candidate count, pending
+        collision, frame velocity). Without a continuation the DSMC works in the
+        centre-of-mass frame: the velocities' mass-weighted mean is subtracted (kept
+        in :attr:`frame_velocity`) and the random streams are seeded with ``seed``;
+        with one the velocities are taken as they are and the run continues bit for
+        bit. Positions, if the state has any, are not used (a homogeneous gas); walls
+        are refused. The box, if any, gives the volume unless a density is given.
     rule : CollisionRule
         Elastic, constant or viscoelastic (the TC model needs pair histories and
         is not available).
     number_density, packing_fraction, volume : float
-        Exactly one: the density n = N / V, the packing fraction
-        sum_i v_i / V (v_i the particle volume, or area in 2D), or V itself.
+        At most one (none: the volume of ``state.box``): the density n = N / V, the
+        packing fraction sum_i v_i / V (v_i the particle volume, or area in 2D), or V
+        itself.
     chi : float, optional
         Pair correlation at contact; default the Enskog value
         :func:`granulargas.theory.contact_value` of the packing fraction
         (``chi=1`` gives the Boltzmann equation).
     seed : int
-        Seed of the random streams (ignored when ``state`` is given).
-    time, collisions, dissipated_energy : carried-over counters.
-    state : dict, optional
-        :attr:`state` of an earlier DSMC to continue bit for bit (random words,
-        candidate count, pending collision, frame velocity), together with its
-        :attr:`velocities`, ``time``, ``collisions`` and ``dissipated_energy``
-        (and, when driven, ``kick_step`` and ``injected_energy``).
+        Seed of the random streams (not used when the state has a continuation).
     driving : WhiteNoise, optional
         The engine's white-noise driving (:mod:`granulargas.engine._drive`, eq. (1)):
         at the times (k + 1/2) dt_k every velocity gets the same momentum-free
         Gaussian kick as in the engine (the same compiled kick and random stream, by
-        particle id). After a kick the pending collision, accepted against the old
+        particle id), from the state's ``kick_step`` on (None: the first after
+        ``time``). After a kick the pending collision, accepted against the old
         velocities, is dropped and the majorant restarts from the kick time (the
         majorant process is memoryless, so this is exact).
-    kick_step : int, optional
-        Index k of the next kick (default: the first after ``time``).
-    injected_energy : float
-        Energy put in by the kicks so far (carried over).
 
     Notes
     -----
@@ -95,15 +95,13 @@ class DSMC:
     partners, so the collision frequency is (N - 1)/N times Enskog's omega(n).
     """
 
-    def __init__(self, velocities, radii, masses, rule: CollisionRule, *,
-                 number_density: float | None = None, packing_fraction: float | None = None,
-                 volume: float | None = None, chi: float | None = None, seed: int = 0,
-                 time: float = 0.0, collisions: int = 0, dissipated_energy: float = 0.0,
-                 state: dict | None = None, driving: WhiteNoise | None = None, kick_step: int | None = None,
-                 injected_energy: float = 0.0):
-        vel = np.asarray(velocities, dtype=np.float64)
-        if vel.ndim != 2 or vel.shape[1] not in (2, 3):
-            raise ConfigError(f"velocities: shape {vel.shape}, expected (N, 2) or (N, 3)")
+    def __init__(self, state: State, rule: CollisionRule, *, number_density: float | None = None,
+                 packing_fraction: float | None = None, volume: float | None = None, chi: float | None = None,
+                 seed: int = 0, driving: WhiteNoise | None = None):
+        if not isinstance(state, State):
+            raise TypeError("state must be a granulargas.state.State")
+        state.check_shapes()
+        vel = state.velocities
         n, d = vel.shape
         if n < 2:
             raise ConfigError(f"velocities: N = {n}, need at least 2 particles")
@@ -111,11 +109,12 @@ class DSMC:
             raise ConfigError(f"velocities: N = {n}, at most 2^31 - 1 particles")
         if not np.all(np.isfinite(vel)):
             raise ConfigError("velocities: non-finite values")
-        rad = np.asarray(radii, dtype=np.float64)
-        mas = np.asarray(masses, dtype=np.float64)
+        rad, mas = state.radii.copy(), state.masses.copy()
+        # per-particle fields the DSMC does not use (a homogeneous gas has no positions and images):
+        # kept as they are, returned by ``state``
+        self._carried = {f.name: getattr(state, f.name).copy() for f in PARTICLE_FIELDS
+                         if f.name not in OWN_FIELDS + ("positions", "images") and getattr(state, f.name) is not None}
         for name, arr in (("radii", rad), ("masses", mas)):
-            if arr.ndim > 1 or (arr.ndim == 1 and arr.shape[0] not in (1, n)):
-                raise ConfigError(f"{name}: shape {arr.shape}, expected a number or ({n},)")
             if not (np.all(arr > 0) and np.all(np.isfinite(arr))):
                 raise ConfigError(f"{name}: every value must be finite and > 0")
         if not isinstance(rule, CollisionRule):
@@ -123,13 +122,23 @@ class DSMC:
         if rule.tc_time is not None:
             raise ConfigError(f"tc_time = {rule.tc_time}: the TC model is not available in DSMC "
                               f"(there is no inelastic collapse to cure; use tc_time=None)")
+        if "wall" in state.boundary:
+            raise ConfigError(f"boundary = {list(state.boundary)}: the DSMC simulates a homogeneous gas, "
+                              f"without walls")
+        time, collisions, dissipated_energy = state.time, state.collisions, state.dissipated_energy
+        kick_step, injected_energy = state.kick_step, state.injected_energy
+        cont = state.dsmc
         self.dimension = d
         self.rule = rule
 
-        # density: exactly one of n, packing fraction, V
+        # density: at most one of n, packing fraction, V; else the state's box
         given = [x is not None for x in (number_density, packing_fraction, volume)]
-        if sum(given) != 1:
-            raise ConfigError("DSMC needs exactly one of number_density, packing_fraction, volume")
+        if sum(given) > 1:
+            raise ConfigError("DSMC takes at most one of number_density, packing_fraction, volume")
+        if sum(given) == 0 and state.box is None:
+            raise ConfigError("DSMC needs a density: the state's box, or one of number_density, "
+                              "packing_fraction, volume")
+        self._box = state.box.copy() if sum(given) == 0 else None
         # identical particles keep no per-particle arrays (32 bytes per particle in 3D)
         self._mono = bool(np.all(rad == rad.flat[0]) and np.all(mas == mas.flat[0]))
         if self._mono:
@@ -138,8 +147,6 @@ class DSMC:
             sigma_max = 2.0 * r0
             self._rad_k = self._mas_k = np.zeros(1)
         else:
-            rad = np.ascontiguousarray(np.broadcast_to(rad, (n,)))
-            mas = np.ascontiguousarray(np.broadcast_to(mas, (n,)))
             r0, m0 = float(rad[0]), float(mas[0])
             solid = float(np.sum(theory.particle_volume(2.0 * rad, d)))
             sigma_max = 2.0 * float(rad.max())
@@ -152,8 +159,11 @@ class DSMC:
         elif packing_fraction is not None:
             value, name = float(packing_fraction), "packing_fraction"
             vol = solid / value if value > 0 else math.nan
-        else:
+        elif volume is not None:
             value, name = float(volume), "volume"
+            vol = value
+        else:
+            value, name = float(np.prod(state.box)), "box"
             vol = value
         if not (vol > 0 and math.isfinite(vol)):
             raise ConfigError(f"{name} = {value}: must be finite and > 0")
@@ -169,7 +179,6 @@ class DSMC:
         if not (chi > 0 and math.isfinite(chi)):
             raise ConfigError(f"chi = {chi}: must be finite and > 0")
         self.chi = chi
-
 
         kind, eps, _, pref, inv_h, coeffs = rule.kernel_arguments()
         self._kind, self._coeffs = kind, coeffs
@@ -200,25 +209,24 @@ class DSMC:
         iscal[_loop.I_ERR_I] = iscal[_loop.I_ERR_J] = -1
         iscal[_loop.I_PENDING_I] = iscal[_loop.I_PENDING_J] = -1
         scal[_loop.S_NEXT] = math.nan
-        if state is None:
+        if cont is None:
             frame = vel.mean(axis=0) if self._mono else (mas @ vel) / mas.sum()
             rec[:, :d] -= frame
             rng = seed_state(seed)
         else:
-            frame = np.asarray(state["frame_velocity"], dtype=np.float64)
-            rng = np.array(state["rng"], dtype=np.uint64)
+            frame = cont.frame_velocity.copy()
+            rng = cont.rng.copy()
             if frame.shape != (d,) or rng.shape != (STATE_WORDS,):
-                raise ConfigError(f"state: frame_velocity needs shape ({d},) and rng ({STATE_WORDS},)")
-            iscal[_loop.I_CANDIDATES] = int(state["candidates"])
-            pi, pj = (int(x) for x in state["pending_pair"])
+                raise ConfigError(f"dsmc: frame_velocity needs shape ({d},) and rng ({STATE_WORDS},)")
+            iscal[_loop.I_CANDIDATES] = cont.candidates
+            pi, pj = cont.pending_pair
             if pi >= 0:
                 if not (0 <= pi < n and 0 <= pj < n and pi != pj):
-                    raise ConfigError(f"state: pending_pair = {(pi, pj)} is not a pair of the {n} particles")
-                if not float(state["pending_time"]) >= float(time):
-                    raise ConfigError(f"state: pending_time = {state['pending_time']} lies before "
-                                      f"time = {time}")
+                    raise ConfigError(f"dsmc: pending_pair = {(pi, pj)} is not a pair of the {n} particles")
+                if not cont.pending_time >= time:
+                    raise ConfigError(f"dsmc: pending_time = {cont.pending_time} lies before time = {time}")
                 iscal[_loop.I_PENDING_I], iscal[_loop.I_PENDING_J] = pi, pj
-                scal[_loop.S_NEXT] = float(state["pending_time"])
+                scal[_loop.S_NEXT] = cont.pending_time
         self.frame_velocity = frame
         self._rng = rng
         self._hist = new_histogram()
@@ -239,11 +247,11 @@ class DSMC:
                     k0 += 1
                 self._kick_step = k0
             else:
-                self._kick_step = int(kick_step)
+                self._kick_step = kick_step
                 if not (self._kick_step + 0.5) * dt > float(time):
                     raise ConfigError(f"kick_step = {kick_step}: the next driving step k must come after the "
                                       f"time {time} ((k + 1/2) interval > time)")
-            self._kick_mass = np.ascontiguousarray(np.broadcast_to(mas, (n,)), dtype=np.float64)
+            self._kick_mass = mas
             self._kick_ident = np.arange(n, dtype=np.int32)
             self._kick_scale = kick_scale(driving.heating_rate, dt, n)
 
@@ -376,18 +384,27 @@ class DSMC:
         return np.full(self.n, self._m0) if self._mono else self._mas_k.copy()
 
     @property
-    def state(self) -> dict:
-        """What continues this run bit for bit besides velocities, time and counters.
+    def continuation(self) -> DSMCContinuation:
+        """What continues this run bit for bit besides velocities, clock and counters:
+        random words, position in the pair stream, the pending collision (already drawn)
+        and the frame velocity (:class:`granulargas.state.DSMCContinuation`)."""
+        return DSMCContinuation(
+            rng=self._rng.copy(), candidates=self.candidates, frame_velocity=self.frame_velocity.copy(),
+            pending_pair=(int(self._iscal[_loop.I_PENDING_I]), int(self._iscal[_loop.I_PENDING_J])),
+            pending_time=float(self._scal[_loop.S_NEXT]))
 
-        ``rng`` (uint64 (5,)), ``candidates`` (int, position in the pair stream),
-        ``pending_pair`` ((i, j), or (-1, -1)) and ``pending_time`` (float; nan
-        when there is no pending collision): the next collision, already drawn;
-        ``frame_velocity`` (d,): the mean velocity subtracted at the start.
-        """
-        return {"rng": self._rng.copy(), "candidates": self.candidates,
-                "frame_velocity": self.frame_velocity.copy(),
-                "pending_pair": (int(self._iscal[_loop.I_PENDING_I]), int(self._iscal[_loop.I_PENDING_J])),
-                "pending_time": float(self._scal[_loop.S_NEXT])}
+    @property
+    def state(self) -> State:
+        """The state as a record (:class:`granulargas.state.State`; no positions, peculiar
+        velocities, ``events`` = collisions, ``dsmc`` = :attr:`continuation`):
+        ``DSMC(dsmc.state, rule, ...)`` with the same settings continues bit for bit. Its box
+        is the one the DSMC took its volume from (None when a density was given)."""
+        return State(positions=None, velocities=self.velocities, radii=self.radii, masses=self.masses,
+                     box=None if self._box is None else self._box.copy(),
+                     time=self.time, collisions=self.collisions, events=self.collisions,
+                     dissipated_energy=self.dissipated_energy, injected_energy=self.injected_energy,
+                     kick_step=None if self.driving is None else self.kick_step, dsmc=self.continuation,
+                     **{name: value.copy() for name, value in self._carried.items()})
 
     # ------------------------------------------------------------- observables
     def _moments(self):

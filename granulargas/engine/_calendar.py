@@ -76,7 +76,7 @@ import numpy as np
 
 from granulargas._numba import inlined, inlined_ir, jit, kernel
 from granulargas.engine._prefetch import prefetch
-from granulargas.engine._state import CALENDAR_STATE, Calendar
+from granulargas.engine._state import CALENDAR_STATE, Calendar, event_rows
 
 PER_WINDOW = 48
 CHUNK = 8  # int32 per chunk row: next chunk + 7 ids (32 bytes)
@@ -105,8 +105,12 @@ def allocate_calendar(n, capacity=None, pool=None, qt=None, where=None) -> Calen
     its width and places all events anew (O(N), self-correcting). ``pool``:
     number of chunks (default :func:`pool_size`; never below what n live
     entries need, so that placing all events anew always succeeds). ``qt``, ``where``:
-    arrays of n to use (views into per-particle rows), else new ones.
+    arrays of n to use (views into the mode's per-particle rows), else those of new rows
+    (:func:`granulargas.engine._state.event_rows`), so that the kernels see one array
+    type in every use.
     """
+    if qt is None or where is None:
+        _, _, where, qt = event_rows(n)
     nb = ring_size(n)
     cap = max(1024, n // 16) if capacity is None else int(capacity)
     chunks = pool_size(n, nb) if pool is None else max(int(pool), pool_size(n, nb, stale=False))
@@ -115,9 +119,9 @@ def allocate_calendar(n, capacity=None, pool=None, qt=None, where=None) -> Calen
     state = np.zeros(1, dtype=CALENDAR_STATE)
     state[0] = (0, 0, nb, 0, -1, -1, 1.0, 0.0, np.inf)
     return Calendar(
-        qt=np.full(n, np.inf) if qt is None else qt,
+        qt=qt,
         chunks=buf[offset : offset + chunks * CHUNK].reshape(chunks, CHUNK),
-        where=np.zeros(n, dtype=np.int32) if where is None else where,
+        where=where,
         small=np.zeros((min(n, cap), 2)),
         buckets=np.zeros((nb + 1, 2), dtype=np.int32),
         state=state,

@@ -28,7 +28,11 @@ Record layout
 * ``events`` :class:`Events` -- the one scheduled event per particle: ``partner``
   i4 (>= 0: a pair collision with that slot; < 0: the event kind, see
   :mod:`granulargas.engine._loop`) and ``tag`` i4 (the partner's ``count`` when
-  predicted; the wall index 2 a + side for a wall collision).
+  predicted; the wall index 2 a + side for a wall collision). In the neighbour-list
+  mode ``partner``, ``tag``, ``calendar.qt`` and ``calendar.where`` are strided views
+  into one 32-byte row per particle (:func:`event_rows`); the cell-crossing mode keeps
+  them in its 64-byte rows (below). Both modes thus pass these arrays with one numba
+  type, and the calendar's kernels compile once for both.
 * ``lists`` :class:`Lists` -- ``centre`` (N, 3) f4 list centres, ``nbl`` (N, M) i4
   neighbour lists, ``nbn`` i4 lengths; work space ``scratch`` i4, ``stencil`` i8 and
   ``mark`` (N,) u1 (all zero between list rebuilds).
@@ -211,10 +215,35 @@ def wall_spec(kind=None, waveform=None, amplitude=None, frequency=None, phase=No
                     table(temperature, np.float64), np.uint64(seed))
 
 
+def event_rows(n: int):
+    """The neighbour-list mode's event and calendar data of each particle in one 32-byte
+    row (half a cache line; the event's particle touches all four at once): views of
+    one buffer of n rows, float64 column 0 ``qt`` (:class:`Calendar`, inf) and int32
+    columns 2 ``partner`` (-1), 3 ``tag`` (:class:`Events`) and 4 ``where``
+    (:class:`Calendar`). Returns (partner, tag, where, qt).
+
+    Strided views, as the cell-crossing mode's rows
+    (:func:`granulargas.engine._crossing.particle_rows`): both modes pass the calendar
+    and the events arrays of one numba type, so that the calendar's kernels compiled
+    for one mode serve the other."""
+    buf = np.zeros(n * 4 + 8)
+    offset = (-buf.ctypes.data % 64) // 8
+    f8 = buf[offset : offset + n * 4].reshape(n, 4)
+    i4 = f8.view(np.int32)
+    f8[:, 0] = np.inf
+    i4[:, 2] = -1
+    return i4[:, 2], i4[:, 3], i4[:, 4], f8[:, 0]
+
+
 def nbytes(engine: Engine) -> int:
-    """Bytes held by the arrays of an engine state."""
-    total = 0
+    """Bytes held by the arrays of an engine state (a buffer that several views share,
+    such as the per-particle rows, counted once and whole)."""
+    seen = {}
     for group in engine:
         for a in (group if isinstance(group, tuple) else (group,)):
-            total += getattr(a, "nbytes", 0)
-    return total
+            if not isinstance(a, np.ndarray):
+                continue
+            while isinstance(a.base, np.ndarray):
+                a = a.base
+            seen[id(a)] = a.nbytes
+    return sum(seen.values())

@@ -36,8 +36,13 @@ from granulargas.errors import (
     SimulationError,
     TableRangeError,
 )
+from granulargas.state import PARTICLE_FIELDS, State
 
 _INT_MAX = np.iinfo(np.int64).max
+#: per-particle fields of granulargas.state.PARTICLE_FIELDS that the engine moves or uses; it keeps
+#: the others as it was given them
+OWN_FIELDS = ("positions", "velocities", "images", "radii", "masses", "last_collision", "contact_until",
+              "contact_partner")
 #: boundary conditions of an axis
 BOUNDARIES = ("periodic", "wall")
 #: neighbour search: neighbour lists with a shell, cell crossings (no lists), or the
@@ -163,52 +168,19 @@ class Simulation:
 
     Parameters
     ----------
-    positions : array (N, d)
-        Positions in units of the reference diameter; wrapped into [0, L) on
-        periodic axes; on a wall axis every sphere must lie within
-        [R_i, L - R_i] (no overlap with a wall).
-    velocities : array (N, d)
-    radii, masses : array (N,)
-    box : array (d,)
-        Box side lengths L.
+    state : granulargas.state.State
+        The state to start from: positions (wrapped into [0, L) on periodic axes; on a
+        wall axis every sphere must lie within [R_i, L - R_i], no overlap with a wall),
+        velocities, radii, masses, box, boundary (flat hard walls at 0 and L on "wall"
+        axes), periodic images (zero on wall axes), the clock and every counter
+        (carried over on restart), each particle's last collision (the TC model) and,
+        for collisions that take time, the contacts under way.
     rule : CollisionRule
         Collision rule of sphere-sphere and sphere-wall collisions.
-    time : float
-        Current time.
-    collisions : int
-        Pair collisions so far (a counter carried over on restart).
-    images : int array (N, d), optional
-        Periodic image counters (unwrapped position = position + images * L);
-        zero on wall axes.
-    last_collision : array (N,), optional
-        Time of each particle's last collision (-inf: none); used by the TC model.
-    shell : float, optional
-        Neighbour-list shell in units of the largest diameter (default from the
-        packing fraction, see :func:`default_shell`).
-    collapse_count : int
-        Inelastic-collapse detector: stop when one particle collides this many
-        times in a row, each within ``1e-10`` thermal collision-length times
-        of the previous one.
-    events : int
-        Events processed so far (counter carried over on restart).
-    dissipated_energy : float
-        Energy dissipated so far (carried over on restart).
-    boundary : sequence of str, optional
-        One entry per axis: "periodic" (default) or "wall" (flat hard walls at 0 and L).
-    wall_collisions : int
-        Sphere-wall collisions so far (carried over on restart).
     driving : WhiteNoise, optional
         White-noise driving (:class:`granulargas.engine.driving.WhiteNoise`):
-        kicks at the times (k + 1/2) * interval.
-    kick_step : int, optional
-        Index k of the next driving step (carried over on restart; default: the
-        first k with (k + 1/2) * interval > time).
-    injected_energy : float
-        Energy put in by the driving so far (carried over on restart).
-    remove_drift : bool
-        Remove the centre-of-mass velocity that round-off accumulates on the
-        periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
-        e.g. a mean flow given on purpose.
+        kicks at the times (k + 1/2) * interval, from the state's ``kick_step`` on
+        (None: the first k with (k + 1/2) * interval > time).
     neighbours : {"lists", "cells", "auto"}
         Neighbour search: neighbour lists with a shell (list expiries as events),
         cell crossings (no lists; each particle is predicted against the
@@ -218,14 +190,17 @@ class Simulation:
         The two modes process different
         events, so their event sequences agree only up to round-off. Cell
         crossings do not take collisions that take time (ConfigError).
-    contact_until : array (N,), optional
-        Resolved rule (collisions that take time): the time at which each
-        particle's contact under way ends (-inf: none); carried over on restart.
-    contact_partner : int array (N,), optional
-        Resolved rule: the particle id of that contact's partner (-1: none).
-    three_body_contacts : int
-        Resolved rule: collisions of a particle still in contact with another
-        partner so far (carried over on restart).
+    shell : float, optional
+        Neighbour-list shell in units of the largest diameter (default from the
+        packing fraction, see :func:`default_shell`).
+    collapse_count : int
+        Inelastic-collapse detector: stop when one particle collides this many
+        times in a row, each within ``1e-10`` thermal collision-length times
+        of the previous one.
+    remove_drift : bool
+        Remove the centre-of-mass velocity that round-off accumulates on the
+        periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
+        e.g. a mean flow given on purpose.
 
     Notes
     -----
@@ -233,7 +208,9 @@ class Simulation:
     ``time = until``. Observables are exact at ``time``; ``positions`` is a
     synchronised copy. ``synchronise()`` brings every particle clock to
     ``time`` and makes the next ``run`` rebuild all internal structures from
-    the public state.
+    the public state; :attr:`state` is that public state as a record, and
+    ``Simulation(sim.state, rule, ...)`` continues where ``sim.synchronise()``
+    would, bit for bit.
     """
 
     #: uniform acceleration (d,) or None; wall kinds (a ``_state.WallSpec``) or None (hard walls at rest)
@@ -246,41 +223,37 @@ class Simulation:
     #: through the gas (kinetic + dissipated + injected), as round-off drift always is
     ROUND_OFF = 1e-20
 
-    def __init__(self, positions, velocities, radii, masses, box, rule: CollisionRule,
-                 time: float = 0.0, collisions: int = 0, images=None, last_collision=None,
-                 *, events: int = 0, dissipated_energy: float = 0.0, shell: float | None = None,
-                 collapse_count: int = 100, boundary=None, wall_collisions: int = 0,
-                 driving: WhiteNoise | None = None, kick_step: int | None = None,
-                 injected_energy: float = 0.0, remove_drift: bool = True, contact_until=None,
-                 contact_partner=None, three_body_contacts: int = 0, neighbours: str = "lists"):
-        pos = np.array(positions, dtype=np.float64, order="C", copy=True)
-        if pos.ndim != 2 or pos.shape[1] not in (2, 3):
-            raise ConfigError(f"positions: shape {pos.shape}, expected (N, 2) or (N, 3)")
+    def __init__(self, state: State, rule: CollisionRule, *, driving: WhiteNoise | None = None,
+                 neighbours: str = "lists", shell: float | None = None, collapse_count: int = 100,
+                 remove_drift: bool = True):
+        if not isinstance(state, State):
+            raise TypeError("state must be a granulargas.state.State")
+        if state.positions is None:
+            raise ConfigError("positions: the state has none (a DSMC state); the engine needs positions (N, d)")
+        state.check_shapes()
+        pos = np.array(state.positions, dtype=np.float64, order="C", copy=True)
         n, d = pos.shape
         if n < 2:
             raise ConfigError(f"positions: N = {n}, need at least 2 particles")
         self.dimension = d
-        vel = np.array(velocities, dtype=np.float64, order="C", copy=True)
-        if vel.shape != (n, d):
-            raise ConfigError(f"velocities: shape {vel.shape}, expected {(n, d)}")
-        rad = np.array(np.broadcast_to(np.asarray(radii, dtype=np.float64), (n,)), order="C")
-        mas = np.array(np.broadcast_to(np.asarray(masses, dtype=np.float64), (n,)), order="C")
+        vel = state.velocities.copy()
+        rad, mas = state.radii.copy(), state.masses.copy()
         if not (np.all(rad > 0) and np.all(np.isfinite(rad))):
             raise ConfigError("radii: every radius must be finite and > 0")
         if not (np.all(mas > 0) and np.all(np.isfinite(mas))):
             raise ConfigError("masses: every mass must be finite and > 0")
-        bx = np.array(np.broadcast_to(np.asarray(box, dtype=np.float64), (d,)), order="C")
+        if state.box is None:
+            raise ConfigError("box: the state has none; the engine needs the box sides (d,)")
+        bx = state.box.copy()
         if not np.all(bx > 0):
             raise ConfigError(f"box = {bx.tolist()}: side lengths must be > 0")
         if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(vel))):
             raise ConfigError("positions/velocities: non-finite values")
         if not isinstance(rule, CollisionRule):
             raise TypeError("rule must be a granulargas.engine.CollisionRule")
-        self.boundary = _boundary(boundary, d)
+        self.boundary = _boundary(state.boundary, d)
         wall = np.array([b == "wall" for b in self.boundary])
-        img = np.zeros((n, d), dtype=np.int64) if images is None else np.array(images, dtype=np.int64, order="C")
-        if img.shape != (n, d):
-            raise ConfigError(f"images: shape {img.shape}, expected {(n, d)}")
+        img = state.array("images")
         if np.any(img[:, wall] != 0):
             raise ConfigError("images: must be 0 on wall axes")
         for a in np.flatnonzero(wall):
@@ -300,35 +273,33 @@ class Simulation:
         wrapped = pos >= bx
         wrapped[:, wall] = False
         pos[wrapped] = 0.0  # guard against -tiny + L rounding to L
-        lc = np.full(n, -np.inf) if last_collision is None else np.array(last_collision, dtype=np.float64, order="C")
-        if lc.shape != (n,):
-            raise ConfigError(f"last_collision: shape {lc.shape}, expected ({n},)")
+        lc = state.array("last_collision")
         if driving is not None and not isinstance(driving, WhiteNoise):
             raise TypeError("driving must be a granulargas.engine.driving.WhiteNoise or None")
         if rule.resolved and np.any(wall):
             raise ConfigError('boundary: walls are not available with collisions that take time '
                               '(duration = "resolved"); use periodic axes')
-        cu = np.full(n, -np.inf) if contact_until is None else np.array(contact_until, dtype=np.float64)
-        cp = np.full(n, -1, dtype=np.int64) if contact_partner is None else np.array(contact_partner,
-                                                                                   dtype=np.int64)
-        if cu.shape != (n,) or cp.shape != (n,):
-            raise ConfigError(f"contact_until, contact_partner: shapes {cu.shape}, {cp.shape}, expected ({n},)")
+        cu, cp = state.array("contact_until"), state.array("contact_partner")
         if np.any((cp < -1) | (cp >= n)) or np.any(np.isnan(cu)):
             raise ConfigError("contact_partner: particle ids in [0, N) or -1; contact_until: no NaN")
         self._contact_until, self._contact_partner = cu, cp
-        self._three_body = int(three_body_contacts)
+        self._three_body = state.three_body_contacts
+        # per-particle fields the engine does not use: kept as they are, returned by ``state``
+        self._carried = {f.name: getattr(state, f.name).copy() for f in PARTICLE_FIELDS
+                         if f.name not in OWN_FIELDS and getattr(state, f.name) is not None}
 
         self._positions, self._velocities, self._images, self._last_collision = pos, vel, img, lc
         self._radii, self._masses, self._box = rad, mas, bx
         self.rule = rule
         self.driving = driving
         self.remove_drift = bool(remove_drift)
-        self._time = float(time)
-        self._collisions = int(collisions)
-        self._events = int(events)
-        self._wall_collisions = int(wall_collisions)
-        self._dissipated = float(dissipated_energy)
-        self._injected = float(injected_energy)
+        self._time = state.time
+        self._collisions = state.collisions
+        self._events = state.events
+        self._wall_collisions = state.wall_collisions
+        self._dissipated = state.dissipated_energy
+        self._injected = state.injected_energy
+        kick_step = state.kick_step
         if driving is None:
             self._kick_step = 0
         elif kick_step is None:
@@ -336,7 +307,7 @@ class Simulation:
             while (self._kick_step + 0.5) * driving.interval <= self._time:  # round-off in the floor
                 self._kick_step += 1
         else:
-            self._kick_step = int(kick_step)
+            self._kick_step = kick_step
             if not (self._kick_step + 0.5) * driving.interval > self._time:
                 raise ConfigError(f"kick_step = {kick_step}: the next driving step k must come after the "
                                   f"current time ((k + 1/2) interval > {self._time:.17g})")
@@ -433,8 +404,8 @@ class Simulation:
             build_grid(rec, lists, spc)
             self._finish_build(particles, events, lists, None, order, qt=qt, where=where)
             return
-        events = _state.Events(partner=np.full(n, -1, dtype=np.int32),
-                               tag=np.zeros(n, dtype=np.int32))
+        partner, tag, where, qt = _state.event_rows(n)
+        events = _state.Events(partner=partner, tag=tag)
         centre = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
         pos = np.ascontiguousarray(rec[:, :3])
         stencil = np.empty(27, dtype=np.int64)
@@ -465,11 +436,12 @@ class Simulation:
             cells = cells._replace(ids=ids)
             self._cell_width = slots
         lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
-        self._finish_build(particles, events, lists, cells, order)
+        self._finish_build(particles, events, lists, cells, order, qt=qt, where=where)
 
     def _finish_build(self, particles, events, lists, cells, order, qt=None, where=None):
         """Contacts, every particle's event, counters and the calendar (after the neighbour search;
-        ``qt``, ``where``: the calendar's per-particle arrays, if the mode keeps them elsewhere)."""
+        ``qt``, ``where``: the calendar's per-particle arrays, views into the mode's per-particle
+        rows)."""
         n = self.n
         spc = self._space
         rec = particles.rec
@@ -873,6 +845,31 @@ class Simulation:
     @property
     def box(self) -> np.ndarray:
         return self._box.copy()
+
+    @property
+    def species(self) -> np.ndarray | None:
+        """Species index of each particle (N,), as given (None: all 0)."""
+        return self._carried["species"].copy() if "species" in self._carried else None
+
+    @property
+    def state(self) -> State:
+        """The public state as a record (:class:`granulargas.state.State`): a synchronised copy at
+        ``time``, particles in id order, every counter; ``Simulation(sim.state, rule, ...)``
+        continues bit for bit where :meth:`synchronise` would. ``contact_until`` and
+        ``contact_partner`` are None unless collisions take time, ``kick_step`` without driving;
+        the per-particle fields the engine does not use are those it was given."""
+        pos, img = self._synchronised() if self._built else (self._positions.copy(), self._images.copy())
+        resolved = self.rule.resolved
+        return State(
+            positions=pos, velocities=self.velocities, radii=self.radii, masses=self.masses, box=self.box,
+            boundary=self.boundary, images=img, last_collision=self.last_collision,
+            contact_until=self.contact_until if resolved else None,
+            contact_partner=self.contact_partner if resolved else None,
+            time=self.time, collisions=self.collisions, events=self.events,
+            dissipated_energy=self.dissipated_energy, wall_collisions=self.wall_collisions,
+            injected_energy=self.injected_energy, kick_step=None if self.driving is None else self.kick_step,
+            three_body_contacts=self.three_body_contacts,
+            **{name: value.copy() for name, value in self._carried.items()})
 
     # ------------------------------------------------------------ observables
     def _vm(self):

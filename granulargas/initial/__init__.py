@@ -1,9 +1,8 @@
 """Initial states: random non-overlapping placement (a lattice gas relaxed by
 hard-sphere Monte Carlo) and Maxwell-Boltzmann velocities.
 
-* :class:`InitialState` (:mod:`~granulargas.initial.state`) -- the public engine state to start from;
 * :func:`random_state` -- the one route from particle sizes, masses, packing
-  fraction, temperature and seed to an :class:`InitialState`
+  fraction, temperature and seed to a :class:`granulargas.state.State`
   (:mod:`~granulargas.initial.lattice_gas` explains the algorithm); config runs
   (:func:`granulargas.run.prepare.fresh_state`) go through it too;
 * :func:`random_positions`, :func:`maxwell_velocities`, :func:`box_for_packing`,
@@ -17,7 +16,5 @@ from granulargas.initial.lattice_gas import (
     random_positions,
     random_state,
 )
-from granulargas.initial.state import InitialState
 
-__all__ = ["InitialState", "box_for_packing", "fluid_s0", "maxwell_velocities", "random_positions",
-           "random_state"]
+__all__ = ["box_for_packing", "fluid_s0", "maxwell_velocities", "random_positions", "random_state"]

@@ -110,7 +110,7 @@ from granulargas import theory
 from granulargas.errors import ConfigError
 from granulargas.initial import _compression as fire
 from granulargas.initial import _montecarlo as mc
-from granulargas.initial.state import InitialState
+from granulargas.state import State
 
 
 def box_for_packing(radii, packing, dimension, aspect=None):
@@ -597,7 +597,7 @@ MIN_WALL_AXIS_DIAMETERS = 4.15
 
 
 def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, masses=None,
-                 aspect=None, sweeps=None, rng=None, boundary=None) -> InitialState:
+                 aspect=None, sweeps=None, rng=None, boundary=None) -> State:
     """A random homogeneous initial state: box, positions, velocities (in this order from one generator).
 
     Parameters
@@ -658,4 +658,4 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
     pos[:, walls] += rmax
     vel = maxwell_velocities(masses, dimension, temperature, rng=rng)
     bnd = None if boundary is None else tuple(boundary)
-    return InitialState(pos, vel, radii, masses, box, boundary=bnd)
+    return State(pos, vel, radii, masses, box, boundary=bnd)

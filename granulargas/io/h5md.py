@@ -58,6 +58,14 @@ before a snapshot), so a run killed in the compiled loop leaves a file that
 holds every frame written before, readable by any HDF5 reader (no SWMR flag to
 clear); the readers ignore a last frame whose time was not yet written.
 
+The per-particle elements are those of the table
+:data:`granulargas.state.PARTICLE_FIELDS`: a run's state (:class:`granulargas.state.State`)
+goes into a frame whole (:meth:`H5MDWriter.write_state`; the time-independent fields once,
+when the file is created; the restart-only per-frame fields a run lists in ``fields``) and
+comes back whole (:func:`read_state`: the frame's fields, box, boundary, time and step, the
+counters of :data:`granulargas.state.COUNTERS` from the observables sample at the frame,
+a DSMC file's random state), which is what a restart reads.
+
 Continuing a run into the same file (:meth:`H5MDWriter.append`): the file is
 opened for writing, cut back to the state the continuation starts from (its last
 complete frame and the observables sample at that frame: a run killed after it
@@ -90,6 +98,7 @@ import numpy as np
 
 from granulargas import __version__
 from granulargas.errors import InputFileError
+from granulargas.state import COUNTERS, FIELDS, PARTICLE_FIELDS, DSMCContinuation, State
 
 CREATOR = "granulargas"
 _wall = _time.monotonic
@@ -104,17 +113,37 @@ DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_p
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
 RESOLVED_OBSERVABLES = ("three_body_contacts",)
-#: per-particle restart state of collisions that take time: (name, dtype)
-CONTACT_ELEMENTS = (("contact_until", np.float64), ("contact_partner", np.int64))
+#: per-frame fields every frame of an EDMD / a DSMC file holds; the other per-frame fields of
+#: granulargas.state.PARTICLE_FIELDS are stored when a run asks for them (``fields``)
+CORE_FIELDS = ("positions", "velocities", "images")
+CORE_FIELDS_DSMC = ("velocities",)
+#: per-frame fields a run may store besides the core ones (restart state of its model)
+OPTIONAL_FIELDS = tuple(x for x in PARTICLE_FIELDS if x.per_frame and x.name not in CORE_FIELDS)
 _INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts")
 #: H5MD box boundary of each axis kind
 _H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
 
 
-def _frame_chunks(n: int, d: int) -> tuple:
+def _frame_chunks(n: int, tail: tuple) -> tuple:
     # one frame per chunk (frame-by-frame readers), split beyond ~8 MB
-    per = max(1, min(n, (1 << 20) // max(d, 1)))
-    return (1, per, d) if d else (1, per)
+    per = max(1, min(n, (1 << 20) // max(int(np.prod(tail)), 1)))
+    return (1, per) + tuple(tail)
+
+
+def _frame_fields(positions: bool, fields) -> tuple:
+    """The per-frame fields a file stores: the core ones of its method and ``fields``, in the
+    order of :data:`granulargas.state.PARTICLE_FIELDS`."""
+    optional = {x.name for x in OPTIONAL_FIELDS}
+    unknown = [x for x in fields if x not in optional]
+    if unknown:
+        raise ValueError(f"fields: {unknown[0]!r} is not one of {', '.join(sorted(optional))}")
+    core = CORE_FIELDS if positions else CORE_FIELDS_DSMC
+    return tuple(x.name for x in PARTICLE_FIELDS if x.name in core or x.name in fields)
+
+
+def _describe(fld) -> str:
+    """The ``description`` attribute of a per-particle element."""
+    return fld.description + (" (kept for exact restarts)" if fld.restart_only else "")
 
 
 class H5MDWriter:
@@ -124,33 +153,29 @@ class H5MDWriter:
     ----------
     path : str or Path
         Output file; created (an existing file is replaced only with ``overwrite``).
-    box : float array (d,)
-        Periodic box edges.
-    radii, masses : float arrays (N,)
-    species : int array (N,), optional
+    state : granulargas.state.State
+        The run's state: its box, boundary and time-independent per-particle fields
+        (radii, masses, species) are written here; no positions (a DSMC state) makes a
+        DSMC file (no positions and images; each frame stores the DSMC continuation).
+    fields : sequence of str
+        Per-frame fields of :data:`granulargas.state.PARTICLE_FIELDS` stored besides the
+        positions, velocities and images: the restart state of the run's model
+        (``last_collision``: TC model; ``contact_until``, ``contact_partner``: collisions
+        that take time, which also get the ``three_body_contacts`` observable).
     parameters : dict, optional
         Attributes of ``parameters/`` (scalars or strings); nested dicts become groups,
         numpy arrays become datasets.
-    last_collision : bool
-        Also store each particle's last collision time per snapshot (TC model restart).
-    contacts : bool
-        Collisions that take time: also store each particle's contact under way per
-        snapshot (``contact_until``, ``contact_partner``; restart) and the
-        ``three_body_contacts`` observable.
     overwrite : bool
-    positions : bool
-        False for a DSMC run: no positions and images; each frame stores the DSMC random
-        state instead (``dsmc_state`` of :meth:`write_snapshot`).
+    driven : bool
+        Also the driving's observables (``injected_energy``, ``kick_step``).
     """
 
-    def __init__(self, path, box, radii, masses, species=None, *, parameters=None,
-                 last_collision=False, overwrite=False, author=None, boundary=None, driven=False, contacts=False,
-                 positions=True):
+    def __init__(self, path, state: State, *, fields=(), parameters=None, overwrite=False, author=None,
+                 driven=False):
         self.path = Path(path)
-        box = np.ascontiguousarray(box, dtype=np.float64)
-        self.d = int(box.shape[0])
-        self.n = int(np.asarray(radii).shape[0])
-        self.positions = bool(positions)
+        self.d, self.n = state.dimension, state.n
+        self.positions = state.positions is not None
+        self.fields = _frame_fields(self.positions, fields)
         if self.path.exists() and not overwrite:
             raise InputFileError(f"{self.path}: output file exists (use --overwrite to replace it)")
         try:
@@ -158,14 +183,14 @@ class H5MDWriter:
         except (OSError, ValueError) as exc:
             raise InputFileError(f"{self.path}: cannot create output file ({_short(exc)})") from None
         self.file = f
-        self.boundary = ("periodic",) * self.d if boundary is None else tuple(boundary)
+        self.boundary = state.boundary
         extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
-                 + (RESOLVED_OBSERVABLES if contacts else ()))
+                 + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ()))
         names = SCALAR_OBSERVABLES + ("momentum",) + extra
         if not self.positions:  # DSMC: no pair virial, no pressure
             names = tuple(x for x in names if x != "pressure")
         try:
-            self._create(box, radii, masses, species, parameters or {}, last_collision, author, names, contacts)
+            self._create(state, parameters or {}, author, names)
         except BaseException:
             self.file.close()
             self.path.unlink(missing_ok=True)
@@ -178,34 +203,34 @@ class H5MDWriter:
     flush_seconds = 2.0
 
     @classmethod
-    def append(cls, path, *, particles: int, dimension: int, last_collision: bool, step: int, time: float,
-               contacts: bool = False):
+    def append(cls, path, state: State, *, fields=()):
         """Open one of our files to continue its run in it (module docstring).
 
-        The file must hold ``particles`` particles in ``dimension`` dimensions and end
-        with a complete frame at (``step``, ``time``) with an observables sample there
-        (the state the continuation starts from); frames and samples after it (a
-        half-written frame, samples of a killed run) are cut off. Everything is checked
-        with the file open read-only: a file that does not fit raises
-        :class:`InputFileError` and stays unchanged.
+        The file must hold the ``state``'s particles in its dimensions, store the same
+        per-frame ``fields`` (:class:`H5MDWriter`) and end with a complete frame at the
+        state's step (``events``) and ``time`` with an observables sample there (the
+        state the continuation starts from); frames and samples after it (a half-written
+        frame, samples of a killed run) are cut off. Everything is checked with the file
+        open read-only: a file that does not fit raises :class:`InputFileError` and stays
+        unchanged.
         """
         path = Path(path)
+        positions = state.positions is not None
+        wanted = _frame_fields(positions, fields)
         with open_run(path) as f, _damaged(path, "the run to continue"):
-            frames, samples = _continuation_point(f, path, particles, dimension, last_collision, step, time,
-                                                  contacts)
+            frames, samples = _continuation_point(f, path, state, wanted)
         f = open_run(path, "r+")
         try:
             with _damaged(path, "the run to continue"):
                 self = cls.__new__(cls)
-                self.path, self.file, self.n, self.d = path, f, particles, dimension
+                self.path, self.file, self.n, self.d = path, f, state.n, state.dimension
                 part = f["particles/all"]
                 self.positions = has_positions(f)
+                self.fields = wanted
                 self.box = np.ascontiguousarray(part["box/edges/value"][frames - 1], dtype=np.float64)
                 self.boundary = read_boundary(f)
-                names = (["position", "velocity", "image"] if self.positions else
-                         ["velocity"] + [f"dsmc/{k}" for k in DSMC_STATE])
-                names += ["box/edges"] + (["last_collision"] if last_collision else [])
-                names += [name for name, _ in CONTACT_ELEMENTS] if contacts else []
+                names = [FIELDS[x].element for x in self.fields] + ["box/edges"]
+                names += [] if self.positions else [f"dsmc/{k}" for k in DSMC_STATE]
                 self._frame_groups = [part[name] for name in names]
                 for g in self._frame_groups:
                     g["value"].resize(frames, axis=0)
@@ -240,7 +265,7 @@ class H5MDWriter:
         self.file.flush()
 
     # ----------------------------------------------------------------- layout
-    def _create(self, box, radii, masses, species, parameters, last_collision, author, names, contacts=False):
+    def _create(self, state, parameters, author, names):
         f, n, d = self.file, self.n, self.d
         h = f.create_group("h5md")
         h.attrs["version"] = np.array([1, 1], dtype=np.int32)
@@ -254,27 +279,30 @@ class H5MDWriter:
         b.attrs["dimension"] = np.int32(d)
         b.attrs["boundary"] = np.array([_H5MD_BOUNDARY[x] for x in self.boundary],
                                        dtype=h5py.string_dtype("ascii", 8))
-        self.box = box
+        if state.box is None:
+            raise ValueError("H5MDWriter: the state has no box")
+        self.box = state.box.copy()
 
-        chunks = _frame_chunks(n, d)
-        elements = (("position", np.float64), ("velocity", np.float64), ("image", np.int64)) if self.positions else (
-            ("velocity", np.float64),)
         groups = []
         step = time = None
-        for name, dtype in elements:
-            g = part.create_group(name)
+        for name in self.fields:
+            fld = FIELDS[name]
+            g = part.create_group(fld.element)
             if step is None:  # the first element owns the frames' clock
                 step = g.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(256,))
                 time = g.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(256,))
             else:
                 g["step"], g["time"] = step, time  # hard links: one clock for all frames
-            g.create_dataset("value", shape=(0, n, d), maxshape=(None, n, d), dtype=dtype, chunks=chunks)
+            tail = fld.shape(d)
+            g.create_dataset("value", shape=(0, n) + tail, maxshape=(None, n) + tail, dtype=fld.dtype,
+                             chunks=_frame_chunks(n, tail))
+            g.attrs["description"] = _describe(fld)
             groups.append(g)
         if not self.positions:
             part["velocity"].attrs["description"] = (
                 "peculiar velocities of a DSMC run (homogeneous gas, no positions)")
             dg = part.create_group("dsmc")
-            dg.attrs["description"] = ("DSMC random state at each frame (granulargas.dsmc.DSMC.state): "
+            dg.attrs["description"] = ("DSMC random state at each frame (granulargas.dsmc.DSMC.continuation): "
                                        "continues the run bit for bit")
             for name, (tail, dtype) in DSMC_STATE.items():
                 tail = tuple(d if x == "d" else x for x in tail)
@@ -287,21 +315,11 @@ class H5MDWriter:
         e["step"], e["time"] = step, time
         e.create_dataset("value", shape=(0, d), maxshape=(None, d), dtype=np.float64, chunks=(256, d))
         groups.append(e)
-        if last_collision:
-            g = part.create_group("last_collision")
-            g["step"], g["time"] = step, time
-            g.create_dataset("value", shape=(0, n), maxshape=(None, n), dtype=np.float64, chunks=_frame_chunks(n, 0))
-            groups.append(g)
-        for name, dtype in CONTACT_ELEMENTS if contacts else ():
-            g = part.create_group(name)
-            g["step"], g["time"] = step, time
-            g.create_dataset("value", shape=(0, n), maxshape=(None, n), dtype=dtype, chunks=_frame_chunks(n, 0))
-            groups.append(g)
         self._frame_groups = groups
-        part.create_dataset("mass", data=np.asarray(masses, dtype=np.float64))
-        part.create_dataset("radius", data=np.asarray(radii, dtype=np.float64))
-        sp = np.zeros(n, np.int32) if species is None else np.asarray(species, dtype=np.int32)
-        part.create_dataset("species", data=sp)
+        for fld in PARTICLE_FIELDS:
+            if not fld.per_frame:  # time-independent: written once
+                part.create_dataset(fld.element, data=state.array(fld.name))
+                part[fld.element].attrs["description"] = _describe(fld)
 
         obs = f.create_group("observables")
         self._obs = {}
@@ -341,33 +359,28 @@ class H5MDWriter:
     def frames(self) -> int:
         return int(self.file[f"particles/all/{_clock_name(self.file)}/step"].shape[0])
 
-    def write_snapshot(self, step, time, positions, velocities, images, last_collision=None, dsmc_state=None,
-                       contacts=None):
-        """Append one frame (synchronised state) and flush (``contacts``: the arrays
-        (contact_until, contact_partner) of collisions that take time).
+    def write_state(self, state: State):
+        """Append one frame: the per-frame fields of a (synchronised) state at its step
+        (``state.events``) and ``time`` (a DSMC file: also ``state.dsmc``), then flush.
 
         The frame's values are written before its step/time, so a reader of a
-        killed run never sees a time without data. A DSMC file (``positions=False``)
-        takes ``positions = images = None`` and ``dsmc_state`` (:attr:`granulargas.dsmc.DSMC.state`)."""
-        if self.positions != (positions is not None) or (not self.positions and dsmc_state is None):
-            raise ValueError("write_snapshot: positions and images for an EDMD file, dsmc_state for a DSMC file")
+        killed run never sees a time without data."""
+        if self.positions != (state.positions is not None) or (not self.positions and state.dsmc is None):
+            raise ValueError("write_state: a state with positions for an EDMD file, with a DSMC continuation "
+                             "for a DSMC file")
         self.flush_observables()
         k = self.frames
-        data = {"position": positions, "velocity": velocities, "image": images, "edges": self.box}
-        if last_collision is not None:
-            data["last_collision"] = last_collision
-        if contacts is not None:
-            data["contact_until"], data["contact_partner"] = contacts
-        if dsmc_state is not None:
-            data.update({name: np.asarray(dsmc_state[name]) for name in DSMC_STATE})
+        data = {FIELDS[name].element: state.array(name) for name in self.fields}
+        data["edges"] = self.box if state.box is None else state.box
+        if state.dsmc is not None:
+            data.update({name: np.asarray(getattr(state.dsmc, name)) for name in DSMC_STATE})
         for g in self._frame_groups:
             name = g.name.rsplit("/", 1)[-1]
             v = g["value"]
             v.resize(k + 1, axis=0)
-            if name in data:
-                v[k] = data[name]
+            v[k] = data[name]
         pos = self.file[f"particles/all/{_clock_name(self.file)}"]
-        for key, val in (("step", step), ("time", time)):
+        for key, val in (("step", state.events), ("time", state.time)):
             pos[key].resize(k + 1, axis=0)
             pos[key][k] = val
         self.file.flush()
@@ -425,19 +438,17 @@ class H5MDWriter:
         self.close()
 
 
-def _continuation_point(f, path, particles, dimension, last_collision, step, time,
-                        contacts=False) -> tuple[int, int]:
+def _continuation_point(f, path, state: State, fields) -> tuple[int, int]:
     """(frames, samples) to keep of a file a run continues in (:meth:`H5MDWriter.append`)."""
     part = f["particles/all"]
+    particles, dimension, step, time = state.n, state.dimension, state.events, state.time
     n, d = (int(x) for x in part[f"{_clock_name(f)}/value"].shape[1:])
     if (n, d) != (particles, dimension):
         raise InputFileError(f"{path}: holds {n} particles in {d}D, the continuation {particles} in {dimension}D")
-    if ("last_collision" in part) != bool(last_collision):
-        raise InputFileError(f"{path}: {'has' if 'last_collision' in part else 'lacks'} the TC model's "
-                             "last-collision times; continue it with the same collision model")
-    if ("contact_until" in part) != bool(contacts):
-        raise InputFileError(f"{path}: {'has' if 'contact_until' in part else 'lacks'} the contacts under way of "
-                             "collisions that take time; continue it with the same collision duration")
+    for fld in OPTIONAL_FIELDS:
+        if (fld.element in part) != (fld.name in fields):
+            raise InputFileError(f"{path}: {'has' if fld.element in part else 'lacks'} {fld.description}; "
+                                 "continue it with the same collision model")
     frames = _frame_count(f)
     clock = _clock_name(f)
     if frames == 0 or int(part[f"{clock}/step"][frames - 1]) != step or float(
@@ -620,12 +631,12 @@ def _check_layout(f, path):
         if part[name].dtype.kind not in "fiu":
             raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name} holds {part[name].dtype} "
                                  "values, not numbers")
-    for name in ("last_collision",) + tuple(name for name, _ in CONTACT_ELEMENTS):
-        if name in part:
-            lc = part.get(f"{name}/value")
-            if not isinstance(lc, h5py.Dataset) or lc.shape[1:] != (n,):
-                raise InputFileError(f"{path}: damaged H5MD file: particles/all/{name}/value is missing "
-                                     f"or not (frames, {n})")
+    for fld in OPTIONAL_FIELDS:
+        if fld.element in part:
+            value, want = part.get(f"{fld.element}/value"), (n,) + fld.shape(d)
+            if not isinstance(value, h5py.Dataset) or value.shape[1:] != want:
+                raise InputFileError(f"{path}: damaged H5MD file: particles/all/{fld.element}/value is missing "
+                                     f"or not (frames{''.join(f', {x}' for x in want)})")
     if not isinstance(f.get("observables"), h5py.Group):
         raise InputFileError(f"{path}: damaged H5MD file: observables/ is missing")
     if not isinstance(f.get("parameters"), h5py.Group):
@@ -649,9 +660,9 @@ def _frame_count(f) -> int:
     lengths = [pos["step"].shape[0], pos["time"].shape[0], pos["value"].shape[0]]
     others = ("velocity/value", "image/value") if has_positions(f) else tuple(f"dsmc/{k}/value" for k in DSMC_STATE)
     lengths += [part[name].shape[0] for name in others + ("box/edges/value",)]
-    for name in ("last_collision",) + tuple(name for name, _ in CONTACT_ELEMENTS):
-        if name in part:
-            lengths.append(part[f"{name}/value"].shape[0])
+    for fld in OPTIONAL_FIELDS:
+        if fld.element in part:
+            lengths.append(part[f"{fld.element}/value"].shape[0])
     return int(min(lengths))
 
 
@@ -742,22 +753,56 @@ def load_snapshot(path, index: int = -1) -> Snapshot:
             return _snapshot(f, k, _static(f))
 
 
-def read_dsmc_state(path, index: int = -1) -> dict:
-    """The DSMC random state stored with one frame of a DSMC file (:attr:`granulargas.dsmc.DSMC.state`)."""
+def read_state(path, index: int = -1) -> State:
+    """One frame as a :class:`granulargas.state.State` (negative index: from the end): every
+    per-particle field of :data:`granulargas.state.PARTICLE_FIELDS` the file holds, the box
+    and boundary, the frame's time and step (``events``), the counters of
+    :data:`granulargas.state.COUNTERS` from the observables sample at the frame, and a DSMC
+    file's continuation. What a run restarts from (:func:`granulargas.run.prepare.restart_state`)."""
     with open_run(path) as f:
-        if has_positions(f):
-            raise InputFileError(f"{path}: not a DSMC file (it has positions and no DSMC state)")
-        n = _frame_count(f)
-        k = index + n if index < 0 else index
-        if not 0 <= k < n:
-            raise InputFileError(f"{path}: snapshot index {index} out of range ({n} snapshots)")
-        with _damaged(path, f"particles/all/dsmc at frame {k}"):
-            g = f["particles/all/dsmc"]
-            out = {name: g[name]["value"][k] for name in DSMC_STATE}
-        out["candidates"] = int(out["candidates"])
-        out["pending_time"] = float(out["pending_time"])
-        out["pending_pair"] = tuple(int(x) for x in out["pending_pair"])
-        return out
+        count = _frame_count(f)
+        if count == 0:
+            raise InputFileError(f"{path}: holds no snapshot")
+        k = index + count if index < 0 else index
+        if not 0 <= k < count:
+            raise InputFileError(f"{path}: snapshot index {index} out of range ({count} snapshots)")
+        with _damaged(path, f"the state at frame {k}"):
+            part = f["particles/all"]
+            values = {}
+            for fld in PARTICLE_FIELDS:
+                if fld.element in part:
+                    values[fld.name] = part[f"{fld.element}/value"][k] if fld.per_frame else part[fld.element][()]
+            clock = part[_clock_name(f)]
+            time, step = float(clock["time"][k]), int(clock["step"][k])
+            counters = _counters_at(f, path, step, time, k)
+            dsmc = None
+            if "dsmc" in part:
+                g = part["dsmc"]
+                dsmc = DSMCContinuation(**{name: g[name]["value"][k] for name in DSMC_STATE})
+            return State(box=part["box/edges/value"][k], boundary=read_boundary(f), time=time, events=step,
+                         dsmc=dsmc, **{"positions": None, **values}, **counters)
+
+
+def _counters_at(f, path, step: int, time: float, k: int) -> dict:
+    """The counters of :data:`granulargas.state.COUNTERS` from the observables sample at frame k."""
+    obs = f["observables"]
+    for name in ("collisions", "dissipated_energy"):
+        if not isinstance(obs.get(name), h5py.Group):
+            raise InputFileError(f"{path}: damaged H5MD file: observables/{name} is missing")
+    g = obs["collisions"]
+    m = min(g["step"].shape[0], g["time"].shape[0], g["value"].shape[0])
+    hits = np.nonzero((g["step"][:m] == step) & (g["time"][:m] == time))[0]
+    if len(hits) == 0:
+        raise InputFileError(f"{path}: no observables sample at snapshot {k} (t = {time:g})")
+    sample = int(hits[-1])
+    out = {}
+    for name, dtype in COUNTERS.items():
+        if name in obs:
+            value = obs[name]["value"]
+            if sample >= value.shape[0]:
+                raise InputFileError(f"{path}: damaged H5MD file: observables/{name} ends before snapshot {k}")
+            out[name] = dtype(value[sample]).item()
+    return out
 
 
 def interrupted_frames(path) -> list[int]:

@@ -61,9 +61,7 @@ class DSMCRun(DSMC):
 
 
 def make_dsmc(config, setup) -> DSMCRun:
-    """The DSMC of a prepared config (module docstring)."""
-    st = setup.state
-    return DSMCRun(st.velocities, st.radii, st.masses, setup.rule, volume=float(np.prod(st.box)),
-                   chi=setup.parameters["dsmc"]["chi"], seed=config.system.seed, time=st.time,
-                   collisions=st.collisions, dissipated_energy=st.dissipated_energy, state=setup.dsmc_state,
-                   driving=setup.driving, kick_step=st.kick_step, injected_energy=st.injected_energy)
+    """The DSMC of a prepared config (module docstring): the volume of the state's box, the
+    restart file's continuation if the state has one."""
+    return DSMCRun(setup.state, setup.rule, chi=setup.parameters["dsmc"]["chi"], seed=config.system.seed,
+                   driving=setup.driving)

@@ -45,12 +45,12 @@ from granulargas import theory
 from granulargas.engine import CollisionRule, WhiteNoise
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
-from granulargas.initial import InitialState, box_for_packing, random_state
+from granulargas.initial import box_for_packing, random_state
 from granulargas.initial.lattice_gas import MIN_WALL_AXIS_DIAMETERS, RANDOM_PLACEMENT_MAX, maxwell_velocities
 from granulargas.io.config import TABLE_BETA_MAX, RunConfig
-from granulargas.io.h5md import (has_positions, load_snapshot, open_run, read_boundary, read_dsmc_state,
-                                 read_observables, snapshot_count)
+from granulargas.io.h5md import has_positions, open_run, read_state
 from granulargas.run.resources import check_dsmc_memory, check_memory
+from granulargas.state import State
 from granulargas.theory import particle_volume
 
 #: observables samples of a run without [output] observables_interval (run.schedule uses it)
@@ -63,14 +63,15 @@ class Setup:
 
     rule: object
     rule_name: str
-    state: InitialState
+    #: the state the run starts from (a DSMC restart: with the file's DSMC continuation)
+    state: State
     prefactor: float | None = None
     table: object = None
     parameters: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
     driving: object = None
-    #: ``run.method = "dsmc"``: the DSMC random state to continue from (None: a fresh start)
-    dsmc_state: dict | None = None
+    #: the restart file the state was read from (None: a fresh state)
+    source: str | None = None
 
 
 # ------------------------------------------------------------------- particles
@@ -99,7 +100,7 @@ def make_particles(config: RunConfig, rng: np.random.Generator):
     return radii, np.ascontiguousarray(masses, dtype=np.float64)
 
 
-def fresh_state(config: RunConfig) -> InitialState:
+def fresh_state(config: RunConfig) -> State:
     """Random non-overlapping positions and Maxwell-Boltzmann velocities with zero
     total momentum and temperature exactly ``initial.temperature``; all drawn from
     ``numpy.random.default_rng(system.seed)`` (radii, then positions, then velocities)
@@ -133,7 +134,7 @@ def fresh_state(config: RunConfig) -> InitialState:
                           f"placement works up to about {limit:g} in {s.dimension}D") from None
 
 
-def fresh_velocities(config: RunConfig) -> InitialState:
+def fresh_velocities(config: RunConfig) -> State:
     """A fresh state without positions (``run.method = "dsmc"``): radii and masses as
     :func:`fresh_state` draws them, the box of the packing fraction (its volume sets the
     density), Maxwell-Boltzmann velocities with zero total momentum and temperature exactly
@@ -145,48 +146,25 @@ def fresh_velocities(config: RunConfig) -> InitialState:
     radii, masses = make_particles(config, rng)
     box = box_for_packing(radii, s.packing_fraction, s.dimension)
     velocities = maxwell_velocities(masses, s.dimension, config.initial.temperature, rng=rng)
-    return InitialState(None, np.ascontiguousarray(velocities), radii, masses, box, boundary=tuple(s.boundary))
+    return State(None, velocities, radii, masses, box, boundary=tuple(s.boundary))
 
 
-def restart_state(config: RunConfig) -> InitialState:
-    """The last snapshot of one of our files, with its time and counters."""
+def restart_state(config: RunConfig) -> State:
+    """The last snapshot of one of our files, with its time and counters
+    (:func:`granulargas.io.h5md.read_state`), checked against the config."""
     path = Path(config.initial.from_file)
     where = f'{config.source}: initial.from = "{path}"'
     try:
-        count = snapshot_count(path)
-    except InputFileError as exc:
-        raise InputFileError(f"{where}: {str(exc).split(': ', 1)[-1]}") from None
-    if count == 0:
-        raise InputFileError(f"{where}: holds no snapshot")
-    try:
-        snap = load_snapshot(path, -1)
-        obs = read_observables(path)
+        state = read_state(path, -1)
         with open_run(path) as f:
-            boundary = read_boundary(f)
             file_method = "edmd" if has_positions(f) else "dsmc"
     except InputFileError as exc:
         raise InputFileError(f"{where}: {str(exc).split(': ', 1)[-1]}") from None
-    for name in ("collisions", "dissipated_energy"):
-        if name not in obs:
-            raise InputFileError(f"{where}: damaged H5MD file: observables/{name} is missing")
-    steps, times, _ = obs["collisions"]
-    hits = np.nonzero((steps == snap.step) & (times == snap.time))[0]
-    if len(hits) == 0:
-        raise InputFileError(f"{where}: no observables sample at its last snapshot (t = {snap.time:g})")
-    k = int(hits[-1])
-    counters = {}
-    for name in ("dissipated_energy", "wall_collisions", "injected_energy", "kick_step", "three_body_contacts"):
-        if name in obs and k >= len(obs[name][2]):
-            raise InputFileError(f"{where}: damaged H5MD file: observables/{name} ends before its last snapshot")
-        if name in obs and name != "dissipated_energy":
-            counters[name] = obs[name][2][k]
-    collisions = int(obs["collisions"][2][k])
-    dissipated = float(obs["dissipated_energy"][2][k])
     if file_method != config.run.method:
         raise ConfigError(f'{config.source}: run.method = "{config.run.method}": restart file {path} is a '
                           f'{"DSMC run (no positions)" if file_method == "dsmc" else "EDMD run"}; continue it '
                           f'with method = "{file_method}"')
-    n, dim = snap.velocities.shape
+    n, dim = state.velocities.shape
     if dim != config.system.dimension:
         raise ConfigError(f"{config.source}: system.dimension = {config.system.dimension}: restart file {path} is {dim}D")
     if n != config.system.particles:
@@ -195,51 +173,21 @@ def restart_state(config: RunConfig) -> InitialState:
         )
     arrays = ("positions", "velocities", "radii", "masses", "box") if file_method == "edmd" else (
         "velocities", "radii", "masses", "box")
-    bad = [name for name in arrays if not np.all(np.isfinite(np.asarray(getattr(snap, name), dtype=np.float64)))]
-    if bad or not (np.all(snap.radii > 0) and np.all(snap.masses > 0) and np.all(snap.box > 0)):
+    bad = [name for name in arrays if not np.all(np.isfinite(getattr(state, name)))]
+    if bad or not (np.all(state.radii > 0) and np.all(state.masses > 0) and np.all(state.box > 0)):
         raise InputFileError(f"{where}: damaged H5MD file: the last snapshot holds non-finite or non-positive "
                              f"{', '.join(bad) or 'radii, masses or box'}")
-    packing = float(particle_volume(2.0 * snap.radii, dim).sum() / np.prod(snap.box))
+    packing = float(particle_volume(2.0 * state.radii, dim).sum() / np.prod(state.box))
     if file_method == "dsmc":
         check_dsmc_memory(config, n=n)
     else:
         check_memory(config, n=n, packing=packing, fresh=False)
-    if boundary != tuple(config.system.boundary):
+    if state.boundary != tuple(config.system.boundary):
         raise ConfigError(
             f"{config.source}: system.boundary = [{', '.join(repr(b) for b in config.system.boundary)}]: "
-            f"restart file {path} has [{', '.join(repr(b) for b in boundary)}]"
+            f"restart file {path} has [{', '.join(repr(b) for b in state.boundary)}]"
         )
-    if file_method == "dsmc":
-        return InitialState(
-            positions=None, velocities=np.ascontiguousarray(snap.velocities, dtype=np.float64),
-            radii=np.ascontiguousarray(snap.radii, dtype=np.float64),
-            masses=np.ascontiguousarray(snap.masses, dtype=np.float64),
-            box=np.ascontiguousarray(snap.box, dtype=np.float64), species=np.asarray(snap.species, dtype=np.int32),
-            time=snap.time, collisions=collisions, events=snap.step, dissipated_energy=dissipated,
-            boundary=boundary, injected_energy=float(counters.get("injected_energy", 0.0)),
-            kick_step=int(counters["kick_step"]) if "kick_step" in counters else None, source=str(path))
-    return InitialState(
-        positions=np.ascontiguousarray(snap.positions, dtype=np.float64),
-        velocities=np.ascontiguousarray(snap.velocities, dtype=np.float64),
-        radii=np.ascontiguousarray(snap.radii, dtype=np.float64),
-        masses=np.ascontiguousarray(snap.masses, dtype=np.float64),
-        box=np.ascontiguousarray(snap.box, dtype=np.float64),
-        species=np.asarray(snap.species, dtype=np.int32),
-        images=np.ascontiguousarray(snap.images, dtype=np.int64),
-        time=snap.time,
-        collisions=collisions,
-        events=snap.step,
-        dissipated_energy=dissipated,
-        boundary=boundary,
-        wall_collisions=int(counters.get("wall_collisions", 0)),
-        injected_energy=float(counters.get("injected_energy", 0.0)),
-        kick_step=int(counters["kick_step"]) if "kick_step" in counters else None,
-        last_collision=None if snap.last_collision is None else np.ascontiguousarray(snap.last_collision),
-        source=str(path),
-        contact_until=None if snap.contact_until is None else np.ascontiguousarray(snap.contact_until),
-        contact_partner=None if snap.contact_partner is None else np.ascontiguousarray(snap.contact_partner),
-        three_body_contacts=int(counters.get("three_body_contacts", 0)),
-    )
+    return state
 
 
 # ------------------------------------------------------------------- collisions
@@ -268,7 +216,7 @@ def reduced_compression(config: RunConfig) -> float:
     return float(compression_prefactor(reduced_young_modulus(config), m.poisson_ratio))
 
 
-def oblique_bounds(prefactor: float, compression: float, state: InitialState) -> tuple[float, float]:
+def oblique_bounds(prefactor: float, compression: float, state: State) -> tuple[float, float]:
     """(beta, delta) of the fastest impact the initial state holds: relative speed twice the
     largest speed, for the pair with the largest pair constants (any two particles)."""
     m, r = state.masses, state.radii
@@ -286,7 +234,7 @@ def reference_mass_si(material) -> float:
     return material.density * float(particle_volume(material.diameter, 3))
 
 
-def beta_bound(prefactor: float, state: InitialState, energy: float | None = None) -> float:
+def beta_bound(prefactor: float, state: State, energy: float | None = None) -> float:
     """Largest beta any pair can reach in the run (rigorous; module docstring).
 
     ``energy``: the largest total kinetic energy the run reaches (default: the
@@ -301,7 +249,7 @@ def beta_bound(prefactor: float, state: InitialState, energy: float | None = Non
     return float(material.pair_constant(prefactor, r_max, r_max, m_min, m_min)) * g_max**0.2
 
 
-def expected_beta(prefactor: float, state: InitialState) -> tuple[float, float]:
+def expected_beta(prefactor: float, state: State) -> tuple[float, float]:
     """(beta_typical, beta_high): beta of two mean particles at the mean normal
     impact speed sqrt(pi T / (2 m_eff)) of a Maxwellian gas, and of the pair with
     the largest b_ij at the fast impact speed 3 sqrt(T / m_eff) (the upper end of
@@ -319,7 +267,7 @@ def expected_beta(prefactor: float, state: InitialState) -> tuple[float, float]:
     return typical, min(high, beta_bound(prefactor, state))
 
 
-def validity_warnings(config: RunConfig, prefactor: float, state: InitialState) -> list[str]:
+def validity_warnings(config: RunConfig, prefactor: float, state: State) -> list[str]:
     """One-line warnings when the run's expected beta range (or, on the material
     route, its impact speeds) leaves the viscoelastic model's range
     (:func:`granulargas.contact.material.validity_problems`)."""
@@ -335,7 +283,7 @@ def validity_warnings(config: RunConfig, prefactor: float, state: InitialState) 
                                                                           speed_of_sound=sound)]
 
 
-def driven_energy_bound(config: RunConfig, prefactor: float, state: InitialState) -> float:
+def driven_energy_bound(config: RunConfig, prefactor: float, state: State) -> float:
     """Total kinetic energy the restitution table of a driven viscoelastic run must cover.
 
     Kicks are Gaussian, so no bound is rigorous: twice the larger of the initial energy
@@ -351,7 +299,7 @@ def driven_energy_bound(config: RunConfig, prefactor: float, state: InitialState
     return 2.0 * max(e0, 0.5 * s.dimension * len(state.masses) * t_ss)
 
 
-def make_rule(config: RunConfig, state: InitialState):
+def make_rule(config: RunConfig, state: State):
     """(rule, name, prefactor, table, warnings, parameters) for the config."""
     c = config.collision
     params = {"model": c.model}
@@ -399,7 +347,7 @@ def make_rule(config: RunConfig, state: InitialState):
     return CollisionRule.viscoelastic(prefactor=k, table=table), "viscoelastic", k, table, warns, params
 
 
-def make_driving(config: RunConfig, prefactor: float | None, state: InitialState):
+def make_driving(config: RunConfig, prefactor: float | None, state: State):
     """(WhiteNoise or None, parameters) of the config's ``[driving]``.
 
     The kick interval, unless given, is at most 0.02 of the shortest time over which
@@ -444,7 +392,7 @@ def make_driving(config: RunConfig, prefactor: float | None, state: InitialState
     return WhiteNoise(h, interval, seed=s.seed), params
 
 
-def initial_state(config: RunConfig) -> InitialState:
+def initial_state(config: RunConfig) -> State:
     """The state a run of ``config`` starts from: the restart file's last snapshot
     (``initial.from``) or a fresh random state."""
     if config.initial.from_file:
@@ -455,6 +403,7 @@ def initial_state(config: RunConfig) -> InitialState:
 def prepare(config: RunConfig) -> Setup:
     """Build rule, table and initial state; raise before any file is written."""
     state = initial_state(config)
+    source = str(Path(config.initial.from_file)) if config.initial.from_file else None
     rule, name, k, table, warns, rule_params = make_rule(config, state)
     driving, driving_params = make_driving(config, k, state)
     s = config.system
@@ -488,14 +437,7 @@ def prepare(config: RunConfig) -> Setup:
         m = config.collision.material
         parameters["units_si"] = {"length_m": m.diameter, "mass_kg": reference_mass_si(m),
                                   "speed_m_per_s": m.speed_unit, "time_s": m.diameter / m.speed_unit}
-    if state.source:
-        parameters["restart"] = {"file": state.source, "time": state.time, "step": state.events,
+    if source:
+        parameters["restart"] = {"file": source, "time": state.time, "step": state.events,
                                  "collisions": state.collisions}
-    dsmc_state = None
-    if config.run.method == "dsmc" and state.source:
-        try:
-            dsmc_state = read_dsmc_state(state.source, -1)
-        except InputFileError as exc:
-            raise InputFileError(f'{config.source}: initial.from = "{state.source}": '
-                                 f'{str(exc).split(": ", 1)[-1]}') from None
-    return Setup(rule, name, state, k, table, parameters, warns, driving, dsmc_state)
+    return Setup(rule, name, state, k, table, parameters, warns, driving, source)

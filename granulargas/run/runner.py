@@ -52,6 +52,7 @@ import numpy as np
 
 from tqdm import tqdm
 
+from granulargas._numba import CompileWatch, announcement
 from granulargas.engine import Simulation
 from granulargas.errors import ConfigError, InelasticCollapseError, InputFileError, SimulationError, UserError
 from granulargas.io.config import RunConfig, parse_config
@@ -61,6 +62,7 @@ from granulargas.observables import sonine_coefficients
 from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
 from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
+from granulargas.run.variants import describe, variants_for
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
     Schedule,
@@ -87,6 +89,7 @@ class RunSummary:
     particles: int = 0
     warnings: tuple = field(default_factory=tuple)
     startup_time: float = 0.0
+    compile_time: float = 0.0  # of the start-up: compiling kernels not yet in numba's cache
     three_body_contacts: int | None = None  # collisions that take time only
     method: str = "edmd"
     candidates: int | None = None  # DSMC: candidate pairs drawn (accepted or not)
@@ -107,10 +110,18 @@ class RunSummary:
             f"collisions   {self.collisions} ({per:.4g} per particle), {counts}", *extra,
             f"time         {self.time:.6g} (stopped by {self.stop_reason})",
             f"wall time    {self.wall_time:.3g} s ({self.collisions_per_second:.4g} collisions/s)"
-            f" + {self.startup_time:.3g} s start-up (JIT compile or cache load, queue build)",
+            f" + {self.startup_time:.3g} s start-up ({self.startup_parts()})",
             f"temperature  {self.final_temperature:.6g} (final)",
             f"output       {self.output} ({self.snapshots} snapshots)",
         ]
+
+
+    def startup_parts(self) -> str:
+        """What the start-up was spent on (initial state, compiling or loading the compiled
+        code, the event queue)."""
+        if self.compile_time > 0.0:
+            return f"{self.compile_time:.3g} s of it compiling, once; initial state, queue build"
+        return "initial state, compiled code from the cache, queue build"
 
 
 # --------------------------------------------------------------------- progress
@@ -303,6 +314,16 @@ def _plain(v):
     return f'"{v}"' if isinstance(v, str) else ("{...}" if hasattr(v, "__dataclass_fields__") else f"{v}")
 
 
+def stored_fields(config: RunConfig, sim) -> tuple:
+    """The per-frame fields of :data:`granulargas.state.PARTICLE_FIELDS` a run stores besides
+    positions, velocities and images: the restart state its model needs
+    (:class:`granulargas.io.h5md.H5MDWriter`)."""
+    if config.run.method == "dsmc":
+        return ()
+    tc = config.collision.model == "constant" and config.collision.tc_time is not None
+    return (("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if sim.rule.resolved else ())
+
+
 def _observables(sim, pressure: bool) -> dict:
     if hasattr(sim, "observables"):  # a DSMC run (run.dsmc_run.DSMCRun)
         return sim.observables()
@@ -379,7 +400,24 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         Bad input (nothing written, nothing changed), a run that cannot continue
         (:class:`SimulationError`; the file keeps the snapshots written so far), or
         :class:`RunInterrupted`.
+
+    Start-up: everything before the first event (initial state, compiling the run's
+    kernels the first time such a run is made or loading them from numba's cache, the
+    event queue, the first frame) is ``RunSummary.startup_time``. The engine's first
+    compilation is announced with one line on ``log`` before it starts (the initial
+    placement's, before the config has passed every check, is not: bad input gets one
+    line). A compilation during the run itself (a kernel first needed there) counts as
+    start-up too, never as run time.
     """
+    start = _time.perf_counter()
+    what = [describe([v for v in variants_for(config) if v.announced])]
+    with CompileWatch(announce=lambda: (log or _stderr)(announcement(what[0])), armed=False) as watch:
+        return _run(config, overwrite, quiet, progress, log, append, stop, start, what, watch)
+
+
+def _run(config, overwrite, quiet, progress, log, append, stop, start, what, watch) -> RunSummary:
+    """:func:`run_config` within its :class:`~granulargas._numba.CompileWatch` (``what[0]``: what
+    the run compiles, as the announcement names it)."""
     path = check_output(config, overwrite, append)
     if append:
         check_same_physics(config, path)
@@ -392,30 +430,23 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     run = config.run
     if run.end_time is not None and st.time >= run.end_time:
         raise ConfigError(f"{config.source}: run.end_time = {run.end_time:g}: the restart file "
-                          f"{st.source} is already at t = {st.time:g}; nothing to run")
+                          f"{setup.source} is already at t = {st.time:g}; nothing to run")
     if run.collisions_per_particle is not None and st.collisions >= collision_budget(config):
         raise ConfigError(f"{config.source}: run.collisions_per_particle = {run.collisions_per_particle:g}: the "
-                          f"restart file {st.source} already has {st.collisions} collisions; nothing to run")
+                          f"restart file {setup.source} already has {st.collisions} collisions; nothing to run")
 
     dsmc = config.run.method == "dsmc"
+    watch.armed = True  # from here on a compile is announced (bad input has had its one line)
     if dsmc:
         sim = make_dsmc(config, setup)
     else:
-        sim = Simulation(
-            st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
-            time=st.time, collisions=st.collisions, images=st.images, last_collision=st.last_collision,
-            events=st.events, dissipated_energy=st.dissipated_energy, boundary=st.boundary,
-            wall_collisions=st.wall_collisions, driving=setup.driving, kick_step=st.kick_step,
-            injected_energy=st.injected_energy, contact_until=st.contact_until,
-            contact_partner=st.contact_partner, three_body_contacts=st.three_body_contacts,
-            neighbours=config.run.neighbours,
-        )
+        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours)
+    if not dsmc:  # the engine's own choice of neighbour mode ("auto" at the state's packing)
+        what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     # a zero-length run compiles (or loads) the engine and builds its queue before
     # the file exists and outside the timed part, so collisions/s measures the
     # event loop; both paths of a restart do it, so restart equality is unaffected
-    w = _time.perf_counter()
     sim.run(until=sim.time)
-    startup = _time.perf_counter() - w
 
     start_key = st.time if schedule.clock == "time" else st.collisions
     keep = schedule.targets > start_key
@@ -424,16 +455,14 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     if config.run.collisions_per_particle is not None:
         budget = collision_budget(config)
 
-    tc = setup.rule_name == "constant" and config.collision.tc_time is not None
     resolved = not dsmc and sim.rule.resolved
+    fields = stored_fields(config, sim)
     if append:
-        writer = H5MDWriter.append(path, particles=len(st.radii), dimension=st.box.shape[0], last_collision=tc,
-                                   step=st.events, time=st.time, contacts=resolved)
+        writer = H5MDWriter.append(path, st, fields=fields)
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
-        writer = H5MDWriter(path, st.box, st.radii, st.masses, st.species, parameters=setup.parameters,
-                            last_collision=tc, overwrite=overwrite, boundary=sim.boundary,
-                            driven=sim.driving is not None, positions=not dsmc, contacts=resolved)
+        writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
+                            driven=sim.driving is not None)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached
@@ -464,19 +493,18 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
 
     def snapshot():
         sim.synchronise()
-        lc = np.asarray(sim.last_collision) if tc else None
-        contacts = (sim.contact_until, sim.contact_partner) if resolved else None
-        writer.write_snapshot(sim.events, sim.time, sim.positions, sim.velocities, sim.images, lc,
-                              dsmc_state=sim.state if dsmc else None, contacts=contacts)
+        writer.write_state(sim.state)
         frame[0] = (sim.events, sim.time)
 
-    wall0 = _time.perf_counter()
     c0 = sim.collisions
     stop_reason = "end_time" if schedule.clock == "time" else "collisions_per_particle"
+    wall0, compiled0 = _time.perf_counter(), watch.seconds
     try:
         if not append:  # a continued file already holds the starting frame and its sample
             writer.write_observables(sim.events, sim.time, _observables(sim, False), flush=False)
             snapshot()
+        # the first frame (its observables' and synchronisation's kernels) is start-up too
+        wall0, compiled0 = _time.perf_counter(), watch.seconds
         last_sample = (sim.events, sim.time)
         for target, snap, sample in zip(targets, is_snap, is_sample):
             if stop:
@@ -540,7 +568,9 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
                 f"{kept} frames flushed before", signum=signum, time=float(sim.time), collisions=int(sim.collisions),
                 output=path) from None
         raise
-    wall = _time.perf_counter() - wall0
+    late = watch.seconds - compiled0  # compiled during the run: start-up, not run time
+    wall = _time.perf_counter() - wall0 - late
+    startup = wall0 - start + late
     done = sim.collisions - c0
     summary = RunSummary(
         output=path,
@@ -555,6 +585,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
         particles=len(st.radii),
         warnings=tuple(setup.warnings),
         startup_time=startup,
+        compile_time=watch.seconds,
         three_body_contacts=int(sim.three_body_contacts) if resolved else None,
         method=config.run.method,
         candidates=int(sim.candidates) if dsmc else None,
@@ -562,7 +593,7 @@ def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True
     writer.set_parameters({"summary": {
         "stop_reason": stop_reason, "time": summary.time, "collisions": summary.collisions,
         "events": summary.events, "wall_time": wall, "collisions_per_second": summary.collisions_per_second,
-        "startup_time": startup,
+        "startup_time": startup, "compile_time": watch.seconds,
         **({"three_body_contacts": summary.three_body_contacts} if resolved else {}),
     }})
     writer.close()

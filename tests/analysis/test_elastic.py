@@ -12,19 +12,21 @@ from granulargas.analysis.elastic import analyze_elastic, block_mean
 from granulargas.analysis.kinds import analyze_file
 from granulargas.cli import main
 from granulargas.io.h5md import H5MDWriter
+from granulargas.state import State
 
 
 def _write(path, n=400, eta=0.3, dim=3, z=(4.0, 3.9, 4.1, 4.0, 3.95, 4.05), rate=10.0):
     rng = np.random.default_rng(1)
     L = (n / th.number_density(eta, dim)) ** (1 / dim)
     nd = n / L**dim
-    with H5MDWriter(path, np.full(dim, L), np.full(n, 0.5), np.ones(n), parameters={"collision": {"model": "elastic"}}) as w:
+    state = State(rng.uniform(0, L, (n, dim)), rng.normal(size=(n, dim)), 0.5, 1.0, np.full(dim, L))
+    with H5MDWriter(path, state, parameters={"collision": {"model": "elastic"}}) as w:
         for k in range(len(z) + 1):
             t = float(k)
             ke = 0.5 * dim * n * (1.0 + 1e-15 * k)
             w.write_observables(k, t, {"temperature": 1.0, "kinetic_energy": ke, "collisions": int(0.5 * n * rate * t),
                                        "pressure": np.nan if k == 0 else z[k - 1] * nd})
-        w.write_snapshot(0, 0.0, rng.uniform(0, L, (n, dim)), rng.normal(size=(n, dim)), np.zeros((n, dim), np.int64))
+        w.write_state(state)
     return path
 
 

@@ -7,6 +7,7 @@ from granulargas import theory as th
 from granulargas.analysis.run import RunInfo, analyze_cooling, cooling_history, snapshot_series, sonine_history
 from granulargas.cli import main
 from granulargas.io.h5md import H5MDWriter
+from granulargas.state import State
 from granulargas.theory.hcs import DSMC_TABLE, hcs_reference
 
 
@@ -20,7 +21,7 @@ def _write(path, dim=3, n=500, eta=0.1, eps=0.9, frames=5, tau0=None):
     L = (n / th.number_density(eta, dim)) ** (1 / dim)
     box = np.full(dim, L)
     tau0 = tau0 or _haff_tau0(eps, th.number_density(eta, dim), dim)
-    with H5MDWriter(path, box, np.full(n, 0.5), np.ones(n),
+    with H5MDWriter(path, State(np.zeros((n, dim)), np.zeros((n, dim)), 0.5, 1.0, box),
                     parameters={"collision": {"model": "constant", "restitution": eps}}) as w:
         t = np.concatenate([[0.0], np.geomspace(0.1, 100 * tau0, 80)])
         T = th.haff_temperature(t, 1.0, tau0)
@@ -28,8 +29,8 @@ def _write(path, dim=3, n=500, eta=0.1, eps=0.9, frames=5, tau0=None):
             w.write_observables(k, tk, {"temperature": Tk, "collisions": int(k * 100)})
         for k, tk in enumerate(np.geomspace(1.0, 100 * tau0, frames)):
             Tk = th.haff_temperature(tk, 1.0, tau0)
-            w.write_snapshot(k, tk, rng.uniform(0, L, (n, dim)), rng.normal(0, np.sqrt(Tk), (n, dim)),
-                             np.zeros((n, dim), np.int64))
+            w.write_state(State(rng.uniform(0, L, (n, dim)), rng.normal(0, np.sqrt(Tk), (n, dim)), 0.5, 1.0, box,
+                                time=tk, events=k))
     return path, tau0
 
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from granulargas.io.h5md import H5MDWriter
+from granulargas.state import State
 
 SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
 
@@ -23,12 +24,13 @@ def tiny_run(tmp_path):
     rng = np.random.default_rng(0)
     n, L = 400, 40.0
     path = tmp_path / "tiny.h5"
-    with H5MDWriter(path, np.full(2, L), np.full(n, 0.5), np.ones(n),
+    with H5MDWriter(path, State(np.zeros((n, 2)), np.zeros((n, 2)), 0.5, 1.0, np.full(2, L)),
                     parameters={"collision": {"model": "constant", "restitution": 0.8}}) as w:
         for k, t in enumerate([0.0, 1.0, 2.0]):
             T = 1.0 / (1 + t) ** 2
             w.write_observables(k, t, {"temperature": T, "collisions": 100 * k})
-            w.write_snapshot(k, t, rng.uniform(0, L, (n, 2)), rng.normal(0, np.sqrt(T), (n, 2)), np.zeros((n, 2), np.int64))
+            w.write_state(State(rng.uniform(0, L, (n, 2)), rng.normal(0, np.sqrt(T), (n, 2)), 0.5, 1.0, np.full(2, L),
+                                time=t, events=k))
     return path
 
 

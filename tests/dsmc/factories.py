@@ -10,6 +10,7 @@ from granulargas.dsmc import DSMC
 from granulargas.dsmc._collide import apply_pair_update, normal_part_2d, normal_part_3d
 from granulargas.dsmc._random import next_u64, pair_of, uniform
 from granulargas.engine import CollisionRule
+from granulargas.state import STATE_FIELDS, State
 
 
 def maxwell(n, dim, seed=0, masses=None):
@@ -22,8 +23,16 @@ def maxwell(n, dim, seed=0, masses=None):
     return v
 
 
+def gas(velocities, radii=0.5, masses=1.0, **fields) -> State:
+    """A DSMC state: no positions, no box (the DSMC's density is then a setting)."""
+    return State(None, velocities, radii, masses, None, **fields)
+
+
 def make_dsmc(n=200, dim=3, rule=None, seed=1, packing=0.01, radii=0.5, masses=1.0, **kw):
-    return DSMC(maxwell(n, dim, seed), radii, masses, rule or CollisionRule.elastic(),
+    """A Maxwellian DSMC; keyword arguments that name fields of the state (``time=``, ...) go
+    into the state, the others are settings."""
+    fields = {k: kw.pop(k) for k in list(kw) if k in STATE_FIELDS}
+    return DSMC(gas(maxwell(n, dim, seed), radii, masses, **fields), rule or CollisionRule.elastic(),
                 packing_fraction=packing, seed=seed, **kw)
 
 

@@ -88,12 +88,13 @@ def test_viscoelastic_restitution_of_each_collision_is_the_engines(end):
     from granulargas.contact import restitution_table
     from granulargas.dsmc import DSMC
     from granulargas.engine import CollisionRule
+    from granulargas.state import State
 
     table = restitution_table(3.0, end=end)
     k = 0.3
     radii, masses = np.array([0.5, 0.8]), np.array([1.0, 2.5])
     r_eff, m_eff = radii.prod() / radii.sum(), masses.prod() / masses.sum()
-    sim = DSMC(np.array([[1.0, 0.2, -0.4], [-0.3, 0.1, 0.6]]), radii, masses,
+    sim = DSMC(State(None, [[1.0, 0.2, -0.4], [-0.3, 0.1, 0.6]], radii, masses, None),
                CollisionRule.viscoelastic(k, table), volume=10.0, seed=3)
     for _ in range(20):
         v0, e0 = sim.velocities, sim.kinetic_energy

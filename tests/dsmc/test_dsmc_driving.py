@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.dsmc.factories import make_dsmc, maxwell
+from tests.dsmc.factories import gas, make_dsmc, maxwell
 from granulargas import theory
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule, WhiteNoise
@@ -43,7 +43,7 @@ def test_driven_steady_state_is_the_kinetic_theory_one(dim):
     t_ss = float(theory.driven_temperature(h, eps, dens, dim, 1.0, 1.0))
     zeta = float(theory.enskog_cooling_rate(eps, dens, t_ss, dim, 1.0, 1.0))
     dt = float(theory.driving_interval(zeta))
-    sim = DSMC(maxwell(n, dim, 3) * math.sqrt(t_ss), 0.5, 1.0, CollisionRule.constant(eps),
+    sim = DSMC(gas(maxwell(n, dim, 3) * math.sqrt(t_ss)), CollisionRule.constant(eps),
                packing_fraction=eta, seed=4, driving=WhiteNoise(h, dt, seed=5))
     sim.run(10.0 / zeta)  # relax
     temps = []
@@ -69,9 +69,7 @@ def test_driven_run_continues_bit_for_bit():
     a.run(30.0)
     for t in (3.3, 7.0, 15.0, 15.15):  # one stop exactly at a kick time
         b.run(t)
-    c = DSMC(b.velocities, 0.5, 1.0, rule, packing_fraction=0.05, time=b.time, collisions=b.collisions,
-             dissipated_energy=b.dissipated_energy, state=b.state, driving=drv, kick_step=b.kick_step,
-             injected_energy=b.injected_energy)
+    c = DSMC(b.state, rule, packing_fraction=0.05, driving=drv)
     b.run(30.0)
     c.run(30.0)
     for x in (b, c):

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from scipy.special import gamma
 
-from tests.dsmc.factories import make_dsmc, maxwell, microcanonical_rate
+from tests.dsmc.factories import gas, make_dsmc, maxwell, microcanonical_rate
 from granulargas import theory
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule
@@ -54,7 +54,7 @@ def test_binary_mixture_equipartition_and_collision_rate(dim):
     radii = np.where(species == 0, 0.5, 0.8)
     masses = np.where(species == 0, 1.0, 3.0)
     v = maxwell(n, dim, seed=7, masses=masses)
-    sim = DSMC(v, radii, masses, CollisionRule.elastic(), packing_fraction=0.05, seed=7)
+    sim = DSMC(gas(v, radii, masses), CollisionRule.elastic(), packing_fraction=0.05, seed=7)
     temp = sim.temperature
     b_d = math.pi ** ((dim - 1) / 2) / math.gamma((dim + 1) / 2)
     count = [n // 2, n // 2]

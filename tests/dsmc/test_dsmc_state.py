@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.dsmc.factories import make_dsmc, maxwell
+from tests.dsmc.factories import gas, make_dsmc, maxwell
 from granulargas import theory
 from granulargas.contact import prefactor_from_damping, restitution_table
 from granulargas.dsmc import DSMC
@@ -25,11 +25,11 @@ def _same(a, b):
     assert a.time == b.time
     assert a.collisions == b.collisions
     assert a.dissipated_energy == b.dissipated_energy
-    sa, sb = a.state, b.state
-    assert np.array_equal(sa["rng"], sb["rng"])
-    assert sa["candidates"] == sb["candidates"] and sa["pending_pair"] == sb["pending_pair"]
-    assert sa["pending_time"] == sb["pending_time"] or (math.isnan(sa["pending_time"])
-                                                        and math.isnan(sb["pending_time"]))
+    sa, sb = a.continuation, b.continuation
+    assert np.array_equal(sa.rng, sb.rng)
+    assert sa.candidates == sb.candidates and sa.pending_pair == sb.pending_pair
+    assert sa.pending_time == sb.pending_time or (math.isnan(sa.pending_time)
+                                                  and math.isnan(sb.pending_time))
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -54,8 +54,7 @@ def test_restart_from_state_is_bit_exact(dim):
     b = make_dsmc(**kw)
     a.run(30.0)
     b.run(12.0)
-    c = DSMC(b.velocities, b.radii, b.masses, b.rule, volume=b.volume, time=b.time,
-             collisions=b.collisions, dissipated_energy=b.dissipated_energy, state=b.state)
+    c = DSMC(b.state, b.rule, volume=b.volume)
     c.run(30.0)
     _same(a, c)
 
@@ -93,7 +92,7 @@ def test_momentum_and_energy_bookkeeping(dim):
     radii = np.where(np.arange(n) % 2 == 0, 0.5, 0.8)
     masses = np.where(np.arange(n) % 2 == 0, 1.0, 3.0)
     v = maxwell(n, dim, seed=3, masses=masses)
-    sim = DSMC(v, radii, masses, CollisionRule.constant(0.7), number_density=0.05, seed=2)
+    sim = DSMC(gas(v, radii, masses), CollisionRule.constant(0.7), number_density=0.05, seed=2)
     p0, e0 = sim.momentum, sim.kinetic_energy
     sim.run(np.inf, max_collisions=10 * n)
     assert np.allclose(sim.momentum, p0, atol=1e-12 * math.sqrt(e0))
@@ -106,7 +105,7 @@ def test_elastic_conserves_energy_and_seed_matters():
     e0 = a.kinetic_energy
     a.run(100.0)
     assert a.kinetic_energy == pytest.approx(e0, rel=1e-12) and a.dissipated_energy == 0.0
-    b = DSMC(maxwell(100, 3, 1), 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.01, seed=2)
+    b = DSMC(gas(maxwell(100, 3, 1), 0.5, 1.0), CollisionRule.elastic(), packing_fraction=0.01, seed=2)
     b.run(100.0)
     assert not np.array_equal(a.velocities, b.velocities)
 
@@ -121,22 +120,22 @@ def test_viscoelastic_beyond_the_table_raises():
 
 def test_density_arguments():
     v = maxwell(50, 3)
-    n_from_phi = DSMC(v, 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.1)
+    n_from_phi = DSMC(gas(v, 0.5, 1.0), CollisionRule.elastic(), packing_fraction=0.1)
     assert n_from_phi.number_density == pytest.approx(0.6 / math.pi * 0.1 * 10)  # 6 phi / pi
     assert n_from_phi.chi == pytest.approx(float(theory.contact_value(0.1, 3)), rel=1e-14)
-    by_n = DSMC(v, 0.5, 1.0, CollisionRule.elastic(), number_density=n_from_phi.number_density)
+    by_n = DSMC(gas(v, 0.5, 1.0), CollisionRule.elastic(), number_density=n_from_phi.number_density)
     assert by_n.packing_fraction == pytest.approx(0.1)
-    by_v = DSMC(v, 0.5, 1.0, CollisionRule.elastic(), volume=50 / n_from_phi.number_density)
+    by_v = DSMC(gas(v, 0.5, 1.0), CollisionRule.elastic(), volume=50 / n_from_phi.number_density)
     assert by_v.packing_fraction == pytest.approx(0.1)
-    two = DSMC(maxwell(50, 2), 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.2)
+    two = DSMC(gas(maxwell(50, 2), 0.5, 1.0), CollisionRule.elastic(), packing_fraction=0.2)
     assert two.number_density == pytest.approx(4 * 0.2 / math.pi)
     assert two.chi == pytest.approx(float(theory.contact_value(0.2, 2)), rel=1e-14)
-    assert DSMC(v, 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.1, chi=1.0).chi == 1.0
+    assert DSMC(gas(v, 0.5, 1.0), CollisionRule.elastic(), packing_fraction=0.1, chi=1.0).chi == 1.0
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    (dict(), "exactly one of"),
-    (dict(packing_fraction=0.1, volume=10.0), "exactly one of"),
+    (dict(), "needs a density"),
+    (dict(packing_fraction=0.1, volume=10.0), "at most one of"),
     (dict(packing_fraction=-0.1), "packing_fraction = -0.1"),
     (dict(packing_fraction=1.5), "must be < 1"),
     (dict(volume=0.0), "volume = 0.0"),
@@ -145,25 +144,25 @@ def test_density_arguments():
 ])
 def test_bad_density_input(kwargs, message):
     with pytest.raises(ConfigError, match=message):
-        DSMC(maxwell(10, 3), 0.5, 1.0, CollisionRule.elastic(), **kwargs)
+        DSMC(gas(maxwell(10, 3), 0.5, 1.0), CollisionRule.elastic(), **kwargs)
 
 
 def test_bad_particles_and_rules():
     rule = CollisionRule.elastic()
     with pytest.raises(ConfigError, match="expected"):
-        DSMC(np.zeros((10, 4)), 0.5, 1.0, rule, packing_fraction=0.1)
+        DSMC(gas(np.zeros((10, 4)), 0.5, 1.0), rule, packing_fraction=0.1)
     with pytest.raises(ConfigError, match="at least 2"):
-        DSMC(np.zeros((1, 3)), 0.5, 1.0, rule, packing_fraction=0.1)
+        DSMC(gas(np.zeros((1, 3)), 0.5, 1.0), rule, packing_fraction=0.1)
     with pytest.raises(ConfigError, match="radii"):
-        DSMC(maxwell(10, 3), -0.5, 1.0, rule, packing_fraction=0.1)
+        DSMC(gas(maxwell(10, 3), -0.5, 1.0), rule, packing_fraction=0.1)
     with pytest.raises(ConfigError, match="masses"):
-        DSMC(maxwell(10, 3), 0.5, np.nan, rule, packing_fraction=0.1)
+        DSMC(gas(maxwell(10, 3), 0.5, np.nan), rule, packing_fraction=0.1)
     with pytest.raises(ConfigError, match="non-finite"):
-        DSMC(np.full((10, 3), np.inf), 0.5, 1.0, rule, packing_fraction=0.1)
+        DSMC(gas(np.full((10, 3), np.inf), 0.5, 1.0), rule, packing_fraction=0.1)
     with pytest.raises(ConfigError, match="TC model"):
-        DSMC(maxwell(10, 3), 0.5, 1.0, CollisionRule.constant(0.5, tc_time=1e-3), packing_fraction=0.1)
+        DSMC(gas(maxwell(10, 3), 0.5, 1.0), CollisionRule.constant(0.5, tc_time=1e-3), packing_fraction=0.1)
     with pytest.raises(TypeError):
-        DSMC(maxwell(10, 3), 0.5, 1.0, "elastic", packing_fraction=0.1)
+        DSMC(gas(maxwell(10, 3), 0.5, 1.0), "elastic", packing_fraction=0.1)
 
 
 def test_bad_run_arguments():
@@ -173,6 +172,34 @@ def test_bad_run_arguments():
         sim.run(0.5)
     with pytest.raises(ValueError, match="needs max_collisions"):
         sim.run(np.inf)
-    still = DSMC(np.zeros((10, 3)), 0.5, 1.0, CollisionRule.elastic(), packing_fraction=0.1)
+    still = DSMC(gas(np.zeros((10, 3)), 0.5, 1.0), CollisionRule.elastic(), packing_fraction=0.1)
     with pytest.raises(Exception, match="all velocities are zero"):
         still.run(1.0)
+
+
+def test_state_record_of_a_dsmc():
+    """dsmc.state: no positions, events = collisions, the continuation, the box the volume came
+    from (None when a density was given), the fields the DSMC does not use carried through."""
+    from granulargas.initial import random_state
+
+    st = random_state(200, 0.05, 3, seed=2)
+    species = (np.arange(200) % 3).astype(np.int32)
+    a = DSMC(st.replace(species=species), CollisionRule.constant(0.8), seed=3)
+    assert a.volume == float(np.prod(st.box))
+    a.run(5.0)
+    s = a.state
+    assert s.positions is None and s.images is None and s.events == s.collisions == a.collisions > 0
+    np.testing.assert_array_equal(s.box, st.box)
+    np.testing.assert_array_equal(s.species, species)
+    assert s.dsmc.candidates == a.candidates and s.time == 5.0
+    b = DSMC(s, CollisionRule.constant(0.8))  # the volume from the state's box, seed unused
+    a.run(10.0)
+    b.run(10.0)
+    _same(a, b)
+    assert make_dsmc(n=20).state.box is None
+
+
+def test_walls_are_refused():
+    with pytest.raises(ConfigError, match="without walls"):
+        DSMC(gas(maxwell(10, 3), boundary=("periodic", "periodic", "wall")), CollisionRule.elastic(),
+             packing_fraction=0.1)

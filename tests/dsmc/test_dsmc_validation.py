@@ -20,13 +20,14 @@ from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
 from granulargas.observables import energy_moments
 from granulargas.run.prepare import beta_bound
+from tests.dsmc.factories import gas
 from tests.dsmc.hcs_reference import collisional_moment_ratio
 
 
 def hcs_samples(dim, eps, n, relax, snapshots, pairs, seed=1):
     """(Q, Q error, a2, a2 error, Q of a Maxwellian, its error) of the DSMC's HCS."""
     v = np.random.default_rng(seed).standard_normal((n, dim))
-    sim = DSMC(v, 0.5, 1.0, CollisionRule.constant(eps), packing_fraction=0.01, seed=seed)
+    sim = DSMC(gas(v), CollisionRule.constant(eps), packing_fraction=0.01, seed=seed)
     sim.run(np.inf, max_collisions=int(relax * n / 2))
     q, q_err, a2 = [], [], []
     for k in range(snapshots):
@@ -73,7 +74,7 @@ def _viscoelastic_comparison(n, seeds, ref_n, times, dim=3, packing=0.02, dampin
     for seed in range(seeds):
         st = random_state(n, packing, dim, seed=seed)
         table = table or restitution_table(1.5 * beta_bound(k, st))
-        sim = Simulation(**st.as_kwargs(), rule=CollisionRule.viscoelastic(k, table))
+        sim = Simulation(st, CollisionRule.viscoelastic(k, table))
         rows = []
         for t in times:
             sim.run(t)
@@ -81,7 +82,7 @@ def _viscoelastic_comparison(n, seeds, ref_n, times, dim=3, packing=0.02, dampin
         engine.append(rows)
     v = np.random.default_rng(5).standard_normal((ref_n, dim))
     v /= math.sqrt(energy_moments(v - v.mean(axis=0), dim, np.ones(1))[0])
-    ref = DSMC(v, 0.5, 1.0, CollisionRule.viscoelastic(k, table), packing_fraction=packing, seed=5)
+    ref = DSMC(gas(v), CollisionRule.viscoelastic(k, table), packing_fraction=packing, seed=5)
     rows = []
     for t in times:
         ref.run(t)

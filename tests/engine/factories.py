@@ -3,17 +3,25 @@
 import numpy as np
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
+from granulargas.state import STATE_FIELDS, State
+
+
+def simulation(state, rule=None, **kw):
+    """``Simulation(state, rule, ...)`` with keyword arguments that name fields of the state
+    (``time=``, ``boundary=``, ...) put into the state and the others passed as settings."""
+    changes = {k: kw.pop(k) for k in list(kw) if k in STATE_FIELDS}
+    return Simulation(state.replace(**changes) if changes else state, rule or CollisionRule.elastic(), **kw)
 
 
 def make_sim(n=24, packing=0.2, dimension=3, seed=0, rule=None, radii=0.5, **kw):
-    st = random_state(n, packing, dimension, seed=seed, radii=radii)
-    return Simulation(**st.as_kwargs(), rule=rule or CollisionRule.elastic(), **kw)
+    return simulation(random_state(n, packing, dimension, seed=seed, radii=radii), rule, **kw)
 
 
 def two_spheres(p1, p2, v1, v2, box=5.0, radii=(0.5, 0.5), masses=(1.0, 1.0), rule=None, **kw):
     d = len(p1)
-    return Simulation(np.array([p1, p2], float), np.array([v1, v2], float), np.array(radii, float),
-                      np.array(masses, float), np.full(d, box), rule or CollisionRule.elastic(), **kw)
+    st = State(np.array([p1, p2], float), np.array([v1, v2], float), np.array(radii, float),
+               np.array(masses, float), np.full(d, box))
+    return simulation(st, rule, **kw)
 
 
 def next_engine_collision(sim):
@@ -55,12 +63,7 @@ def hermite_table(func, beta_max=25.0, n=4000):
 
 
 def walled_state(n, packing, dimension, walls, seed=0, radii=0.5, temperature=1.0):
-    """A random state in a box with flat walls on the axes ``walls`` (no sphere overlapping one).
-
-    Returns (kwargs for Simulation without the boundary, boundary tuple).
-    """
+    """A random state in a box with flat walls on the axes ``walls`` (no sphere overlapping one)."""
     boundary = tuple("wall" if a in walls else "periodic" for a in range(dimension))
-    st = random_state(n, packing, dimension, temperature=temperature, seed=seed, radii=radii,
-                      boundary=boundary)
-    return dict(positions=st.positions, velocities=st.velocities, radii=st.radii, masses=st.masses,
-                box=st.box), boundary
+    return random_state(n, packing, dimension, temperature=temperature, seed=seed, radii=radii,
+                        boundary=boundary)

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.errors import ConfigError, TableRangeError
+from granulargas.state import State
 
 from tests.engine.factories import two_spheres
 
@@ -118,9 +119,9 @@ def test_impact_beyond_table_raises_with_context():
 def test_tc_model_makes_quick_recollisions_elastic(tc_time, second_elastic):
     """Three spheres in a row: 0 hits 1 at t = 0.5, then 1 hits 2 at t = 0.5 + 0.5/0.75."""
     eps = 0.5
-    sim = Simulation(np.array([[1.0, 3, 3], [2.5, 3, 3], [4.0, 3, 3]]),
-                     np.array([[1.0, 0, 0], [0, 0, 0], [0, 0, 0]]), np.full(3, 0.5), np.ones(3),
-                     np.full(3, 9.0), CollisionRule.constant(eps, tc_time=tc_time))
+    sim = Simulation(State(np.array([[1.0, 3, 3], [2.5, 3, 3], [4.0, 3, 3]]),
+                           np.array([[1.0, 0, 0], [0, 0, 0], [0, 0, 0]]), np.full(3, 0.5), np.ones(3),
+                           np.full(3, 9.0)), CollisionRule.constant(eps, tc_time=tc_time))
     sim.run(np.inf, max_collisions=2)
     assert sim.time == pytest.approx(0.5 + 0.5 / 0.75, rel=1e-13)
     first = 0.5 * (1 - eps**2) * 0.5 * 1.0**2

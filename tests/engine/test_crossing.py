@@ -53,7 +53,7 @@ def test_polydisperse_next_event_matches_reference(dimension):
     n = 60
     radii = np.random.default_rng(7).uniform(0.3, 0.5, n)
     st = random_state(n, 0.1, dimension, seed=5, radii=radii)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(0.7), neighbours="cells")
+    sim = Simulation(st, CollisionRule.constant(0.7), neighbours="cells")
     for _ in range(300):
         dt, i, j = next_collision(sim.positions, sim.velocities, sim.radii, sim.box)
         t0 = sim.time
@@ -77,9 +77,9 @@ def test_free_running_sequence_matches_reference(case):
 @pytest.mark.parametrize("d, walls", [(3, (2,)), (2, (0, 1))])
 def test_walls_sequence_matches_reference(d, walls):
     """Pair and wall events, first 60, against the reference loop with walls."""
-    kw, boundary = walled_state(60, 0.1, d, walls, seed=11)
+    st = walled_state(60, 0.1, d, walls, seed=11)
     r = WALL_RULES["constant"]
-    sim = Simulation(**kw, rule=r, boundary=boundary, neighbours="cells")
+    sim = Simulation(st, r, neighbours="cells")
     ref, _, vel = run_reference(sim.positions, sim.velocities, sim.radii, sim.masses, sim.box, 60,
                                 eps=r.restitution, walls=walls, wall_eps=r.wall_restitution)
     assert sum(j < 0 for _, _, j in ref) >= 3
@@ -91,13 +91,6 @@ def test_walls_sequence_matches_reference(d, walls):
     assert check(sim) == []
 
 
-def _public(sim):
-    return dict(positions=sim.positions, velocities=sim.velocities, radii=sim.radii,
-                masses=sim.masses, box=sim.box, time=sim.time, collisions=sim.collisions,
-                images=sim.images, last_collision=sim.last_collision, events=sim.events,
-                dissipated_energy=sim.dissipated_energy)
-
-
 @pytest.mark.parametrize("rule", [CollisionRule.elastic(), CollisionRule.constant(0.8, tc_time=1e-3),
                                   VISCOELASTIC], ids=["elastic", "constant-tc", "viscoelastic"])
 @pytest.mark.parametrize("d", [2, 3])
@@ -106,11 +99,11 @@ def test_restart_equality_bit_for_bit(rule, d):
     a = cells(n=200, packing=0.08, dimension=d, seed=5, rule=rule)
     a.run(5.0)
     a.synchronise()
-    saved = _public(a)
+    saved = a.state
     a.run(10.0)
-    b = Simulation(**saved, rule=rule, neighbours="cells")
+    b = Simulation(saved, rule, neighbours="cells")
     b.run(10.0)
-    assert a.collisions == b.collisions > saved["collisions"] + 100
+    assert a.collisions == b.collisions > saved.collisions + 100
     assert a.events == b.events
     for k in ("positions", "velocities", "images", "last_collision"):
         np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
@@ -121,18 +114,18 @@ def test_restart_equality_bit_for_bit(rule, d):
 def test_driven_restart_equality_and_energy_balance(d):
     """Driving with cell crossings: injected - dissipated = change of kinetic energy; momentum
     kept; a restart continues bit for bit."""
-    kw = random_state(200, 0.08, d, seed=6).as_kwargs()
+    st = random_state(200, 0.08, d, seed=6)
     rule = CollisionRule.constant(0.7)
     drive = WhiteNoise(0.3, 0.037, seed=5)
-    a = Simulation(**kw, rule=rule, driving=drive, neighbours="cells")
+    a = Simulation(st, rule, driving=drive, neighbours="cells")
     e0, p0 = a.kinetic_energy, a.momentum
     a.run(3.0)
     a.synchronise()
-    saved = dict(_public(a), kick_step=a.kick_step, injected_energy=a.injected_energy)
+    saved = a.state
     a.run(6.0)
     assert a.kinetic_energy == pytest.approx(e0 + a.injected_energy - a.dissipated_energy, rel=1e-10)
     np.testing.assert_allclose(a.momentum, p0, atol=1e-12)
-    b = Simulation(**saved, rule=rule, driving=drive, neighbours="cells")
+    b = Simulation(saved, rule, driving=drive, neighbours="cells")
     b.run(6.0)
     assert a.collisions == b.collisions and a.events == b.events
     np.testing.assert_array_equal(a.velocities, b.velocities)

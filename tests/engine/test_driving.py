@@ -19,8 +19,8 @@ def test_one_kick_from_rest_heats_by_h_dt_equally_for_every_mass_and_keeps_momen
     n, d, h, dt = 20000, 3, 2.0, 0.05
     st = random_state(n, 0.1, d, seed=4)
     masses = np.where(np.arange(n) % 2 == 0, 1.0, 3.0)
-    sim = Simulation(st.positions, np.zeros((n, d)), st.radii, masses, st.box,
-                     CollisionRule.elastic(), driving=WhiteNoise(h, dt, seed=9))
+    sim = Simulation(st.replace(velocities=np.zeros((n, d)), masses=masses), CollisionRule.elastic(),
+                     driving=WhiteNoise(h, dt, seed=9))
     assert sim.kick_step == 0
     sim.run(0.5 * dt)  # the step at t = dt / 2 (a step due at the end of a run is executed)
     assert sim.kick_step == 1 and sim.events == 1 and sim.collisions == 0
@@ -51,7 +51,7 @@ def test_kick_normals_are_standard_normal_and_independent():
 
 def test_driven_energy_balance_and_momentum():
     st = random_state(300, 0.2, 2, seed=3)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(0.8),
+    sim = Simulation(st, CollisionRule.constant(0.8),
                      driving=WhiteNoise(0.5, 0.02, seed=1))
     e0 = sim.kinetic_energy
     p0 = sim.momentum
@@ -69,21 +69,17 @@ def test_restart_equality_with_driving_bit_for_bit(d, walls):
     """run(t); synchronise; run(2t) == restart from the state at t; run(2t): the kicks'
     random stream continues from the saved step index."""
     if walls:
-        kw, boundary = walled_state(200, 0.3, d, (d - 1,), seed=6)
+        st = walled_state(200, 0.3, d, (d - 1,), seed=6)
     else:
-        kw, boundary = random_state(200, 0.3, d, seed=6).as_kwargs(), None
+        st = random_state(200, 0.3, d, seed=6)
     rule = CollisionRule.constant(0.7, wall_restitution=0.9)
     drive = WhiteNoise(0.3, 0.037, seed=5)
-    a = Simulation(**kw, rule=rule, boundary=boundary, driving=drive)
+    a = Simulation(st, rule, driving=drive)
     a.run(3.0)
     a.synchronise()
-    saved = dict(positions=a.positions, velocities=a.velocities, radii=a.radii, masses=a.masses,
-                 box=a.box, time=a.time, collisions=a.collisions, images=a.images,
-                 last_collision=a.last_collision, events=a.events,
-                 dissipated_energy=a.dissipated_energy, wall_collisions=a.wall_collisions,
-                 kick_step=a.kick_step, injected_energy=a.injected_energy)
+    saved = a.state
     a.run(6.0)
-    b = Simulation(**saved, rule=rule, boundary=boundary, driving=drive)
+    b = Simulation(saved, rule, driving=drive)
     b.run(6.0)
     assert a.kick_step == b.kick_step == 162 and a.collisions == b.collisions
     assert a.events == b.events and a.wall_collisions == b.wall_collisions
@@ -91,7 +87,7 @@ def test_restart_equality_with_driving_bit_for_bit(d, walls):
         np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
     assert a.injected_energy == b.injected_energy and a.dissipated_energy == b.dissipated_energy
     # another seed, another stream
-    c = Simulation(**saved, rule=rule, boundary=boundary, driving=WhiteNoise(0.3, 0.037, seed=6))
+    c = Simulation(saved, rule, driving=WhiteNoise(0.3, 0.037, seed=6))
     c.run(6.0)
     assert not np.array_equal(c.velocities, b.velocities)
 
@@ -99,8 +95,8 @@ def test_restart_equality_with_driving_bit_for_bit(d, walls):
 def test_chunking_does_not_change_a_driven_run():
     st = random_state(150, 0.3, 3, seed=7)
     drive = WhiteNoise(0.2, 0.05, seed=2)
-    a = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(0.9), driving=drive)
-    b = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(0.9), driving=drive)
+    a = Simulation(st, CollisionRule.constant(0.9), driving=drive)
+    b = Simulation(st, CollisionRule.constant(0.9), driving=drive)
     for t in np.linspace(0.3, 4.0, 9):
         a.run(t)
         a.temperature, a.positions
@@ -123,8 +119,8 @@ def test_bad_driving_raises_config_error(kwargs, match):
 def test_kick_step_must_lie_ahead():
     st = random_state(50, 0.1, 3, seed=1)
     with pytest.raises(ConfigError, match="kick_step"):
-        Simulation(**st.as_kwargs(), rule=CollisionRule.elastic(), time=1.0,
-                   driving=WhiteNoise(0.1, 0.5), kick_step=1)  # (1 + 1/2) 0.5 < 1
+        Simulation(st.replace(time=1.0, kick_step=1), CollisionRule.elastic(),
+                   driving=WhiteNoise(0.1, 0.5))  # (1 + 1/2) 0.5 < 1
 
 
 def _steady_state(d, eps, packing, n, h, measure, seed=1):
@@ -139,7 +135,7 @@ def _steady_state(d, eps, packing, n, h, measure, seed=1):
                                             a2=theory.driven_sonine_a2(eps, d)))
     dt_k = theory.driving_interval(zeta)
     st = random_state(n, packing, d, temperature=t_th, seed=seed)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps),
+    sim = Simulation(st, CollisionRule.constant(eps),
                      driving=WhiteNoise(h, dt_k, seed=seed))
     spacing = max(1, round(0.25 / zeta / dt_k))  # kicks between samples
     first = round(5.0 / zeta / dt_k)

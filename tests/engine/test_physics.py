@@ -138,14 +138,14 @@ def test_inelastic_collapse_detected_tc_model_and_viscoelastic_run_through(seed)
     """Dense 2D gas, eps = 0.3: collapse; TC and viscoelastic (eps ~ 0.3 at thermal speed) run."""
     st = random_state(400, 0.5, 2, seed=seed)
     assert pade_eps(1.5 * (0.25 * 1.5 / 0.5**2) ** 0.2) == pytest.approx(0.3, abs=0.05)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(0.3))
+    sim = Simulation(st, CollisionRule.constant(0.3))
     with pytest.raises(InelasticCollapseError, match=r"inelastic collapse at t = .*\(particles \[\d+, \d+\]\)") as err:
         sim.run(2000.0)
     assert "CollisionRule.constant(eps, tc_time=...)" in str(err.value)  # a Python caller gets the Python cure
     assert err.value.where.startswith("at t = ")
     for rule in [CollisionRule.constant(0.3, tc_time=1e-4),
                  CollisionRule.viscoelastic(1.5, hermite_table(pade_eps))]:
-        sim = Simulation(**st.as_kwargs(), rule=rule)
+        sim = Simulation(st, rule)
         sim.run(2000.0)
         assert sim.time == 2000.0 and sim.temperature < 1e-3
         assert check(sim) == []

@@ -40,7 +40,7 @@ def test_polydisperse_next_event_matches_reference(dimension):
     n = 60
     radii = _poly(n, 7)
     st = random_state(n, 0.3, dimension, seed=5, radii=radii)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(0.7))
+    sim = Simulation(st, CollisionRule.constant(0.7))
     for _ in range(300):
         dt, i, j = next_collision(sim.positions, sim.velocities, sim.radii, sim.box)
         t0 = sim.time

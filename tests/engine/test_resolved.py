@@ -103,7 +103,7 @@ def test_oblique_trajectory_after_contact_matches_direct_integration(tables, off
 @pytest.mark.parametrize("dimension", [2, 3])
 def test_gas_conserves_momentum_and_balances_energy(tables, dimension):
     st = random_state(40, 0.2, dimension, seed=3)
-    sim = Simulation(**st.as_kwargs(), rule=resolved(tables, 0.02), remove_drift=False)
+    sim = Simulation(st, resolved(tables, 0.02), remove_drift=False)
     e0, p0 = sim.kinetic_energy, sim.momentum
     sim.run(np.inf, max_collisions=600)
     assert sim.dissipated_energy > 0.01 * e0
@@ -116,7 +116,7 @@ def test_event_sequence_matches_reference_loop(tables, dimension):
     """Independent runs of the engine and the naive loop (same rule) agree collision by collision."""
     st = random_state(24, 0.25, dimension, seed=11)
     rule = resolved(tables, 0.02)
-    sim = Simulation(**st.as_kwargs(), rule=rule, remove_drift=False)
+    sim = Simulation(st, rule, remove_drift=False)
     ref, _, vel = run_reference(sim.positions, sim.velocities, sim.radii, sim.masses, sim.box, 40, rule=rule)
     for t, i, j in ref:
         te, a, b = next_engine_collision(sim)
@@ -130,20 +130,15 @@ def test_restart_from_public_state_is_bit_identical(tables):
     public state (contacts under way included)."""
     st = random_state(60, 0.3, 3, seed=5)
     rule = resolved(tables, 0.02)
-    full = Simulation(**st.as_kwargs(), rule=rule, remove_drift=False)
+    full = Simulation(st, rule, remove_drift=False)
     full.run(0.3)
     full.synchronise()
     full.run(0.6)
-    half = Simulation(**st.as_kwargs(), rule=rule, remove_drift=False)
+    half = Simulation(st, rule, remove_drift=False)
     half.run(0.3)
     half.synchronise()
     assert np.any(half.contact_until > half.time)  # contacts under way at the restart
-    again = Simulation(half.positions, half.velocities, half.radii, half.masses, half.box, rule,
-                       time=half.time, collisions=half.collisions, images=half.images,
-                       last_collision=half.last_collision, events=half.events,
-                       dissipated_energy=half.dissipated_energy, remove_drift=False,
-                       contact_until=half.contact_until, contact_partner=half.contact_partner,
-                       three_body_contacts=half.three_body_contacts)
+    again = Simulation(half.state, rule, remove_drift=False)
     again.run(0.6)
     np.testing.assert_array_equal(again.positions, full.positions)
     np.testing.assert_array_equal(again.velocities, full.velocities)
@@ -153,9 +148,9 @@ def test_restart_from_public_state_is_bit_identical(tables):
 
 
 def test_third_particles_are_counted_in_a_dense_soft_gas_only(tables):
-    dense = Simulation(**random_state(60, 0.35, 3, seed=7).as_kwargs(), rule=resolved(tables, 0.02))
+    dense = Simulation(random_state(60, 0.35, 3, seed=7), resolved(tables, 0.02))
     dense.run(np.inf, max_collisions=1000)
-    dilute = Simulation(**random_state(60, 0.05, 3, seed=7).as_kwargs(), rule=resolved(tables, 1e-5))
+    dilute = Simulation(random_state(60, 0.05, 3, seed=7), resolved(tables, 1e-5))
     dilute.run(np.inf, max_collisions=1000)
     assert dense.three_body_contacts > 0
     assert dilute.three_body_contacts == 0
@@ -171,7 +166,7 @@ def test_resolved_rule_needs_stiffness_and_table(tables):
         CollisionRule.viscoelastic(K, tab, duration="slow")
     with pytest.raises(ConfigError, match="walls"):
         st = random_state(20, 0.1, 3, seed=1, boundary=("periodic", "periodic", "wall"))
-        Simulation(**st.as_kwargs(), rule=resolved(tables, 0.02))
+        Simulation(st, resolved(tables, 0.02))
 
 
 def test_impact_beyond_the_table_extends_it(tables):
@@ -193,7 +188,7 @@ def test_driven_gas_balances_energy(tables):
     from granulargas.engine import WhiteNoise
 
     st = random_state(40, 0.2, 3, seed=4)
-    sim = Simulation(**st.as_kwargs(), rule=resolved(tables, 0.02), driving=WhiteNoise(0.5, 0.05, seed=2),
+    sim = Simulation(st, resolved(tables, 0.02), driving=WhiteNoise(0.5, 0.05, seed=2),
                      remove_drift=False)
     e0 = sim.kinetic_energy
     sim.run(2.0)

@@ -21,6 +21,7 @@ from granulargas.contact import restitution_table
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.initial import random_state
 from granulargas.errors import SimulationError, TableRangeError
+from granulargas.state import State
 
 
 def state(n=200, packing=0.2, dimension=3, seed=3):
@@ -28,9 +29,7 @@ def state(n=200, packing=0.2, dimension=3, seed=3):
 
 
 def sim_from(st, rule, velocity_scale=1.0):
-    kw = st.as_kwargs()
-    kw["velocities"] = kw["velocities"] * velocity_scale
-    return Simulation(**kw, rule=rule)
+    return Simulation(st.replace(velocities=st.velocities * velocity_scale), rule)
 
 
 @pytest.mark.parametrize("dimension", [2, 3])
@@ -63,8 +62,8 @@ def _cool(sim, n, stop_lnT, remove_drift):
             sim.synchronise()
             v = sim.velocities
             v -= (sim.masses[:, None] * v).sum(axis=0) / sim.masses.sum()
-            sim = Simulation(sim.positions, v, sim.radii, sim.masses, sim.box, sim.rule, time=sim.time,
-                             collisions=sim.collisions, images=sim.images, events=sim.events)
+            sim = Simulation(State(sim.positions, v, sim.radii, sim.masses, sim.box, time=sim.time,
+                                   collisions=sim.collisions, images=sim.images, events=sim.events), sim.rule)
     return sim, np.array(lnT), np.array(s), np.array(events)
 
 
@@ -78,7 +77,7 @@ def test_cooling_through_150_decades_keeps_haff_rate_per_collision():
     eps, n = 0.5, 300
     st = cooling_state(n)
     assert float(st.box[0]) < theory.instability_length(eps, theory.number_density(0.05, 3), 3)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps))
+    sim = Simulation(st, CollisionRule.constant(eps))
     sim, lnT, s, events = _cool(sim, n, math.log(1e-150), remove_drift=True)
     slope_theory = -(1 - eps**2) * (1 + 3 * theory.sonine_a2(eps, 3) / 16) / 3
     early = np.polyfit(s[s < 0.3 * s[-1]], lnT[s < 0.3 * s[-1]], 1)[0]
@@ -97,7 +96,7 @@ def test_cooling_below_round_off_of_the_momentum_keeps_the_cost_per_collision(di
     (Simulation.run), so events per collision stay flat down to T/T0 = 1e-45."""
     n = 300
     st = random_state(n=n, packing=0.05, dimension=dimension, temperature=1.0, seed=5)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.constant(eps))
+    sim = Simulation(st, CollisionRule.constant(eps))
     sim, lnT, s, events = _cool(sim, n, math.log(stop), remove_drift=False)
     assert lnT[-1] < math.log(stop)
     assert np.max(events) < 3 * np.median(events)
@@ -142,7 +141,7 @@ def test_tiny_damping_dissipates_as_kinetic_theory_says():
     b, n = 1e-4, 500
     st = random_state(n=n, packing=0.1, dimension=3, temperature=1.0, seed=2)
     table = restitution_table(0.01)
-    sim = Simulation(**st.as_kwargs(), rule=CollisionRule.viscoelastic(prefactor=b, table=table))
+    sim = Simulation(st, CollisionRule.viscoelastic(prefactor=b, table=table))
     sim.run(until=math.inf, max_collisions=100_000)
     s = 2.0 * sim.collisions / n
     measured = -math.log(sim.temperature) / s * 3

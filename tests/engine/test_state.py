@@ -6,18 +6,12 @@ import pytest
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.engine.invariants import check
 from granulargas.errors import ConfigError
+from granulargas.state import State
 
 from tests.engine.factories import hermite_table, make_sim, pade_eps
 
 RULES = [CollisionRule.elastic(), CollisionRule.constant(0.8, tc_time=1e-3),
          CollisionRule.viscoelastic(0.4, hermite_table(pade_eps))]
-
-
-def _public(sim):
-    return dict(positions=sim.positions, velocities=sim.velocities, radii=sim.radii,
-                masses=sim.masses, box=sim.box, time=sim.time, collisions=sim.collisions,
-                images=sim.images, last_collision=sim.last_collision, events=sim.events,
-                dissipated_energy=sim.dissipated_energy)
 
 
 @pytest.mark.parametrize("rule", RULES, ids=["elastic", "constant-tc", "viscoelastic"])
@@ -27,13 +21,11 @@ def test_restart_equality_bit_for_bit(rule, d):
     a = make_sim(n=200, packing=0.35, dimension=d, seed=5, rule=rule)
     a.run(3.0)
     a.synchronise()
-    saved = _public(a)
+    saved = a.state
     a.run(6.0)
-    b = Simulation(**{k: saved[k] for k in ("positions", "velocities", "radii", "masses", "box")},
-                   rule=rule, **{k: saved[k] for k in ("time", "collisions", "images",
-                                                      "last_collision", "events", "dissipated_energy")})
+    b = Simulation(saved, rule)
     b.run(6.0)
-    assert a.collisions == b.collisions > saved["collisions"]
+    assert a.collisions == b.collisions > saved.collisions
     assert a.events == b.events
     for k in ("positions", "velocities", "images", "last_collision"):
         np.testing.assert_array_equal(getattr(a, k), getattr(b, k))
@@ -157,7 +149,7 @@ def test_bad_input_raises_config_error(kwargs, match):
                 velocities=np.zeros((4, 3)), radii=0.5, masses=1.0, box=[10.0, 10.0, 10.0])
     base.update(kwargs)
     with pytest.raises(ConfigError, match=match):
-        Simulation(**base, rule=CollisionRule.elastic())
+        Simulation(State(**base), CollisionRule.elastic())
 
 
 def test_run_backwards_rejected():
@@ -198,7 +190,7 @@ def test_float32_list_centres_stay_safe_far_from_the_origin():
     vel = rng.normal(size=pos.shape)
     vel -= vel.mean(axis=0)
     n = len(pos)
-    sim = Simulation(pos, vel, np.full(n, 0.5), np.ones(n), np.array([30000.0, 6.0, 6.0]),
+    sim = Simulation(State(pos, vel, np.full(n, 0.5), np.ones(n), np.array([30000.0, 6.0, 6.0])),
                      CollisionRule.elastic())
     for t in (2.0, 4.0, 6.0):
         sim.run(t)
@@ -214,7 +206,7 @@ def test_rebuild_tests_the_rounded_centre():
 
     box = np.array([30000.0, 6.0, 6.0])
     pos = np.array([[29980.0, 3.0, 3.0], [29990.0, 3.0, 3.0]])
-    sim = Simulation(pos, np.zeros((2, 3)), np.full(2, 0.5), np.ones(2), box,
+    sim = Simulation(State(pos, np.zeros((2, 3)), np.full(2, 0.5), np.ones(2), box),
                      CollisionRule.elastic(), shell=1.0)
     sim._build()
     e = sim._engine
@@ -228,3 +220,63 @@ def test_rebuild_tests_the_rounded_centre():
     assert st == 0
     assert e.lists.nbn.tolist() == [1, 1]
     assert check(sim) == []
+
+
+@pytest.mark.parametrize("neighbours", ["lists", "cells"])
+@pytest.mark.parametrize("d", [2, 3])
+def test_state_continues_where_a_synchronise_would(neighbours, d):
+    """Simulation(sim.state, ...) taken mid-run (no synchronise) continues bit for bit where
+    sim.synchronise() would, with walls, driving and the TC model (every counter carried), and
+    reading sim.state changes nothing in the run it is read from."""
+    from granulargas.engine import WhiteNoise
+    from granulargas.initial import random_state
+
+    st = random_state(150, 0.15, d, seed=9, boundary=("periodic",) * (d - 1) + ("wall",))
+    rule = CollisionRule.constant(0.8, tc_time=1e-3, wall_restitution=0.9)
+    drive = WhiteNoise(0.3, 0.07, seed=4)
+    runs = [Simulation(st, rule, driving=drive, neighbours=neighbours) for _ in range(3)]
+    for sim in runs:
+        sim.run(2.0)
+    read, synchronised, untouched = runs
+    saved = read.state
+    synchronised.synchronise()
+    assert saved.time == 2.0 and saved.kick_step == synchronised.kick_step > 0
+    assert saved.wall_collisions == synchronised.wall_collisions > 0
+    assert saved.injected_energy == synchronised.injected_energy > 0
+    continued = Simulation(saved, rule, driving=drive, neighbours=neighbours)
+    for sim in runs + [continued]:
+        sim.run(4.0)
+    for a, b in ((continued, synchronised), (read, untouched)):
+        sa, sb = a.state, b.state
+        for name in ("positions", "velocities", "images", "last_collision"):
+            np.testing.assert_array_equal(getattr(sa, name), getattr(sb, name))
+        for name in ("time", "collisions", "events", "wall_collisions", "kick_step", "dissipated_energy",
+                     "injected_energy"):
+            assert getattr(sa, name) == getattr(sb, name), name
+    assert continued.collisions > saved.collisions + 100
+
+
+def test_state_carries_what_the_engine_does_not_use():
+    st = make_sim(n=30, packing=0.1).state
+    assert st.species is None and st.contact_until is None and st.kick_step is None
+    species = np.arange(30, dtype=np.int32) % 2
+    sim = Simulation(st.replace(species=species), CollisionRule.elastic())
+    sim.run(1.0)
+    np.testing.assert_array_equal(sim.state.species, species)
+
+
+@pytest.mark.parametrize("state, match", [
+    (State(None, np.zeros((4, 3)), 0.5, 1.0, 10.0), "positions: the state has none"),
+    (State(np.ones((4, 3)), np.zeros((4, 3)), 0.5, 1.0, None), "box: the state has none"),
+    (State(np.ones((4, 3)), np.zeros((4, 3)), 0.5, 1.0, 10.0, last_collision=np.zeros(3)),
+     r"last_collision: shape \(3,\), expected \(4,\)"),
+    (State(np.ones((4, 3)), np.zeros((4, 3)), 0.5, 1.0, 10.0, contact_partner=[0, 1, 2, 9]), "contact_partner"),
+])
+def test_bad_state_raises_config_error(state, match):
+    with pytest.raises(ConfigError, match=match):
+        Simulation(state, CollisionRule.elastic())
+
+
+def test_a_state_is_required():
+    with pytest.raises(TypeError, match="granulargas.state.State"):
+        Simulation(np.zeros((4, 3)), CollisionRule.elastic())

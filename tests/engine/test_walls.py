@@ -10,6 +10,7 @@ from granulargas.contact import restitution, restitution_table
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.engine.invariants import check
 from granulargas.errors import ConfigError
+from granulargas.state import State
 
 from tests.engine.factories import hermite_table, pade_eps, walled_state
 from tests.engine.reference import next_event, restitution as ref_eps, run_reference
@@ -70,8 +71,8 @@ def next_engine_event(sim):
 @pytest.mark.parametrize("rule", list(RULES), ids=list(RULES))
 def test_next_event_with_walls_matches_reference_every_step(case, rule):
     d, walls, packing, n = case
-    kw, boundary = walled_state(n, packing, d, walls, seed=d + len(walls))
-    sim = Simulation(**kw, rule=RULES[rule], boundary=boundary)
+    st = walled_state(n, packing, d, walls, seed=d + len(walls))
+    sim = Simulation(st, RULES[rule])
     kinds = [next_engine_event(sim)[0] for _ in range(200)]
     assert kinds.count("wall") > 10 and kinds.count("pair") > 50
     assert check(sim) == []
@@ -81,9 +82,9 @@ def test_next_event_with_walls_matches_reference_every_step(case, rule):
 @pytest.mark.parametrize("rule", ["elastic", "constant"])
 def test_free_running_sequence_with_walls_matches_reference(d, walls, rule):
     """Independent runs agree while chaos has not amplified round-off (first 60 events)."""
-    kw, boundary = walled_state(60, 0.3, d, walls, seed=11)
+    st = walled_state(60, 0.3, d, walls, seed=11)
     r = RULES[rule]
-    sim = Simulation(**kw, rule=r, boundary=boundary)
+    sim = Simulation(st, r)
     eps = 1.0 if rule == "elastic" else r.restitution
     wall_eps = 1.0 if rule == "elastic" else r.wall_restitution
     ref, _, vel = run_reference(sim.positions, sim.velocities, sim.radii, sim.masses, sim.box, 60,
@@ -109,8 +110,8 @@ def test_single_sphere_bounce_follows_the_restitution_of_the_sphere_plane_contac
         pos = np.array([[5.0] * (d - 1) + [4.0], [2.0] * d])
         vel = np.zeros((2, d))
         vel[0, -1] = -speed
-        sim = Simulation(pos, vel, [radius, 0.5], [mass, 1.0], box, rule,
-                         boundary=("periodic",) * (d - 1) + ("wall",))
+        sim = Simulation(State(pos, vel, [radius, 0.5], [mass, 1.0], box,
+                               boundary=("periodic",) * (d - 1) + ("wall",)), rule)
         sim.run((4.0 - radius) / speed * 1.5)
         assert sim.wall_collisions == 1 and sim.collisions == 0
         beta = k * (radius * speed / mass**2) ** 0.2
@@ -125,8 +126,8 @@ def test_wall_collision_elastic_constant_and_separate_wall_restitution():
     box = np.full(3, 6.0)
     for rule, eps in [(CollisionRule.elastic(), 1.0), (CollisionRule.constant(0.7), 0.7),
                       (CollisionRule.constant(0.7, wall_restitution=0.9), 0.9)]:
-        sim = Simulation([[3.0, 3.0, 5.0], [1.0, 1.0, 1.0]], [[0.0, 0.0, 2.0], [0, 0, 0]],
-                         0.5, 1.0, box, rule, boundary=("periodic", "periodic", "wall"))
+        sim = Simulation(State([[3.0, 3.0, 5.0], [1.0, 1.0, 1.0]], [[0.0, 0.0, 2.0], [0, 0, 0]],
+                               0.5, 1.0, box, boundary=("periodic", "periodic", "wall")), rule)
         sim.run(1.0)  # contact at z = 5.5 after 0.25
         assert sim.wall_collisions == 1
         assert sim.velocities[0, 2] == pytest.approx(-2.0 * eps, rel=1e-15)
@@ -137,8 +138,8 @@ def test_wall_collision_elastic_constant_and_separate_wall_restitution():
 
 @pytest.mark.parametrize("d, walls, packing", [(3, (2,), 0.4), (3, (0, 1, 2), 0.3), (2, (0,), 0.6)])
 def test_invariants_and_energy_with_walls(d, walls, packing):
-    kw, boundary = walled_state(400, packing, d, walls, seed=3)
-    sim = Simulation(**kw, rule=CollisionRule.constant(0.9), boundary=boundary)
+    st = walled_state(400, packing, d, walls, seed=3)
+    sim = Simulation(st, CollisionRule.constant(0.9))
     e0 = sim.kinetic_energy
     for t in (0.5, 1.0, 3.0):
         sim.run(t)
@@ -152,24 +153,21 @@ def test_invariants_and_energy_with_walls(d, walls, packing):
         np.testing.assert_array_equal(sim.images[:, a], 0)
     periodic = [a for a in range(d) if a not in walls]
     if periodic:  # momentum along the periodic axes is still conserved
-        p0 = (kw["masses"][:, None] * kw["velocities"]).sum(axis=0)
+        p0 = (st.masses[:, None] * st.velocities).sum(axis=0)
         np.testing.assert_allclose(sim.momentum[periodic], p0[periodic], atol=1e-10)
 
 
 @pytest.mark.parametrize("d", [2, 3])
 def test_restart_equality_with_walls_bit_for_bit(d):
     walls = (d - 1,)
-    kw, boundary = walled_state(200, 0.35, d, walls, seed=5)
+    st = walled_state(200, 0.35, d, walls, seed=5)
     rule = CollisionRule.constant(0.8, tc_time=1e-3, wall_restitution=0.7)
-    a = Simulation(**kw, rule=rule, boundary=boundary)
+    a = Simulation(st, rule)
     a.run(3.0)
     a.synchronise()
-    saved = dict(positions=a.positions, velocities=a.velocities, radii=a.radii, masses=a.masses,
-                 box=a.box, time=a.time, collisions=a.collisions, images=a.images,
-                 last_collision=a.last_collision, events=a.events,
-                 dissipated_energy=a.dissipated_energy, wall_collisions=a.wall_collisions)
+    saved = a.state
     a.run(6.0)
-    b = Simulation(**saved, rule=rule, boundary=boundary)
+    b = Simulation(saved, rule)
     b.run(6.0)
     assert a.collisions == b.collisions and a.wall_collisions == b.wall_collisions > 0
     assert a.events == b.events
@@ -180,9 +178,9 @@ def test_restart_equality_with_walls_bit_for_bit(d):
 
 def test_periodic_runs_ignore_the_wall_code():
     """An all-periodic boundary given explicitly is the default, bit for bit."""
-    kw, _ = walled_state(150, 0.3, 3, (), seed=2)
-    a = Simulation(**kw, rule=CollisionRule.constant(0.9))
-    b = Simulation(**kw, rule=CollisionRule.constant(0.9), boundary=("periodic",) * 3)
+    st = walled_state(150, 0.3, 3, (), seed=2)
+    a = Simulation(st, CollisionRule.constant(0.9))
+    b = Simulation(st.replace(boundary=("periodic",) * 3), CollisionRule.constant(0.9))
     a.run(4.0)
     b.run(4.0)
     np.testing.assert_array_equal(a.positions, b.positions)
@@ -204,7 +202,7 @@ def test_bad_wall_input_raises_config_error(kwargs, match):
                 boundary=("periodic", "periodic", "wall"))
     base.update(kwargs)
     with pytest.raises(ConfigError, match=match):
-        Simulation(**base, rule=CollisionRule.elastic())
+        Simulation(State(**base), CollisionRule.elastic())
 
 
 def _wall_pressure_against_eos(d, n, packing, t_end, seed=1):
@@ -212,8 +210,8 @@ def _wall_pressure_against_eos(d, n, packing, t_end, seed=1):
     gas between walls on the last axis, averaged from t = 20 to t_end."""
     from granulargas import theory
 
-    kw, boundary = walled_state(n, packing, d, (d - 1,), seed=seed)
-    sim = Simulation(**kw, rule=CollisionRule.elastic(), boundary=boundary)
+    st = walled_state(n, packing, d, (d - 1,), seed=seed)
+    sim = Simulation(st, CollisionRule.elastic())
     sim.run(20.0)
     sim.wall_pressure_window()
     L = sim.box[-1]

@@ -9,6 +9,7 @@ from granulargas.cli import main
 from granulargas.errors import InputFileError, UserError
 from granulargas.io.gsd import GSD_TIME_KEY, export_gsd
 from granulargas.io.h5md import H5MDWriter, iter_snapshots
+from granulargas.state import State
 
 # gsd is in the `test` extra: a missing gsd fails here rather than skipping the export tests
 import gsd.hoomd as gsd_hoomd  # noqa: E402
@@ -21,12 +22,13 @@ def write_h5md(path, dimension, n=37, frames=4, seed=0):
     radii = rng.uniform(0.3, 0.6, n)
     masses = rng.uniform(0.5, 2.0, n)
     species = (np.arange(n) % 3 == 0).astype(np.int32) * 2  # species 0 and 2
-    with H5MDWriter(path, box, radii, masses, species) as w:
+    state = State(np.zeros((n, dimension)), np.zeros((n, dimension)), radii, masses, box, species=species)
+    with H5MDWriter(path, state) as w:
         for k in range(frames):
             pos = rng.uniform(0, 1, (n, dimension)) * box
             vel = rng.normal(size=(n, dimension))
             img = rng.integers(-3, 4, (n, dimension))
-            w.write_snapshot(17 * k, 0.25 * k + 0.1, pos, vel, img)
+            w.write_state(state.replace(positions=pos, velocities=vel, images=img, events=17 * k, time=0.25 * k + 0.1))
     return path
 
 

@@ -11,8 +11,10 @@ from granulargas.io.h5md import (
     load_snapshot,
     read_observables,
     read_parameters,
+    read_state,
     snapshot_count,
 )
+from granulargas.state import STATE_FIELDS, DSMCContinuation, State
 
 
 def _write(path, frames=3, n=20, d=3, seed=0, **kw):
@@ -22,7 +24,8 @@ def _write(path, frames=3, n=20, d=3, seed=0, **kw):
     masses = rng.uniform(0.5, 2.0, n)
     params = {"config": "[system]\nseed = 1\n", "seed": 1, "collision": {"model": "constant", "restitution": 0.9},
               "table": np.arange(8.0).reshape(2, 4)}
-    w = H5MDWriter(path, box, radii, masses, parameters=params, **kw)
+    state = State(np.zeros((n, d)), np.zeros((n, d)), radii, masses, box)
+    w = H5MDWriter(path, state, parameters=params, **kw)
     data = []
     for k in range(frames):
         pos = rng.uniform(0, 4.0, (n, d))
@@ -30,7 +33,7 @@ def _write(path, frames=3, n=20, d=3, seed=0, **kw):
         img = rng.integers(-2, 3, (n, d))
         w.write_observables(10 * k, 0.5 * k, {"temperature": 1.0 / (k + 1), "collisions": 7 * k,
                                              "momentum": np.zeros(d)})
-        w.write_snapshot(10 * k, 0.5 * k, pos, vel, img)
+        w.write_state(state.replace(positions=pos, velocities=vel, images=img, events=10 * k, time=0.5 * k))
         data.append((pos, vel, img))
     w.close()
     return box, radii, masses, data
@@ -134,3 +137,77 @@ def test_foreign_files_are_rejected(tmp_path):
         read_observables(q)
     with pytest.raises(InputFileError, match="file not found"):
         read_parameters(tmp_path / "missing.h5")
+
+
+def _full_state(rng, n=12, d=3, **extra):
+    return State(rng.uniform(0, 4.0, (n, d)), rng.normal(size=(n, d)), rng.uniform(0.3, 0.5, n),
+                 rng.uniform(0.5, 2.0, n), np.full(d, 4.0), boundary=("periodic",) * (d - 1) + ("wall",),
+                 images=rng.integers(-2, 3, (n, d)) * np.array([1] * (d - 1) + [0]),
+                 species=np.arange(n) % 2, last_collision=rng.uniform(0, 1, n),
+                 contact_until=rng.uniform(0, 1, n), contact_partner=rng.integers(-1, n, n), time=2.5,
+                 collisions=40, events=97, dissipated_energy=1.25, wall_collisions=6, injected_energy=0.5,
+                 kick_step=11, three_body_contacts=3, **extra)
+
+
+def _counters(st, d):
+    return {"temperature": 1.0, "collisions": st.collisions, "dissipated_energy": st.dissipated_energy,
+            "momentum": np.zeros(d), "wall_collisions": st.wall_collisions, "injected_energy": st.injected_energy,
+            "kick_step": st.kick_step, "three_body_contacts": st.three_body_contacts}
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_write_state_and_read_state_round_trip_every_field(tmp_path, d):
+    """write_state / read_state: each per-particle field the run stores, box, boundary, time,
+    step and every counter (from the observables sample at the frame) come back exactly."""
+    rng = np.random.default_rng(d)
+    first, other = _full_state(rng, d=d), _full_state(rng, d=d)
+    last = other.replace(radii=first.radii, masses=first.masses, species=first.species, time=3.5, events=150,
+                         collisions=70)  # time-independent fields as in the first frame
+    fields = ("last_collision", "contact_until", "contact_partner")
+    p = tmp_path / "s.h5"
+    with H5MDWriter(p, first, fields=fields, driven=True) as w:
+        for st in (first, last):
+            w.write_observables(st.events, st.time, _counters(st, d))
+            w.write_state(st)
+    for index, st in ((0, first), (-1, last)):
+        back = read_state(p, index)
+        for name in STATE_FIELDS:
+            if name in ("dsmc",):
+                continue
+            want, got = getattr(st, name), getattr(back, name)
+            if isinstance(want, np.ndarray):
+                assert got.dtype == want.dtype and np.array_equal(got, want), name
+            else:
+                assert got == want, name
+    with h5py.File(p, "r") as f:  # each element says what it holds, and which are restart state only
+        part = f["particles/all"]
+        assert part["last_collision"].attrs["description"].endswith("(kept for exact restarts)")
+        assert part["position"].attrs["description"] == "positions, wrapped into the box on periodic axes"
+        assert part["species"].attrs["description"] == "species indices"
+    # a frame without an observables sample at its time is no restart state
+    with H5MDWriter(tmp_path / "t.h5", first) as w:
+        w.write_observables(0, 0.0, {"collisions": 0, "dissipated_energy": 0.0})
+        w.write_state(first)
+    with pytest.raises(InputFileError, match=r"no observables sample at snapshot 0 \(t = 2.5\)"):
+        read_state(tmp_path / "t.h5")
+
+
+def test_dsmc_frames_store_the_continuation(tmp_path):
+    rng = np.random.default_rng(5)
+    cont = DSMCContinuation(rng=rng.integers(0, 2**63, 5, dtype=np.uint64), candidates=1234, pending_pair=(3, 7),
+                            pending_time=2.75, frame_velocity=[0.1, -0.2, 0.3])
+    st = State(None, rng.normal(size=(10, 3)), 0.5, 1.0, np.full(3, 8.0), time=2.5, collisions=900, events=900,
+               dissipated_energy=3.0, dsmc=cont)
+    p = tmp_path / "d.h5"
+    with H5MDWriter(p, st) as w:
+        w.write_observables(900, 2.5, {"temperature": 1.0, "collisions": 900, "dissipated_energy": 3.0,
+                                       "momentum": np.zeros(3)})
+        w.write_state(st)
+    back = read_state(p)
+    assert back.positions is None and back.images is None
+    assert np.array_equal(back.velocities, st.velocities) and (back.time, back.events) == (2.5, 900)
+    assert np.array_equal(back.dsmc.rng, cont.rng) and back.dsmc.pending_pair == (3, 7)
+    assert (back.dsmc.candidates, back.dsmc.pending_time) == (1234, 2.75)
+    with pytest.raises(ValueError, match="DSMC continuation"):
+        with H5MDWriter(tmp_path / "e.h5", st) as w:
+            w.write_state(st.replace(dsmc=None))

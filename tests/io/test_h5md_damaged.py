@@ -11,8 +11,10 @@ from granulargas.io.h5md import (
     load_snapshot,
     read_observables,
     read_parameters,
+    read_state,
     snapshot_count,
 )
+from granulargas.state import State
 from tests.io.test_h5md import _write
 
 READERS = {
@@ -20,8 +22,14 @@ READERS = {
     "load_snapshot": load_snapshot,
     "read_observables": read_observables,
     "read_parameters": read_parameters,
+    "read_state": read_state,
     "snapshot_count": snapshot_count,
 }
+
+
+def _state(n, **fields):
+    """A 3D state of n particles at rest (the continuation's particle count, step and time)."""
+    return State(np.zeros((n, 3)), np.zeros((n, 3)), 0.5, 1.0, np.full(3, 4.0), **fields)
 
 
 @pytest.fixture
@@ -100,9 +108,9 @@ def test_files_of_other_programs(tmp_path):
 def test_append_checks_before_changing_anything(good, tmp_path):
     before = good.read_bytes()
     with pytest.raises(InputFileError, match="holds 20 particles in 3D, the continuation 21 in 3D"):
-        H5MDWriter.append(good, particles=21, dimension=3, last_collision=False, step=20, time=1.0)
+        H5MDWriter.append(good, _state(21, events=20, time=1.0))
     with pytest.raises(InputFileError, match="its last frame is not the state the continuation starts from"):
-        H5MDWriter.append(good, particles=20, dimension=3, last_collision=False, step=10, time=0.5)
+        H5MDWriter.append(good, _state(20, events=10, time=0.5))
     with pytest.raises(InputFileError, match="lacks the TC model's last-collision times"):
-        H5MDWriter.append(good, particles=20, dimension=3, last_collision=True, step=20, time=1.0)
+        H5MDWriter.append(good, _state(20, events=20, time=1.0), fields=("last_collision",))
     assert good.read_bytes() == before

@@ -12,11 +12,12 @@ from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule
 from granulargas.errors import ConfigError
 from granulargas.io.config import load_config, parse_config
-from granulargas.io.h5md import (has_positions, interrupted_frames, iter_snapshots, load_snapshot, read_dsmc_state,
-                                 read_observables, read_parameters)
+from granulargas.io.h5md import (has_positions, interrupted_frames, iter_snapshots, load_snapshot,
+                                 read_observables, read_parameters, read_state)
 from granulargas.observables import sonine_coefficients
 from granulargas.run.prepare import prepare
 from granulargas.run.runner import RunInterrupted, StopRequest, run_config
+from granulargas.state import State
 
 DSMC_3D = """
 [system]
@@ -118,7 +119,7 @@ def test_the_run_is_the_dsmc_the_config_describes(dsmc_config):
     assert par["dsmc"]["chi"] == pytest.approx(chi, rel=1e-12)
     assert par["packing_fraction"] == pytest.approx(0.05, rel=1e-12)
     rule = CollisionRule.viscoelastic(prefactor=setup.prefactor, table=setup.table)
-    ref = DSMC(setup.state.velocities, first.radii, first.masses, rule, volume=float(np.prod(box)),
+    ref = DSMC(State(None, setup.state.velocities, first.radii, first.masses, box), rule,
                chi=par["dsmc"]["chi"], seed=7)
     assert np.array_equal(ref.velocities, first.velocities)
     for t in (5.0, 10.0, 15.0, 20.0):
@@ -151,7 +152,7 @@ def test_restart_and_append_equal_the_uninterrupted_run(dsmc_config, tmp_path):
     _assert_same_datasets(full.output, part)
     a, b = load_snapshot(full.output, -1), load_snapshot(new.output, -1)
     assert np.array_equal(a.velocities, b.velocities)
-    assert read_dsmc_state(full.output)["candidates"] == read_dsmc_state(new.output)["candidates"]
+    assert read_state(full.output).dsmc.candidates == read_state(new.output).dsmc.candidates
 
 
 def test_a_signal_keeps_the_state_and_the_continuation_is_exact(dsmc_config, tmp_path):
@@ -321,7 +322,7 @@ def test_sigint_in_a_real_dsmc_process(write_config, tmp_path):
     frames = list(iter_snapshots(out))
     assert interrupted_frames(out) == [len(frames) - 1] and frames[-1].time > frames[-2].time
     t_s = frames[-1].time
-    assert read_dsmc_state(out)["candidates"] > 0
+    assert read_state(out).dsmc.candidates > 0
     assert main(["run", str(path), "--restart", str(out), "--append", "--quiet",
                  "--set", f"run.end_time={t_s + 1.0!r}"]) == 0
     assert [s.time for s in iter_snapshots(out)][-1] == t_s + 1.0

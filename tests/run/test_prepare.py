@@ -11,6 +11,7 @@ from granulargas.errors import ConfigError
 from granulargas.initial import box_for_packing, random_state
 from granulargas.io.config import parse_config
 from granulargas.run.prepare import fresh_state, mean_particle
+from granulargas.state import State
 from granulargas.theory import particle_volume
 
 CONFIG = """
@@ -43,7 +44,7 @@ def test_engine_smallest_box_boundary():
     assert MIN_BOX_DIAMETERS == 3.15  # 3 cells per side x (1 diameter + 0.05 minimum shell)
     for box, ok in ((MIN_BOX_DIAMETERS, True), (math.nextafter(MIN_BOX_DIAMETERS, 0.0), False)):
         pos = _lattice(2, box)
-        args = (pos, np.zeros_like(pos), np.full(8, 0.5), np.ones(8), np.full(3, box), CollisionRule.elastic())
+        args = (State(pos, np.zeros_like(pos), np.full(8, 0.5), np.ones(8), np.full(3, box)), CollisionRule.elastic())
         if ok:
             sim = Simulation(*args)
             sim.run(until=0.1)
@@ -66,7 +67,7 @@ def test_config_and_engine_agree_at_the_smallest_box(side, ok):
             fresh_state(config)
         return
     state = fresh_state(config)
-    Simulation(**state.as_kwargs(), rule=CollisionRule.elastic()).run(until=0.1)
+    Simulation(state, CollisionRule.elastic()).run(until=0.1)
 
 
 def test_config_route_is_the_initial_route():
@@ -76,7 +77,7 @@ def test_config_route_is_the_initial_route():
     direct = random_state(64, 0.2, 3, 1.0, radii=0.5, masses=1.0, rng=np.random.default_rng(3))
     for name in ("positions", "velocities", "radii", "masses", "box"):
         np.testing.assert_array_equal(getattr(state, name), getattr(direct, name))
-    assert state.species.dtype == np.int32 and not state.species.any()
+    assert state.array("species").dtype == np.int32 and not state.array("species").any()
 
 
 def test_mean_particle_mass_from_density():

@@ -127,6 +127,5 @@ def test_resolved_with_cell_crossings_is_refused_and_auto_uses_lists(write_confi
 
     setup = prepare(load_config(write_config(RESOLVED, name="auto.toml")))
     st = setup.state
-    sim = Simulation(st.positions, st.velocities, st.radii, st.masses, st.box, setup.rule,
-                     neighbours="auto")
+    sim = Simulation(st, setup.rule, neighbours="auto")
     assert sim.neighbours == "lists"

@@ -38,13 +38,13 @@ def _measure(n, d, eta):
     """Peak bytes (tracemalloc: numpy reports its allocations) of the initial placement, and of
     the engine's first build with the state it starts from."""
     warm = random_state(n, eta, d, seed=2)  # compile first (same code paths): JIT allocations are not the run's
-    Simulation(warm.positions, warm.velocities, warm.radii, warm.masses, warm.box, CollisionRule.elastic()).run(until=0.0)
+    Simulation(warm, CollisionRule.elastic()).run(until=0.0)
     tracemalloc.start()
     st = random_state(n, eta, d, seed=1)
     placement = tracemalloc.get_traced_memory()[1]
     tracemalloc.reset_peak()
     base = tracemalloc.get_traced_memory()[0]
-    sim = Simulation(st.positions, st.velocities, st.radii, st.masses, st.box, CollisionRule.elastic())
+    sim = Simulation(st, CollisionRule.elastic())
     sim.run(until=0.0)
     engine = tracemalloc.get_traced_memory()[1] - base
     tracemalloc.stop()
@@ -69,7 +69,7 @@ def test_memory_estimate_bounds_the_measured_peak(monkeypatch, n, d, eta, large)
 
 def test_cell_count_is_the_engines():
     st = random_state(2000, 0.01, 3, seed=1)
-    sim = Simulation(st.positions, st.velocities, st.radii, st.masses, st.box, CollisionRule.elastic())
+    sim = Simulation(st, CollisionRule.elastic())
     assert resources.run_memory(2000, 3, 0.01)["engine_cells"] == float(np.prod(sim._space.ncell))
 
 

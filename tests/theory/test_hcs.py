@@ -112,11 +112,12 @@ def _maxwell_pair_moment(p, dim):
 def test_cooling_factors_are_pair_averages_of_the_hcs_velocities(dim):
     from granulargas.dsmc import DSMC
     from granulargas.engine import CollisionRule
+    from granulargas.state import State
 
     eps, n = 0.3, 20_000
     rng = np.random.default_rng(5)
-    sim = DSMC(rng.standard_normal((n, dim)), 0.5, 1.0, CollisionRule.constant(eps), number_density=0.01, chi=1.0,
-               seed=3)
+    sim = DSMC(State(None, rng.standard_normal((n, dim)), 0.5, 1.0, None), CollisionRule.constant(eps),
+               number_density=0.01, chi=1.0, seed=3)
     sim.run(np.inf, max_collisions=15 * n)  # 30 collisions per particle
     m1, m3 = [], []
     for _ in range(20):

@@ -1,0 +1,165 @@
+"""What a run compiles: the variants of the package's compiled code, named for the user.
+
+numba compiles a kernel for the types of its arguments, and the engine is built so
+that a feature a run does not use leaves no code in its loop (ARCHITECTURE.md,
+``mode_flags``): each kind of run therefore compiles a loop of its own, once, the
+first time such a run is made, and every later run of that kind loads it from the
+cache (:func:`granulargas._numba.cache_location`). :data:`VARIANTS` lists these
+kinds, one entry each: its name (``granulargas compile NAME``), what it is (the
+line a run prints before it compiles it), the tiny run that compiles it, and
+which runs use it. What does *not* make a variant: the dimension (2D runs use the
+3D kernels with z = 0), the collision rule (elastic, constant, viscoelastic and
+the TC model share one loop), walls and polydispersity (run-time data), the
+numbers of particles and of snapshots.
+
+A feature that adds a compiled variant adds one entry here: its tiny config (the
+keys that select it, on top of :data:`TINY`), the variants it builds on
+(``after``: their kernels are compiled first, so that parallel builds do not
+compile the same kernel twice), and the test of a config that selects it.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from granulargas.engine.simulation import neighbour_mode
+from granulargas.initial.lattice_gas import SORTED_MIN_PARTICLES
+from granulargas.io.config import RunConfig, parse_config
+
+#: the tiny run every engine variant's build starts from (3D, 64 spheres, viscoelastic)
+TINY = {
+    "system.dimension": 3, "system.particles": 64, "system.packing_fraction": 0.05, "system.seed": 1,
+    "collision.model": "viscoelastic", "collision.damping": 0.1,
+    "run.collisions_per_particle": 4, "output.snapshots": 2,
+}
+#: a soft material for collisions that take time (t_c / t_free ~ 0.1 at packing 0.1)
+_MATERIAL = {
+    "collision.material.young_modulus": 1e6, "collision.material.poisson_ratio": 0.3,
+    "collision.material.dissipation_time": 1e-5, "collision.material.diameter": 0.01,
+    "collision.material.density": 1000, "collision.material.speed_unit": 0.5,
+    "collision.duration": "resolved", "system.packing_fraction": 0.1, "collision.damping": None,
+}
+_DRIVEN = {"driving.model": "white_noise", "driving.heating_rate": 0.005}
+_DSMC = {"run.method": "dsmc", "system.particles": 256}
+
+
+def _placement(config: RunConfig) -> bool:
+    return config.run.method == "edmd" and not config.initial.from_file
+
+
+def _engine(mode: str, resolved: bool = False, driven: bool = False) -> Callable[[RunConfig, str], bool]:
+    """Runs of the event-driven engine in neighbour mode ``mode`` (with collisions that take
+    time: ``resolved``; ``driven``: the driven ones only)."""
+    def uses(config: RunConfig, neighbours: str) -> bool:
+        return (config.run.method == "edmd" and neighbours == mode
+                and (config.collision.duration == "resolved") == resolved
+                and (config.driving is not None or not driven))
+    return uses
+
+
+def _dsmc(driven: bool = False) -> Callable[[RunConfig, str], bool]:
+    return lambda config, neighbours: config.run.method == "dsmc" and (config.driving is not None or not driven)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One compiled variant: ``name``, ``what`` it is (for the user), the ``config`` keys of
+    its tiny build (on top of :data:`TINY`; None: ``build`` instead), the variants whose
+    kernels it reuses (``after``: built first), and ``uses(config, neighbours)``: whether
+    a run of ``config`` in that neighbour mode needs it."""
+
+    name: str
+    what: str
+    config: dict | None
+    uses: Callable[[RunConfig, str], bool]
+    after: tuple = ()
+    build: Callable[[], None] | None = field(default=None, compare=False)
+    #: a run announces the variant before compiling it; the initial placement compiles
+    #: before the run can tell a bad config from a good one (a placement too dense for
+    #: its radii fails there), and bad input gets one line on stderr: not announced
+    announced: bool = True
+
+
+def _build_placement():
+    """The initial placement's kernels of small systems: sweeps, and the growth steps with
+    pushes that dense and polydisperse states need."""
+    from granulargas.initial import random_state
+
+    random_state(64, 0.05, 3, seed=1)
+    random_state(64, 0.45, 3, seed=1, radii=[0.4, 0.5] * 32)
+
+
+def _build_large_placement():
+    """The large systems' placement: sweeps over sorted particles (threads) and the compression."""
+    from granulargas.initial import random_state
+
+    random_state(SORTED_MIN_PARTICLES, 0.45, 3, seed=1)
+
+
+#: every compiled variant, one entry each (module docstring)
+VARIANTS = (
+    Variant("placement", "the initial placement", None, lambda c, m: _placement(c), build=_build_placement,
+            announced=False),
+    Variant("placement-large", f"the initial placement of large systems (from {SORTED_MIN_PARTICLES} particles)",
+            None, lambda c, m: _placement(c) and c.system.particles >= SORTED_MIN_PARTICLES,
+            after=("placement",), build=_build_large_placement, announced=False),
+    Variant("lists", "the neighbour-list engine", {"run.neighbours": "lists"}, _engine("lists"),
+            after=("placement",)),
+    Variant("cells", "the cell-crossing engine", {"run.neighbours": "cells"}, _engine("cells"),
+            after=("placement", "lists")),
+    Variant("lists-driven", "its driving step", {"run.neighbours": "lists", **_DRIVEN},
+            _engine("lists", driven=True), after=("lists",)),
+    Variant("cells-driven", "its driving step", {"run.neighbours": "cells", **_DRIVEN},
+            _engine("cells", driven=True), after=("cells",)),
+    Variant("resolved", "the engine of collisions that take time", {"run.neighbours": "lists", **_MATERIAL},
+            _engine("lists", resolved=True), after=("placement", "lists")),
+    Variant("resolved-driven", "its driving step", {"run.neighbours": "lists", **_MATERIAL, **_DRIVEN},
+            _engine("lists", resolved=True, driven=True), after=("resolved",)),
+    Variant("dsmc", "the DSMC", _DSMC, _dsmc()),
+    Variant("dsmc-driven", "its driving step", {**_DSMC, **_DRIVEN}, _dsmc(driven=True), after=("dsmc",)),
+)
+BY_NAME = {v.name: v for v in VARIANTS}
+
+
+def run_neighbours(config: RunConfig, packing: float | None = None) -> str:
+    """The engine's neighbour mode for ``config`` ("auto" resolved as the engine does, at the
+    config's packing fraction or at ``packing``, the state's own)."""
+    if config.collision.duration == "resolved":
+        return "lists"
+    eta = config.system.packing_fraction if packing is None else packing
+    return neighbour_mode(config.run.neighbours, eta, config.system.dimension)
+
+
+def variants_for(config: RunConfig, neighbours: str | None = None) -> list[Variant]:
+    """The variants a run of ``config`` (in neighbour mode ``neighbours``, default
+    :func:`run_neighbours`) compiles the first time it is made."""
+    mode = neighbours or run_neighbours(config)
+    return [v for v in VARIANTS if v.uses(config, mode)]
+
+
+def describe(variants) -> str:
+    """``the initial placement and the cell-crossing engine``: the variants' ``what``, joined
+    (a driving step, "its driving step", follows its engine)."""
+    parts = [v.what for v in variants]
+    if not parts:
+        return "the run's kernels"
+    return parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
+
+
+def tiny_config(variant: Variant, directory) -> RunConfig:
+    """The tiny run that compiles ``variant`` (its output file in ``directory``)."""
+    keys = {**TINY, **variant.config, "output.file": str(Path(directory) / f"{variant.name}.h5")}
+    sections: dict[str, dict] = {}
+    for key, value in keys.items():
+        if value is None:
+            continue
+        section, _, name = key.rpartition(".")
+        sections.setdefault(section, {})[name] = value
+    text = []
+    for section, values in sections.items():
+        text.append(f"[{section}]")
+        text += [f"{name} = {json.dumps(value)}" for name, value in values.items()]
+    return parse_config("\n".join(text) + "\n", source=f"<{variant.name}>")
