@@ -2,11 +2,12 @@
 
 Public API (contract in ARCHITECTURE.md)::
 
-    from granulargas.engine import Simulation, CollisionRule, WhiteNoise
+    from granulargas.engine import Simulation, CollisionRule, WhiteNoise, Wall, Walls
 """
 
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
 from granulargas.engine.simulation import Simulation
+from granulargas.engine.walls import Wall, Walls
 
-__all__ = ["Simulation", "CollisionRule", "WhiteNoise"]
+__all__ = ["Simulation", "CollisionRule", "WhiteNoise", "Wall", "Walls"]
