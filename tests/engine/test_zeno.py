@@ -14,10 +14,10 @@ from tests.engine.reference import run_scene
 def test_elastic_below_matches_the_reference(neighbours):
     """Constant eps = 0.5 with a floor at the median normal speed: about half the collisions are
     elastic. The engine's sequence (pairs and walls) and final velocities against the reference."""
-    kw, boundary = walled_state(40, 0.25, 3, (2,), seed=5)
+    st = walled_state(40, 0.25, 3, (2,), seed=5)
     floor = 0.8
     rule = CollisionRule.constant(0.5, wall_restitution=0.7, elastic_below=floor)
-    sim = Simulation(**kw, rule=rule, boundary=boundary, neighbours=neighbours)
+    sim = Simulation(st, rule, neighbours=neighbours)
     ref, _, vel, _ = run_scene(sim.positions, sim.velocities, sim.radii, sim.masses, sim.box, 80, walls=(2,),
                                eps=0.5, wall_eps=0.7, elastic_below=floor)
     t_end = ref[-1][0]
@@ -26,7 +26,7 @@ def test_elastic_below_matches_the_reference(neighbours):
     assert sim.collisions == sum(j >= 0 for _, _, j in ref)
     np.testing.assert_allclose(sim.velocities, vel, rtol=1e-7, atol=1e-9)
     # and the floor mattered
-    _, _, vel_no_floor, _ = run_scene(kw["positions"], kw["velocities"], kw["radii"], kw["masses"], kw["box"], 80,
+    _, _, vel_no_floor, _ = run_scene(st.positions, st.velocities, st.radii, st.masses, st.box, 80,
                                       walls=(2,), eps=0.5, wall_eps=0.7)
     assert not np.allclose(vel, vel_no_floor, rtol=1e-3)
 
