@@ -704,14 +704,14 @@ class Simulation:
         i, j = int(c["err_i"]), int(c["err_j"])
         ids = [int(self._order[k]) for k in (i, j) if k >= 0]
         where = f"at t = {float(c['time']):.12g} after {int(c['collisions'])} collisions (particles {ids})"
+        zeno = (f"inelastic collapse {where}: ever faster collisions (a grain coming to rest on a wall, or a "
+                f"cluster on a shaken plate, bounces infinitely often in a finite time); set a restitution floor "
+                f"(collision.elastic_below: collisions below that normal speed are elastic; "
+                f"CollisionRule.constant(eps, elastic_below=v)) or the TC model (collision.tc_time)")
+        trap = self.gravity is not None or "wall" in self.boundary
         if status == _loop.COLLAPSE:
-            if self.gravity is not None or "wall" in self.boundary:
-                # a grain at rest on a wall or a cluster on a shaken plate: a Zeno trap of bounces
-                raise InelasticCollapseError(
-                    f"inelastic collapse {where}: ever faster collisions (a grain coming to rest on a wall, "
-                    f"or a cluster on a shaken plate); set collision.elastic_below (collisions below that normal "
-                    f"speed are elastic: CollisionRule.constant(eps, elastic_below=v)) or the TC model "
-                    f"(collision.tc_time)")
+            if trap:
+                raise InelasticCollapseError(zeno, where=where)
             if self.rule.kind == "constant":
                 raise InelasticCollapseError(
                     f"inelastic collapse {where}: the collision rate diverges; use the TC model "
@@ -720,6 +720,9 @@ class Simulation:
         if status == _loop.TABLE_RANGE:
             raise TableRangeError(f"impact beyond the restitution table {where}: build the table "
                                   f"with a larger beta_max")
+        if status == _loop.WATCHDOG and trap and i >= 0 and self._engine.particles.lastcoll[i] == float(c["time"]):
+            # a particle that keeps colliding at one instant of the clock: bounces faster than it resolves
+            raise InelasticCollapseError(zeno, where=where)
         if status == _loop.WATCHDOG:
             raise SimulationError(f"event-queue watchdog {where}: an event in the past or an endless "
                                   f"run of zero-time events")

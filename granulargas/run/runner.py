@@ -355,6 +355,14 @@ def collapse_message(config: RunConfig, where: str) -> str:
     (the TC model's ``collision.tc_time``, with a value that changed T(t) by 0.03 % in the
     collapse demonstration of docs/choosing-a-model.md, or the viscoelastic model)."""
     tc = TC_TIME_FRACTION * mean_free_time(config)
+    if config.gravity is not None or config.system.walls:
+        speed = ELASTIC_BELOW_FRACTION * math.sqrt(config.initial.temperature / config.particles.mass) \
+            if config.particles.mass else ELASTIC_BELOW_FRACTION
+        return (f"inelastic collapse {where}: ever faster collisions (a grain coming to rest on a wall, or a "
+                f"cluster on a shaken plate, bounces infinitely often in a finite time); set collision.elastic_below "
+                f"in {config.source} (collisions below that normal speed are elastic, e.g. elastic_below = "
+                f"{speed:.2g}: {ELASTIC_BELOW_FRACTION:g} of the initial thermal speed) or collision.tc_time "
+                f"(the TC model)")
     return (f"inelastic collapse {where}: the collision rate diverges; set collision.tc_time in {config.source} "
             f"(the TC model, e.g. tc_time = {tc:.2g}: {TC_TIME_FRACTION:.0e} of the initial mean free time) "
             f"or use collision.model = \"viscoelastic\"")
@@ -362,6 +370,8 @@ def collapse_message(config: RunConfig, where: str) -> str:
 
 #: tc_time the collapse error proposes, in mean free times at the initial temperature
 TC_TIME_FRACTION = 1e-6
+#: elastic_below the collapse error of a scene with walls or gravity proposes, in initial thermal speeds
+ELASTIC_BELOW_FRACTION = 1e-3
 
 
 def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True, progress=None,
