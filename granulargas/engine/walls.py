@@ -87,6 +87,13 @@ class Wall:
         return 2.0 * self.amplitude if self.kind == "vibrating" else 0.0
 
     @property
+    def max_speed(self) -> float:
+        """sup |W'|: A omega (sine), (2/pi) A omega (triangle), (4/pi) A omega (bi-parabolic); 0 at rest."""
+        if self.kind != "vibrating":
+            return 0.0
+        return _walls.velocity_bound(self.waveform, self.amplitude, self.frequency)
+
+    @property
     def mean_square_velocity(self) -> float:
         """<W'^2> over a period (0 at rest)."""
         if self.kind != "vibrating":

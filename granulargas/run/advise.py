@@ -71,6 +71,7 @@ from granulargas.errors import ConfigError
 from granulargas.run import validity as V
 from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds, reduced_compression,
                                      reduced_prefactor)
+from granulargas.run.vibrated import is_vibrated, scene_lines
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
@@ -220,6 +221,8 @@ def choose_method(config, instability_length: float = math.inf, duration: str | 
     rule DSMC out."""
     s, c = config.system, config.collision
     eta = s.packing_fraction
+    if getattr(config, "gravity", None) is not None:
+        return "edmd", "gravity needs positions (DSMC simulates a homogeneous gas)"
     if "wall" in s.boundary:
         return "edmd", "walls need positions (DSMC simulates a homogeneous gas)"
     if c.tc_time is not None:
@@ -293,8 +296,13 @@ class Advice:
     duration: str | None = None
     duration_reason: str = ""
     notes: tuple = ()
+    #: a vibrated scene's lines (:func:`granulargas.run.vibrated.scene_lines`), in place of the cooling advice
+    scene: tuple = ()
 
     def lines(self) -> list[str]:
+        if self.scene:
+            name = {"dsmc": "DSMC", "edmd": "EDMD"}[self.method]
+            return list(self.scene) + [f"method       {name}: {self.method_reason}"]
         out = [f"run          T {1:g} -> {self.T_end:.3g} T0 by t = {self.t_end:.4g} (kinetic theory)"]
         if self.model == "elastic":
             out.append("advice       elastic collisions: nothing to choose")
@@ -394,6 +402,10 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     table = V.table_range_error(gas)
     if table:
         raise ConfigError(table)
+    if is_vibrated(config):  # no free cooling: the scene's numbers (granulargas.run.vibrated)
+        adv = Advice(gas.model, tolerance, math.nan, math.nan, box=_box(config), scene=tuple(scene_lines(config)))
+        _set_method(adv, config)
+        return adv
     t_end, T_end = V.run_temperature_range(gas)
     adv = Advice(gas.model, tolerance, t_end, T_end / gas.temperature, box=_box(config))
     notes = []
@@ -475,6 +487,8 @@ def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
     """
     driving = getattr(config, "driving", None)
     if driving is not None and driving.heating_rate > 0.0:
+        return None
+    if is_vibrated(config):  # no free cooling to compare (the run summary shows the scene)
         return None
     adv = advise(config, tolerance)
     if adv.model == "elastic" or adv.eps_best is None:

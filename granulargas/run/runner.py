@@ -293,11 +293,16 @@ def check_same_physics(config: RunConfig, path: Path) -> None:
     if old is None:
         raise InputFileError(f"{path}: parameters/config is missing or not a valid config; --append needs the "
                              "file's config")
-    if (config.driving is None) != (old.driving is None):
-        given = "has no [driving]" if config.driving is None else "has [driving]"
-        raise ConfigError(f"{config.source}: {given}, but the file {path} was run "
-                          f"{'with' if old.driving is not None else 'without'} it; --append continues the same "
-                          "physics (write a new file with --output instead)")
+    for name in ("driving", "gravity", "walls"):
+        if (getattr(config, name) is None) != (getattr(old, name) is None):
+            given = f"has no [{name}]" if getattr(config, name) is None else f"has [{name}]"
+            raise ConfigError(f"{config.source}: {given}, but the file {path} was run "
+                              f"{'with' if getattr(old, name) is not None else 'without'} it; --append continues the "
+                              "same physics (write a new file with --output instead)")
+    for name in ("gravity", "walls"):
+        if getattr(config, name) != getattr(old, name):
+            raise ConfigError(f"{config.source}: [{name}] differs from the one the file {path} was run with; --append "
+                              "continues the same physics (write a new file with --output instead)")
     for section in _SAME_PHYSICS:
         new_s, old_s = getattr(config, section), getattr(old, section)
         for f in fields(new_s):
@@ -339,8 +344,14 @@ def _observables(sim, pressure: bool) -> dict:
         "sonine_a2": float(a2),
         "sonine_a3": float(a3),
     }
+    if sim.gravity is not None:
+        out["potential_energy"] = float(sim.potential_energy)
     if "wall" in sim.boundary:
         out["wall_collisions"] = int(sim.wall_collisions)
+        if (sim.walls is not None and sim.walls.moving) or sim.gravity is not None:  # a vibrated scene
+            out["wall_work"] = float(sim.wall_work)
+            # the momentum per wall over the interval (read before the wall pressure resets it)
+            out["wall_impulse"] = sim.wall_impulse() if pressure else np.full((sim.dimension, 2), math.nan)
         out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
     if sim.driving is not None:
         out["injected_energy"] = float(sim.injected_energy)
@@ -450,7 +461,8 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
     if dsmc:
         sim = make_dsmc(config, setup)
     else:
-        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours)
+        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
+                         gravity=setup.gravity, walls=setup.walls)
     if not dsmc:  # the engine's own choice of neighbour mode ("auto" at the state's packing)
         what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     # a zero-length run compiles (or loads) the engine and builds its queue before
@@ -472,7 +484,8 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None)
+                            driven=sim.driving is not None, gravity=setup.gravity is not None,
+                            wall_kinds=setup.walls is not None and setup.walls.moving)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached

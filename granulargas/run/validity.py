@@ -77,9 +77,10 @@ from granulargas import theory
 from granulargas.contact import restitution_table
 from granulargas.contact.material import damping_from_prefactor, rho_from_material
 from granulargas.errors import ConfigError
-from granulargas.io.config import TABLE_BETA_MAX
+from granulargas.io.config import TABLE_BETA_MAX, RunConfig
 from granulargas.theory.moments import speed_quadrature
 from granulargas.run.prepare import mean_particle, reduced_prefactor
+from granulargas.run.vibrated import is_vibrated, scene_lines
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -220,9 +221,17 @@ class RunValidity:
     warnings: list = field(default_factory=list)
     errors: list = field(default_factory=list)
     driven: bool = False
+    #: a vibrated scene's lines (gravity, thermal or vibrating walls: :mod:`granulargas.run.vibrated`),
+    #: in place of the homogeneous gas's temperature range
+    scene: list = field(default_factory=list)
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
+        if self.scene:
+            out = [x for x in self.scene if not x.startswith("warning: ")]
+            out += [f"warning: {w}" for w in self.warnings]
+            out += [f"error: {e}" for e in self.errors]
+            return out
         if self.driven:
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady state of the driving, "
                    "Enskog theory)"]
@@ -312,6 +321,15 @@ def check_run(config) -> RunValidity:
     driving = getattr(config, "driving", None)
     if driving is not None and driving.heating_rate > 0.0:
         return _check_driven(config, gas)
+    if isinstance(config, RunConfig) and is_vibrated(config):
+        # the walls put energy in (or, under gravity alone, the gas comes to rest on the floor): no
+        # cooling curve to predict; the scene's numbers instead
+        lines = scene_lines(config)
+        rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, math.nan, scene=lines)
+        rv.tc_ratio = contact_time_ratio(gas)
+        _warn_contact(rv, gas, None)
+        rv.warnings += [x[len("warning: "):] for x in lines if x.startswith("warning: ")]
+        return rv
     src = gas.source
     spread = curve = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:

@@ -43,6 +43,10 @@ _MATERIAL = {
     "collision.duration": "resolved", "system.packing_fraction": 0.1, "collision.damping": None,
 }
 _DRIVEN = {"driving.model": "white_noise", "driving.heating_rate": 0.005}
+#: a floor under gravity; a vibrating floor (the loops of the flight and of the wall kinds)
+_GRAVITY = {"system.boundary": ["periodic", "periodic", "wall"], "gravity.acceleration": [0.0, 0.0, -0.1],
+            "collision.elastic_below": 1e-3}
+_WALLS = {**_GRAVITY, "walls.z_low.kind": "vibrating", "walls.z_low.amplitude": 0.05, "walls.z_low.frequency": 1.0}
 _DSMC = {"run.method": "dsmc", "system.particles": 256}
 
 
@@ -50,13 +54,25 @@ def _placement(config: RunConfig) -> bool:
     return config.run.method == "edmd" and not config.initial.from_file
 
 
-def _engine(mode: str, resolved: bool = False, driven: bool = False) -> Callable[[RunConfig, str], bool]:
+def scene_kind(config: RunConfig) -> str | None:
+    """The engine's flight and wall kinds: "walls" (thermal or vibrating walls, with or without
+    gravity), "gravity" (gravity, hard walls at rest) or None."""
+    if config.walls is not None and config.walls.moving:
+        return "walls"
+    if config.gravity is not None and any(config.gravity.vector):
+        return "gravity"
+    return None
+
+
+def _engine(mode: str, resolved: bool = False, driven: bool = False,
+            scene: str | None = None) -> Callable[[RunConfig, str], bool]:
     """Runs of the event-driven engine in neighbour mode ``mode`` (with collisions that take
-    time: ``resolved``; ``driven``: the driven ones only)."""
+    time: ``resolved``; ``driven``: the driven ones only; ``scene``: their :func:`scene_kind`)."""
     def uses(config: RunConfig, neighbours: str) -> bool:
         return (config.run.method == "edmd" and neighbours == mode
                 and (config.collision.duration == "resolved") == resolved
-                and (config.driving is not None or not driven))
+                and (config.driving is not None or not driven)
+                and scene_kind(config) == scene)
     return uses
 
 
@@ -114,6 +130,14 @@ VARIANTS = (
             _engine("lists", driven=True), after=("lists",)),
     Variant("cells-driven", "its driving step", {"run.neighbours": "cells", **_DRIVEN},
             _engine("cells", driven=True), after=("cells",)),
+    Variant("lists-gravity", "the neighbour-list engine under gravity", {"run.neighbours": "lists", **_GRAVITY},
+            _engine("lists", scene="gravity"), after=("lists",)),
+    Variant("cells-gravity", "the cell-crossing engine under gravity", {"run.neighbours": "cells", **_GRAVITY},
+            _engine("cells", scene="gravity"), after=("cells",)),
+    Variant("lists-walls", "the neighbour-list engine with thermal or vibrating walls",
+            {"run.neighbours": "lists", **_WALLS}, _engine("lists", scene="walls"), after=("lists-gravity",)),
+    Variant("cells-walls", "the cell-crossing engine with thermal or vibrating walls",
+            {"run.neighbours": "cells", **_WALLS}, _engine("cells", scene="walls"), after=("cells-gravity",)),
     Variant("resolved", "the engine of collisions that take time", {"run.neighbours": "lists", **_MATERIAL},
             _engine("lists", resolved=True), after=("placement", "lists")),
     Variant("resolved-driven", "its driving step", {"run.neighbours": "lists", **_MATERIAL, **_DRIVEN},
