@@ -64,6 +64,16 @@ BASES = {
         "run": {"collisions_per_particle": 1.0},
         "output": {"file": "out.h5"},
     },
+    "vibrated-2d": {
+        "system": {"dimension": 2, "particles": 64, "packing_fraction": 0.05, "seed": 6,
+                   "boundary": ["periodic", "wall"]},
+        "collision": {"model": "constant", "restitution": 0.9, "elastic_below": 0.001},
+        "gravity": {"acceleration": [0.0, -1.0]},
+        "walls": {"y_low": {"kind": "vibrating", "amplitude": 0.1, "frequency": 1.5, "waveform": "sine"},
+                  "y_high": {"kind": "thermal", "temperature": 1.0}},
+        "run": {"end_time": 1.0},
+        "output": dict(_OUTPUT),
+    },
     "tc-2d": {
         "system": {"dimension": 2, "particles": 100, "packing_fraction": 0.3, "seed": 5},
         "collision": {"model": "constant", "restitution": 0.5, "tc_time": 1e-3},
@@ -426,7 +436,7 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
     return Outcome(code, out.getvalue(), err.getvalue(), time.perf_counter() - start, fired.is_set(), exc)
 
 
-KEY_RE = re.compile(r"\b(system|particles|initial|collision|run|output)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
+KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|gravity|walls|run|output)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
 
 
 def check_outcome(o: Outcome, before: dict, after: dict, *, output_made: bool = True, long_runs: bool = False):
