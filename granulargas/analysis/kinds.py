@@ -16,6 +16,7 @@ from __future__ import annotations
 from granulargas.analysis.driven import analyze_driven
 from granulargas.analysis.elastic import analyze_elastic
 from granulargas.analysis.run import RunInfo, analyze_cooling
+from granulargas.analysis.vibrated import analyze_vibrated
 
 __all__ = ["ANALYSES", "analyze_file"]
 
@@ -24,6 +25,7 @@ ANALYSES = {
     "cooling": analyze_cooling,
     "elastic": analyze_elastic,
     "driven": analyze_driven,
+    "vibrated": analyze_vibrated,
 }
 
 

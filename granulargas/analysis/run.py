@@ -245,8 +245,13 @@ def _mean_particle_mass(radii, masses, dim) -> float:
 
 
 def run_kind(info: RunInfo) -> str:
-    """``"driven"`` (white-noise driving), ``"elastic"`` (energy conserved: eps = 1 or
-    damping 0) or ``"cooling"``."""
+    """``"vibrated"`` (gravity, thermal or vibrating walls), ``"driven"`` (white-noise
+    driving), ``"elastic"`` (energy conserved: eps = 1 or damping 0) or ``"cooling"``."""
+    walls = info.parameters.get("walls")
+    moving = isinstance(walls, dict) and any(isinstance(w, dict) and w.get("kind") in ("thermal", "vibrating")
+                                              for w in walls.values())
+    if isinstance(info.parameters.get("gravity"), dict) or moving:
+        return "vibrated"
     drv = info.parameters.get("driving")
     if isinstance(drv, dict) and float(drv.get("heating_rate", 0.0)) > 0.0:
         return "driven"

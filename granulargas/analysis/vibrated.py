@@ -28,7 +28,8 @@ import numpy as np
 
 from granulargas.analysis.elastic import block_mean
 
-__all__ = ["LayerAccumulator", "LayerProfile", "centre_of_mass", "energy_balance", "EnergyBalance"]
+__all__ = ["LayerAccumulator", "LayerProfile", "centre_of_mass", "energy_balance", "EnergyBalance", "steady_mean",
+           "VibratedAnalysis", "analyze_vibrated"]
 
 
 @dataclass(frozen=True)
@@ -185,3 +186,165 @@ def steady_mean(time, values, t_from: float | None = None):
     t = np.asarray(time, dtype=float)
     t_from = 0.5 * (t[0] + t[-1]) if t_from is None else float(t_from)
     return block_mean(np.asarray(values, dtype=float)[t >= t_from])
+
+
+# ------------------------------------------------------------------ a run's file
+#: layers of the profiles
+LAYERS = 40
+
+
+@dataclass(frozen=True)
+class VibratedAnalysis:
+    """A run under gravity or with thermal or vibrating walls (see :func:`analyze_vibrated`)."""
+
+    info: object  # granulargas.analysis.run.RunInfo
+    time: np.ndarray  # observables' times
+    temperature: np.ndarray
+    kinetic: np.ndarray
+    potential: np.ndarray
+    dissipated: np.ndarray
+    wall_work: np.ndarray
+    t_from: float  # the steady state (averages) from here on
+    axis: int  # the axis of the profiles
+    gravity: tuple | None
+    walls: dict  # side -> wall parameters (the file's parameters/walls)
+    profile: LayerProfile
+    com_time: np.ndarray
+    com: np.ndarray  # centre of mass along ``axis`` at the snapshots
+    balance: EnergyBalance
+    kind: str = "vibrated"
+
+    @property
+    def theory_name(self) -> str:
+        if self.hydrostatic is not None:
+            return "hydrostatic equilibrium dp/dz = -m g n, p = n T_w Z(n) (local density)"
+        if self.bed is not None:
+            return "dilute vibrated bed at leading order (Kumaran 1998; McNamara & Luding 1998)"
+        return "energy balance of the steady state (power in = power dissipated)"
+
+    @property
+    def g_axis(self) -> float:
+        """|g| along the axis of the profiles (0 without gravity)."""
+        return 0.0 if self.gravity is None else abs(self.gravity[self.axis])
+
+    @property
+    def column(self) -> float:
+        """Particles per unit floor area (length in 2D) across ``axis``."""
+        return self.info.particles / float(np.prod(np.delete(self.info.box, self.axis)))
+
+    @property
+    def elastic(self) -> bool:
+        return self.info.model == "elastic" or (self.info.model == "constant" and self.info.restitution == 1.0)
+
+    @property
+    def thermal_floor(self):
+        """T_w of a thermal wall the gas rests on under gravity (None otherwise)."""
+        if self.gravity is None or self.g_axis == 0:
+            return None
+        down = 0 if self.gravity[self.axis] < 0 else 1
+        w = self.walls.get("xyz"[self.axis] + ("_low", "_high")[down])
+        return float(w["temperature"]) if w and w.get("kind") == "thermal" else None
+
+    @property
+    def hydrostatic(self):
+        """The hydrostatic n(z) at the layer centres for an elastic gas on a thermal floor (None otherwise)."""
+        tw = self.thermal_floor
+        if tw is None or not self.elastic or any(w.get("kind") == "vibrating" for w in self.walls.values()):
+            return None
+        from granulargas.theory import vibrated as V
+
+        L = float(self.info.box[self.axis])
+        R = 0.5 * self.info.diameter
+        z = self.profile.centres
+        if self.gravity[self.axis] > 0:
+            z = L - z  # measured from the floor
+        return V.hydrostatic_density(z, self.column, tw, self.g_axis, self.info.mass, self.info.diameter,
+                                     self.info.dimension, bottom=R, top=L - R)
+
+    @property
+    def bed(self):
+        """(leading-order T, its small parameters) of a vibrating floor under gravity with a constant e < 1."""
+        if self.gravity is None or self.g_axis == 0 or self.info.model != "constant" or not (
+                self.info.restitution is not None and self.info.restitution < 1.0):
+            return None
+        down = 0 if self.gravity[self.axis] < 0 else 1
+        w = self.walls.get("xyz"[self.axis] + ("_low", "_high")[down])
+        if not w or w.get("kind") != "vibrating":
+            return None
+        from granulargas.engine.walls import Wall
+        from granulargas.theory import vibrated as V
+
+        wall = Wall.vibrating(w["amplitude"], w["frequency"], w["waveform"], w["phase"])
+        return V.bed_parameters(self.column, self.info.restitution, wall.amplitude, wall.mean_square_velocity,
+                                self.g_axis, self.info.dimension, self.info.diameter, self.info.mass)
+
+    @property
+    def steady(self) -> np.ndarray:
+        return self.time >= self.t_from
+
+    def summary(self) -> dict:
+        T, Te = block_mean(self.temperature[self.steady])
+        com, come = block_mean(self.com[self.com_time >= self.t_from]) if self.com.size else (math.nan, math.nan)
+        b = self.balance
+        out = {
+            "kind": self.kind, "model": self.info.model, "dimension": self.info.dimension,
+            "particles": self.info.particles, "t_final": float(self.time[-1]), "steady_from": self.t_from,
+            "axis": "xyz"[self.axis], "gravity": list(self.gravity) if self.gravity else None,
+            "T_steady": T, "T_steady_error": Te, "centre_of_mass": com, "centre_of_mass_error": come,
+            "power_in": b.power_in, "power_in_error": b.power_in_error, "dissipation": b.dissipation,
+            "dissipation_error": b.dissipation_error, "balance_ratio": b.ratio, "balance_ratio_error": b.ratio_error,
+            "theory": self.theory_name,
+        }
+        bed = self.bed
+        if bed is not None:
+            out.update(T_bed_theory=bed["temperature"], bed_dissipation=bed["dissipation"],
+                       bed_plate_speed=bed["plate_speed"], bed_amplitude=bed["amplitude"],
+                       bed_floor_packing=bed["floor_packing"])
+        if self.thermal_floor is not None:
+            out["T_wall"] = self.thermal_floor
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+
+
+def _scene_axis(gravity, walls: dict, boundary) -> int:
+    """The axis of the profiles: gravity's (its largest component), else the axis of a vibrating
+    or thermal wall, else the first wall axis."""
+    if gravity is not None and any(gravity):
+        return int(np.argmax(np.abs(gravity)))
+    for name, w in walls.items():
+        if w.get("kind") in ("vibrating", "thermal"):
+            return "xyz".index(name[0])
+    return next((a for a, b in enumerate(boundary) if b == "wall"), len(boundary) - 1)
+
+
+def analyze_vibrated(path, t_range=None, with_sonine: bool = True, **_) -> VibratedAnalysis:
+    """Analyse a run under gravity or with thermal or vibrating walls: the steady state (the
+    second half of the run, or ``t_range[0]`` on), its layer profiles along the axis of gravity
+    (or of the vibrating wall), the centre of mass at the snapshots and the energy balance."""
+    from granulargas.analysis.run import RunInfo
+    from granulargas.io.h5md import iter_snapshots, read_observables
+
+    info = RunInfo.from_file(path)
+    obs = read_observables(path)
+    t = obs["temperature"][1]
+
+    def series(name):
+        return obs[name][2] if name in obs else np.zeros_like(t)
+
+    params = info.parameters
+    g = params.get("gravity", {}).get("acceleration") if isinstance(params.get("gravity"), dict) else None
+    gravity = tuple(float(x) for x in np.ravel(g)) if g is not None else None
+    walls = params.get("walls", {}) if isinstance(params.get("walls"), dict) else {}
+    t_from = float(t_range[0]) if t_range else 0.5 * (float(t[0]) + float(t[-1]))
+    axis = _scene_axis(gravity, walls, info.boundary)
+    L = float(info.box[axis])
+    acc = LayerAccumulator(axis, np.linspace(0.0, L, LAYERS + 1), info.box)
+    com_t, com = [], []
+    for snap in iter_snapshots(path):
+        com_t.append(snap.time)
+        com.append(centre_of_mass(snap.positions, snap.masses, axis))
+        if snap.time >= t_from and with_sonine:
+            acc.add(snap.positions, snap.velocities, snap.masses)
+    balance = energy_balance(t, series("wall_work"), series("dissipated_energy"), t_from)
+    return VibratedAnalysis(info, t, obs["temperature"][2], series("kinetic_energy"), series("potential_energy"),
+                            series("dissipated_energy"), series("wall_work"), t_from, axis, gravity, walls,
+                            acc.profile(), np.asarray(com_t), np.asarray(com), balance)
