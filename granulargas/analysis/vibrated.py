@@ -337,13 +337,23 @@ def analyze_vibrated(path, t_range=None, with_sonine: bool = True, **_) -> Vibra
     t_from = float(t_range[0]) if t_range else 0.5 * (float(t[0]) + float(t[-1]))
     axis = _scene_axis(gravity, walls, info.boundary)
     L = float(info.box[axis])
-    acc = LayerAccumulator(axis, np.linspace(0.0, L, LAYERS + 1), info.box)
-    com_t, com = [], []
+    # the layers span the heights the gas reaches in the steady state (a bed fills a few
+    # gravitational heights of a tall box): up to the highest 0.2 % of the particles
+    com_t, com, top = [], [], 0.0
     for snap in iter_snapshots(path):
         com_t.append(snap.time)
         com.append(centre_of_mass(snap.positions, snap.masses, axis))
-        if snap.time >= t_from and with_sonine:
-            acc.add(snap.positions, snap.velocities, snap.masses)
+        if snap.time >= t_from:
+            z = snap.positions[:, axis]
+            top = max(top, float(np.quantile(z if gravity is None or gravity[axis] <= 0 else L - z, 0.998)))
+    span = min(L, 1.05 * top) if top > 0 and gravity is not None and gravity[axis] != 0 else L
+    edges = np.linspace(0.0, span, LAYERS + 1) if gravity is None or gravity[axis] <= 0 else \
+        np.linspace(L - span, L, LAYERS + 1)
+    acc = LayerAccumulator(axis, edges, info.box)
+    if with_sonine:
+        for snap in iter_snapshots(path):
+            if snap.time >= t_from:
+                acc.add(snap.positions, snap.velocities, snap.masses)
     balance = energy_balance(t, series("wall_work"), series("dissipated_energy"), t_from)
     return VibratedAnalysis(info, t, obs["temperature"][2], series("kinetic_energy"), series("potential_energy"),
                             series("dissipated_energy"), series("wall_work"), t_from, axis, gravity, walls,
