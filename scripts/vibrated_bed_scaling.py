@@ -36,17 +36,20 @@ def run_bed(column, speed, e, dim, amplitude, t_end, width, seed):
     u2 = 0.5 * speed**2
     p = V.bed_parameters(column, e, amplitude, u2, 1.0, dim)
     T_th = p["temperature"]
-    n = max(int(round(column * width ** (dim - 1))), 20)
+    n = max(int(round(column * width ** (dim - 1))), 100)
     width = (n / column) ** (1.0 / (dim - 1))  # the floor that holds n particles at this column
     height = max(12.0 * T_th, 30.0)
-    aspect = [width] * (dim - 1) + [height]
-    box_volume = np.prod(aspect)
+    # placed within about three gravitational heights (no potential energy to shed first), then
+    # given the tall box
+    low = max(3.0 * T_th, 12.0 * (column + 1.0), 10.0)
+    aspect = [width] * (dim - 1) + [low]
     unit = math.pi / 6.0 if dim == 3 else math.pi / 4.0
-    packing = n * unit / box_volume
+    packing = n * unit / np.prod(aspect)
     margins = np.zeros((dim, 2))
     margins[-1, 0] = 2.0 * amplitude
     st = random_state(n, packing, dim, temperature=T_th, seed=seed, aspect=aspect,
                       boundary=("periodic",) * (dim - 1) + ("wall",), margins=margins)
+    st = st.replace(box=np.array([width] * (dim - 1) + [max(height, low)]))
     nu = speed / (2.0 * math.pi * amplitude)
     walls = Walls(**{"xyz"[dim - 1] + "_low": Wall.vibrating(amplitude, nu)})
     g = [0.0] * (dim - 1) + [-1.0]

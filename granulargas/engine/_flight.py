@@ -82,11 +82,10 @@ def partner_at(j, dt, rec, flight):
     if flight is None:
         return (rec[j, 0] + rec[j, 3] * dt, rec[j, 1] + rec[j, 4] * dt, rec[j, 2] + rec[j, 5] * dt,
                 rec[j, 3], rec[j, 4], rec[j, 5])
-    wx = rec[j, 3] + flight[0] * dt
-    wy = rec[j, 4] + flight[1] * dt
-    wz = rec[j, 5] + flight[2] * dt
-    return (rec[j, 0] + 0.5 * (rec[j, 3] + wx) * dt, rec[j, 1] + 0.5 * (rec[j, 4] + wy) * dt,
-            rec[j, 2] + 0.5 * (rec[j, 5] + wz) * dt, wx, wy, wz)
+    h = 0.5 * dt * dt
+    return (rec[j, 0] + rec[j, 3] * dt + flight[0] * h, rec[j, 1] + rec[j, 4] * dt + flight[1] * h,
+            rec[j, 2] + rec[j, 5] * dt + flight[2] * h, rec[j, 3] + flight[0] * dt, rec[j, 4] + flight[1] * dt,
+            rec[j, 5] + flight[2] * dt)
 
 
 @inlined
@@ -112,6 +111,10 @@ def descend_root(h, u, a):
     when u > 0 (then only a < 0 brings the gap back). A touching gap (h <= 0) that
     closes (u < 0, or u = 0 and a < 0) gives 0; one that opens gives the later root.
     """
+    if a == 0.0:  # a straight gap (no acceleration along the axis): no square root
+        if u < 0.0:
+            return h / -u if h > 0.0 else 0.0
+        return math.inf
     if h <= 0.0:
         if u < 0.0 or (u == 0.0 and a < 0.0):
             return 0.0
@@ -174,12 +177,13 @@ def expiry_delay(dx, dy, dz, vx, vy, vz, radius, flight):
             window = 2.0 * math.sqrt(2.0 * radius / math.sqrt(g2)) if g2 > 0.0 else math.inf
             if window == math.inf:
                 return math.inf
-        c2 = w2 + ex * gx + ey * gy + ez * gz + abs(wx * gx + wy * gy + wz * gz) * window + 0.25 * g2 * window * window
+        slack = abs(wx * gx + wy * gy + wz * gz) * window + 0.25 * g2 * window * window
+        c2 = w2 + ex * gx + ey * gy + ez * gz + slack
         u = descend_root(-c0, -2.0 * (ex * wx + ey * wy + ez * wz), -2.0 * c2)
         if u > window:
             u = window
         s += u
-        if -c0 < EXPIRY_SLACK * r2:
+        if -c0 < EXPIRY_SLACK * r2 or slack < EXPIRY_SLACK * w2:  # close, or the bound nearly exact
             break
     return s
 

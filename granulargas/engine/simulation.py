@@ -540,14 +540,11 @@ class Simulation:
                              wallkinds=self._wallkinds())
 
     def _flight(self):
-        """The flight the kernels take: None (straight) or the (3,) gravity vector; zeros with
-        thermal or vibrating walls and no gravity (one compiled loop serves walls with and
-        without gravity)."""
-        if self.gravity is None and self._wallkinds() is None:
+        """The flight the kernels take: None (straight) or the (3,) gravity vector."""
+        if self.gravity is None:
             return None
         g = np.zeros(3)
-        if self.gravity is not None:
-            g[: self.dimension] = self.gravity
+        g[: self.dimension] = self.gravity
         return g
 
     def _wallkinds(self):
