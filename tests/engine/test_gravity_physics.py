@@ -5,7 +5,10 @@
   profile dp/dz = -m g n with p = n T_w Z(n) from the project's equation of state
   (:func:`granulargas.theory.vibrated.hydrostatic_density`) -- within the statistical error
   (block means over snapshots). The layers within 1.5 diameters of the floor and the lid are
-  left out: the local-density approximation does not describe the layering at a wall.
+  left out: the local-density approximation does not describe the layering at a wall, whose
+  excess of particles at contact also leaves the bulk a little short of the column's mean;
+  the hydrostatic equation is local, so the profile is compared in shape, with its
+  normalisation fitted over the inner layers (one parameter).
 * A steady vibrated bed puts in what it dissipates.
 """
 
@@ -13,6 +16,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.optimize import minimize_scalar
 
 from granulargas.analysis.vibrated import LayerAccumulator, energy_balance
 from granulargas.engine import CollisionRule, Simulation, Wall, Walls
@@ -59,11 +63,20 @@ def _check_equilibrium(st, prof, counts, v2, edges, g, tw, d, blocks=40):
     with np.errstate(invalid="ignore", divide="ignore"):
         tb = vb / (d * cb)
     centres = 0.5 * (edges[1:] + edges[:-1])
-    column = st.n / section
-    theory = V.hydrostatic_density(centres, column, tw, g, 1.0, 1.0, d, bottom=0.5, top=L - 0.5)
-    baro = V.barometric_density(centres, column, tw, g, 1.0, bottom=0.5, top=L - 0.5)
     inner = (centres > 1.5) & (centres < L - 1.5) & (cb.min(axis=0) > 20)
     lda = (g / tw) ** 2  # (sigma / ell)^2
+
+    def fitted(profile):
+        """The profile (a function of the column) with the column that fits the inner layers best."""
+        def chi2(c):
+            p = profile(c)
+            return float(np.sum(((n_mean - p) / np.hypot(n_err, lda * p))[inner] ** 2))
+        c = minimize_scalar(chi2, bounds=(0.8 * st.n / section, 1.2 * st.n / section), method="bounded",
+                            options={"xatol": 1e-9}).x
+        return profile(c)
+
+    theory = fitted(lambda c: V.hydrostatic_density(centres, c, tw, g, 1.0, 1.0, d, bottom=0.5, top=L - 0.5))
+    baro = fitted(lambda c: V.barometric_density(centres, c, tw, g, 1.0, bottom=0.5, top=L - 0.5))
     z = (n_mean - theory) / np.hypot(n_err, lda * theory)
     assert np.mean(z[inner] ** 2) < 2.5 and np.max(np.abs(z[inner])) < 4.0, (z[inner], n_mean[inner], theory[inner])
     # the equation of state matters: the barometric law is refused near the floor
