@@ -29,16 +29,15 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
-
 from granulargas import theory
 from granulargas.analysis.elastic import block_mean
-from granulargas.analysis.run import CoolingHistory, RunInfo, _clean, cooling_history, sonine_history
+from granulargas.analysis.run import (CoolingHistory, RunInfo, _clean, cooling_history, run_identity,
+                                      sonine_history)
 
 __all__ = ["DrivenAnalysis", "analyze_driven", "RELAXATION_TIMES", "RELAXATION_FRACTION"]
 
 #: cooling times 1/zeta(T_ss) left out as relaxation
-RELAXATION_TIMES = 5.0
+RELAXATION_TIMES = theory.driven.RELAXATION_TIMES
 #: ... and at least this fraction of the run
 RELAXATION_FRACTION = 0.1
 
@@ -116,15 +115,10 @@ class DrivenAnalysis:
         return m - bias, e
 
     def temperature_theory(self, t) -> np.ndarray:
-        """T(t) from T0 by ``dT/dt = H - zeta(T) T`` (zeta ~ sqrt(T) at the steady a2 and eps)."""
-        t = np.asarray(t, dtype=float)
-        T0 = float(self.history.temperature[0])
-        if not math.isfinite(self.theory.temperature):
-            return T0 + self.heating_rate * (t - t[0])
-        z = self.theory.cooling_rate / math.sqrt(self.theory.temperature)
-        sol = solve_ivp(lambda _, y: [self.heating_rate - z * y[0] ** 1.5], (t[0], t[-1]), [T0],
-                        t_eval=t, rtol=1e-10, atol=1e-14 * T0, method="LSODA")
-        return sol.y[0]
+        """T(t) from T0 by ``dT/dt = H - zeta(T) T`` (zeta ~ sqrt(T) at the steady a2 and eps;
+        :func:`granulargas.theory.relaxation_temperature`)."""
+        return theory.relaxation_temperature(t, float(self.history.temperature[0]), self.heating_rate,
+                                             self.theory.temperature)
 
     def summary(self) -> dict:
         """JSON-friendly numbers (``granulargas analyze --json``)."""
@@ -132,10 +126,7 @@ class DrivenAnalysis:
         a2, a2_err = self.a2_mean
         th = self.theory
         return _clean({
-            "kind": self.kind,
-            "model": self.info.model,
-            "dimension": self.info.dimension,
-            "particles": self.info.particles,
+            **run_identity(self.info, self.kind),
             "t_final": float(self.time[-1]),
             "T_final": float(self.history.temperature[-1]),
             "theory": th.name,

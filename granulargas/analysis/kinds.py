@@ -8,7 +8,8 @@ that analyses such a file. Every analysis object has ``kind``, ``info``
 report and the figure of each kind are registered in
 :mod:`granulargas.cli.analyze` and :mod:`granulargas.analysis.plots`. A new kind
 of run (a driven steady state, say) plugs in by adding its entry here, a branch
-in ``run_kind`` and its report and figure there.
+in ``run_kind`` and its report and figure there. A file whose collision model is
+not recorded (kind ``"unknown"``) is refused with one line: no theory applies.
 """
 
 from __future__ import annotations
@@ -17,8 +18,10 @@ from granulargas.analysis.driven import analyze_driven
 from granulargas.analysis.elastic import analyze_elastic
 from granulargas.analysis.run import RunInfo, analyze_cooling
 from granulargas.analysis.vibrated import analyze_vibrated
+from granulargas.errors import InputFileError
+from granulargas.io.scene import MODELS
 
-__all__ = ["ANALYSES", "analyze_file"]
+__all__ = ["ANALYSES", "analyze_file", "unknown_model"]
 
 #: kind -> analysis function ``f(path, **options)``
 ANALYSES = {
@@ -35,5 +38,18 @@ def analyze_file(path, **options):
     ``options`` go to the kind's function (``t_range``, ``with_sonine`` for cooling
     runs; ``with_sonine`` for elastic ones).
     """
-    kind = RunInfo.from_file(path).kind
-    return ANALYSES[kind](path, **options)
+    info = RunInfo.from_file(path)
+    if info.kind == "unknown":
+        raise InputFileError(unknown_model(info))
+    return ANALYSES[info.kind](path, **options)
+
+
+def unknown_model(info) -> str:
+    """The line that refuses a file whose collision model the analysis does not know."""
+    coll = info.parameters.get("collision")
+    given = coll.get("model") if isinstance(coll, dict) else None
+    what = ("records no collision model (parameters/collision/model)" if given is None else
+            f"records collision model {given!r} without its parameters" if given in MODELS else
+            f"records collision model {given!r}, which the analysis does not know")
+    return (f"{info.path}: {what}, so there is no kinetic theory to compare it with; a run built in Python "
+            "records its model when written with granulargas.run.record.RunWriter (docs/engine.md)")

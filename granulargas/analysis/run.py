@@ -55,6 +55,7 @@ from granulargas.analysis.cooling import (
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import InputFileError
 from granulargas.io.h5md import iter_snapshots, load_snapshot, read_observables, read_parameters
+from granulargas.io.scene import Scene
 from granulargas.theory.gas import CoolingCurve, Gas, cooling_curve, hcs_of, pressure_factor, relaxation_collisions
 from granulargas.theory.hcs import FIRST_SONINE
 
@@ -138,6 +139,7 @@ class RunInfo:
     solid_fraction: float = math.nan  # sum of the particle volumes over the box volume
     boundary: tuple = ()  # "periodic" or "wall" per axis
     method: str = "edmd"  # "dsmc": a homogeneous gas without positions (velocities only)
+    scene: Scene = field(default_factory=Scene)  # the kind of run: which comparisons apply
 
     @classmethod
     def from_file(cls, path) -> "RunInfo":
@@ -163,6 +165,8 @@ class RunInfo:
                                  / float(np.prod(snap.box))),
             boundary=tuple(snap.boundary) or ("periodic",) * int(snap.box.shape[0]),
             method=str(params.get("method", "edmd")),
+            scene=Scene.from_parameters(params, int(snap.box.shape[0]), tuple(snap.boundary), radii, masses,
+                                        snap.contact_until is not None),
         )
 
     @property
@@ -246,20 +250,9 @@ def _mean_particle_mass(radii, masses, dim) -> float:
 
 def run_kind(info: RunInfo) -> str:
     """``"vibrated"`` (gravity, thermal or vibrating walls), ``"driven"`` (white-noise
-    driving), ``"elastic"`` (energy conserved: eps = 1 or damping 0) or ``"cooling"``."""
-    walls = info.parameters.get("walls")
-    moving = isinstance(walls, dict) and any(isinstance(w, dict) and w.get("kind") in ("thermal", "vibrating")
-                                              for w in walls.values())
-    if isinstance(info.parameters.get("gravity"), dict) or moving:
-        return "vibrated"
-    drv = info.parameters.get("driving")
-    if isinstance(drv, dict) and float(drv.get("heating_rate", 0.0)) > 0.0:
-        return "driven"
-    if info.model == "constant" and info.restitution is not None and info.restitution < 1.0:
-        return "cooling"
-    if info.model == "viscoelastic" and info.prefactor:
-        return "cooling"
-    return "elastic"
+    driving), ``"elastic"`` (energy conserved: eps = 1 or damping 0), ``"cooling"``, or ``"unknown"`` (the file does not record its collision
+    model, :class:`granulargas.io.scene.Scene`)."""
+    return info.scene.kind
 
 
 def theory_name(info: RunInfo) -> str:
@@ -581,7 +574,7 @@ class CoolingAnalysis:
             "Z": self.Z,
             "Z_theory": self.Z_theory,
             "instability_length": p.instability_length,
-            "box": float(info.box.max()),
+            "box": float(info.box.max()) if info.scene.space else None,  # a DSMC's box only sets the density
         })
 
 
@@ -589,7 +582,7 @@ def run_identity(info: RunInfo, kind: str) -> dict:
     """The first keys of every ``analyze --json`` summary: the file and the gas it holds."""
     return {"file": info.path, "kind": kind, "model": info.model, "dimension": info.dimension,
             "particles": info.particles, "packing_fraction": info.packing_fraction,
-            "monodisperse": info.monodisperse}
+            "monodisperse": info.monodisperse, "scene": {**info.scene.as_dict(), "text": info.scene.describe()}}
 
 
 def history_span(h: CoolingHistory) -> dict:

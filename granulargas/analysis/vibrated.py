@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from granulargas.analysis.elastic import block_mean
+from granulargas.analysis.run import run_identity
 
 __all__ = ["LayerAccumulator", "LayerProfile", "centre_of_mass", "energy_balance", "EnergyBalance", "steady_mean",
            "VibratedAnalysis", "analyze_vibrated"]
@@ -287,8 +288,7 @@ class VibratedAnalysis:
         com, come = block_mean(self.com[self.com_time >= self.t_from]) if self.com.size else (math.nan, math.nan)
         b = self.balance
         out = {
-            "kind": self.kind, "model": self.info.model, "dimension": self.info.dimension,
-            "particles": self.info.particles, "t_final": float(self.time[-1]), "steady_from": self.t_from,
+            **run_identity(self.info, self.kind), "t_final": float(self.time[-1]), "steady_from": self.t_from,
             "axis": "xyz"[self.axis], "gravity": list(self.gravity) if self.gravity else None,
             "T_steady": T, "T_steady_error": Te, "centre_of_mass": com, "centre_of_mass_error": come,
             "power_in": b.power_in, "power_in_error": b.power_in_error, "dissipation": b.dissipation,

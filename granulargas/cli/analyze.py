@@ -67,15 +67,17 @@ def _dev(value, ref):
 def _header(info) -> list[str]:
     lines = [
         f"{info.path}",
-        f"  {info.dimension}D, N = {info.particles}, box = {' x '.join(_fmt(float(L)) for L in info.box)}, "
-        f"packing fraction = {info.packing_fraction:.4g}, model = {info.model}"
+        f"  {info.dimension}D, N = {info.particles}, "
+        + (f"box = {' x '.join(_fmt(float(L)) for L in info.box)}, " if info.scene.space else
+           f"number density = {info.number_density:.4g}, ")
+        + f"packing fraction = {info.packing_fraction:.4g}, model = {info.model}"
         + (f" (restitution {info.restitution:g})" if info.restitution is not None and info.model == "constant" else "")
         + (f" (damping {info.damping:.4g})" if info.damping is not None else ""),
     ]
     if info.method == "dsmc":
         lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; the pressure is not "
                      "sampled)")
-    if not info.monodisperse:
+    if info.scene.shows("polydisperse_theory"):
         lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
                      f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
                      f"same number density (packing {info.packing_fraction:.4g})")
@@ -94,10 +96,11 @@ def cooling_report(a, rows: int = 10) -> str:
     info, p, h = a.info, a.prediction, a.history
     lines = _header(info)
     lines.append(f"  theory: {a.theory_name}")
+    space = info.scene.shows("instability")  # a DSMC run has no box to compare with L_c
     lines.append(f"  closed form ({p.name}): T0 = {p.T0:.4g}, tau0 = {_fmt(p.tau0)}, "
-                 f"exponent = -{p.exponent:.4g}; mean free path = {p.mean_free_path:.4g}, "
-                 f"instability length L_c = {_fmt(p.instability_length)}")
-    if math.isfinite(p.instability_length):
+                 f"exponent = -{p.exponent:.4g}; mean free path = {p.mean_free_path:.4g}"
+                 + (f", instability length L_c = {_fmt(p.instability_length)}" if space else ""))
+    if space and math.isfinite(p.instability_length):
         L = float(info.box.max())
         side = "below" if L < p.instability_length else "ABOVE"
         lines.append(f"  box length {L:.4g} is {side} L_c ({p.instability_length:.4g})"
@@ -179,9 +182,10 @@ def elastic_report(a, rows: int = 10) -> str:
     if a.info.walls:
         lines.append("  (walls: Z and the collision frequency below use the mean density of the whole box, "
                      "depleted next to the walls; the wall pressure against the bulk density is the test)")
-    lines.append(f"  Z = P/(nT) = {_pm(s['Z'], s['Z_error'])}; {s['Z_theory_name']} {s['Z_theory']:.5g}"
-                 f"{_dev(s['Z'], s['Z_theory'])}; {s['Z_reference_name']} {s['Z_reference']:.5g}"
-                 f"{_dev(s['Z'], s['Z_reference'])}")
+    if a.info.scene.shows("pressure"):  # DSMC samples no pressure
+        lines.append(f"  Z = P/(nT) = {_pm(s['Z'], s['Z_error'])}; {s['Z_theory_name']} {s['Z_theory']:.5g}"
+                     f"{_dev(s['Z'], s['Z_theory'])}; {s['Z_reference_name']} {s['Z_reference']:.5g}"
+                     f"{_dev(s['Z'], s['Z_reference'])}")
     lines.append(f"  collision frequency per particle {_pm(s['collision_frequency'], s['collision_frequency_error'])}; "
                  f"Enskog {s['collision_frequency_theory']:.5g}"
                  f"{_dev(s['collision_frequency'], s['collision_frequency_theory'])}")

@@ -153,6 +153,32 @@ def _describe(fld) -> str:
     return fld.description + (" (kept for exact restarts)" if fld.restart_only else "")
 
 
+#: every dataset the writer creates carries HDF5's Fletcher-32 checksum (verified on each read)
+CHECKSUMS = True
+
+
+def _dataset(group, name, **kwargs):
+    """``group.create_dataset(name, **kwargs)`` with the Fletcher-32 checksum filter (chunked
+    storage; HDF5 checks every chunk when it is read, :func:`_read`)."""
+    return group.create_dataset(name, fletcher32=CHECKSUMS, **kwargs)
+
+
+def write_text(group, name, text: str):
+    """A text as a one-element dataset of fixed-length UTF-8 bytes (checksummed like every
+    dataset; a variable-length string cannot carry the filter). :func:`read_text` reads it."""
+    data = text.encode("utf-8")
+    return _dataset(group, name, data=np.array([data], dtype=f"S{max(len(data), 1)}"), chunks=(1,))
+
+
+def read_text(ds) -> str:
+    """The text of a dataset written by :func:`write_text` (or a variable-length string of an
+    older file)."""
+    value = _read(ds)
+    if isinstance(value, np.ndarray) and value.shape == (1,):
+        value = value[0]
+    return value.decode("utf-8") if isinstance(value, bytes) else str(value)
+
+
 class H5MDWriter:
     """Append-only H5MD writer for one run.
 
@@ -239,7 +265,7 @@ class H5MDWriter:
                 part = f["particles/all"]
                 self.positions = has_positions(f)
                 self.fields = wanted
-                self.box = np.ascontiguousarray(part["box/edges/value"][frames - 1], dtype=np.float64)
+                self.box = np.ascontiguousarray(_read(part["box/edges/value"], frames - 1), dtype=np.float64)
                 self.boundary = read_boundary(f)
                 names = [FIELDS[x].element for x in self.fields] + ["box/edges"]
                 names += [] if self.positions else [f"dsmc/{k}" for k in DSMC_STATE]
@@ -266,10 +292,10 @@ class H5MDWriter:
         """Record the last frame as the state at which a signal stopped the run (written off the
         schedule, unless the stop fell on a scheduled frame)."""
         g = self.file["parameters"]
-        old = list(g["interrupted_frames"][()]) if "interrupted_frames" in g else []
+        old = list(_read(g["interrupted_frames"])) if "interrupted_frames" in g else []
         if "interrupted_frames" in g:
             del g["interrupted_frames"]
-        g.create_dataset("interrupted_frames", data=np.asarray(old + [self.frames - 1], dtype=np.int64))
+        _dataset(g, "interrupted_frames", data=np.asarray(old + [self.frames - 1], dtype=np.int64))
         g["interrupted_frames"].attrs["description"] = (
             "frames at which a signal stopped the run (the state reached; off the output schedule unless "
             "the stop fell on a scheduled frame)")
@@ -301,12 +327,12 @@ class H5MDWriter:
             fld = FIELDS[name]
             g = part.create_group(fld.element)
             if step is None:  # the first element owns the frames' clock
-                step = g.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(256,))
-                time = g.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(256,))
+                step = _dataset(g, "step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(256,))
+                time = _dataset(g, "time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(256,))
             else:
                 g["step"], g["time"] = step, time  # hard links: one clock for all frames
             tail = fld.shape(d)
-            g.create_dataset("value", shape=(0, n) + tail, maxshape=(None, n) + tail, dtype=fld.dtype,
+            _dataset(g, "value", shape=(0, n) + tail, maxshape=(None, n) + tail, dtype=fld.dtype,
                              chunks=_frame_chunks(n, tail))
             g.attrs["description"] = _describe(fld)
             groups.append(g)
@@ -320,17 +346,17 @@ class H5MDWriter:
                 tail = tuple(d if x == "d" else x for x in tail)
                 g = dg.create_group(name)
                 g["step"], g["time"] = step, time
-                g.create_dataset("value", shape=(0,) + tail, maxshape=(None,) + tail, dtype=dtype,
+                _dataset(g, "value", shape=(0,) + tail, maxshape=(None,) + tail, dtype=dtype,
                                  chunks=(256,) + tail)
                 groups.append(g)
         e = b.create_group("edges")
         e["step"], e["time"] = step, time
-        e.create_dataset("value", shape=(0, d), maxshape=(None, d), dtype=np.float64, chunks=(256, d))
+        _dataset(e, "value", shape=(0, d), maxshape=(None, d), dtype=np.float64, chunks=(256, d))
         groups.append(e)
         self._frame_groups = groups
         for fld in PARTICLE_FIELDS:
             if not fld.per_frame:  # time-independent: written once
-                part.create_dataset(fld.element, data=state.array(fld.name))
+                _dataset(part, fld.element, data=state.array(fld.name))
                 part[fld.element].attrs["description"] = _describe(fld)
 
         obs = f.create_group("observables")
@@ -341,11 +367,11 @@ class H5MDWriter:
             dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
             g = obs.create_group(name)
             if step is None:
-                step = g.create_dataset("step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(1024,))
-                time = g.create_dataset("time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(1024,))
+                step = _dataset(g, "step", shape=(0,), maxshape=(None,), dtype=np.int64, chunks=(1024,))
+                time = _dataset(g, "time", shape=(0,), maxshape=(None,), dtype=np.float64, chunks=(1024,))
             else:
                 g["step"], g["time"] = step, time  # hard links: one clock for all observables
-            g.create_dataset("value", shape=(0,) + shape, maxshape=(None,) + shape, dtype=dtype,
+            _dataset(g, "value", shape=(0,) + shape, maxshape=(None,) + shape, dtype=dtype,
                              chunks=(1024,) + shape)
             self._obs[name] = g
         self._obs_clock = (step, time)
@@ -470,15 +496,15 @@ def _continuation_point(f, path, state: State, fields) -> tuple[int, int]:
                                  "continue it with the same collision model")
     frames = _frame_count(f)
     clock = _clock_name(f)
-    if frames == 0 or int(part[f"{clock}/step"][frames - 1]) != step or float(
-            part[f"{clock}/time"][frames - 1]) != time:
+    if frames == 0 or int(_read(part[f"{clock}/step"], frames - 1)) != step or float(
+            _read(part[f"{clock}/time"], frames - 1)) != time:
         raise InputFileError(f"{path}: its last frame is not the state the continuation starts from")
     names = list(f["observables"])
     for name in tuple(x for x in SCALAR_OBSERVABLES if x not in OPTIONAL_OBSERVABLES) + ("momentum",):
         g = f["observables"].get(name)
         if not isinstance(g, h5py.Group) or any(not isinstance(g.get(p), h5py.Dataset) for p in ("step", "time", "value")):
             raise InputFileError(f"{path}: damaged H5MD file: observables/{name} is missing or incomplete")
-    obs_step, obs_time = f["observables/temperature/step"][()], f["observables/temperature/time"][()]
+    obs_step, obs_time = _read(f["observables/temperature/step"]), _read(f["observables/temperature/time"])
     hits = np.nonzero((obs_step == step) & (obs_time == time))[0]
     if len(hits) == 0:
         raise InputFileError(f"{path}: no observables sample at its last frame (t = {time:g})")
@@ -506,14 +532,16 @@ def _write_parameters(group, params: dict):
             continue
         if isinstance(value, dict):
             _write_parameters(group.require_group(key), value)
-        elif isinstance(value, np.ndarray):
+        elif isinstance(value, np.ndarray) and value.ndim > 0:
             if key in group:
                 del group[key]
-            group.create_dataset(key, data=value)
+            _dataset(group, key, data=value)
         elif isinstance(value, str) and (len(value) > 200 or "\n" in value):
             if key in group:
                 del group[key]
-            group.create_dataset(key, data=value, dtype=h5py.string_dtype())
+            write_text(group, key, value)
+        elif isinstance(value, np.ndarray):
+            group.attrs[key] = value.item()
         elif isinstance(value, (list, tuple)):
             group.attrs[key] = np.asarray(value)
         else:
@@ -662,6 +690,22 @@ def _check_layout(f, path):
         raise InputFileError(f"{path}: damaged H5MD file: parameters/ is missing")
 
 
+def _read(ds, selection=()):
+    """``ds[selection]``; a read that fails (a Fletcher-32 checksum mismatch, damaged storage)
+    raises :class:`InputFileError` with one line naming the file and the element (and the
+    frame, for an integer selection)."""
+    try:
+        return ds[selection]
+    except (OSError, RuntimeError) as exc:
+        where = ds.name.lstrip("/")
+        if isinstance(selection, (int, np.integer)):
+            where += f", frame {int(selection)}" if where.startswith("particles/") else f", row {int(selection)}"
+        checksum = ds.fletcher32 and "filter" in str(exc).lower()
+        why = ("checksum mismatch (Fletcher-32): the stored data changed after they were written" if checksum
+               else f"unreadable ({_short(exc)})")
+        raise InputFileError(f"{ds.file.filename}: damaged H5MD file: {where}: {why}") from None
+
+
 @contextmanager
 def _damaged(path, what: str):
     """Turn what h5py raises on damaged content into one line naming the file and the element."""
@@ -688,11 +732,11 @@ def _frame_count(f) -> int:
 def _snapshot(f, k, static) -> Snapshot:
     part = f["particles/all"]
     radii, masses, species, boundary = static
-    lc = part["last_collision/value"][k] if "last_collision" in part else None
+    lc = _read(part["last_collision/value"], k) if "last_collision" in part else None
     snap = _read_snapshot(part, k, radii, masses, species, lc, boundary)
     if "contact_until" in part and "contact_partner" in part:
-        snap = dataclasses.replace(snap, contact_until=part["contact_until/value"][k],
-                                   contact_partner=part["contact_partner/value"][k])
+        snap = dataclasses.replace(snap, contact_until=_read(part["contact_until/value"], k),
+                                   contact_partner=_read(part["contact_partner/value"], k))
     for name in ("positions", "velocities", "box") if snap.positions is not None else ("velocities", "box"):
         if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")
@@ -706,12 +750,12 @@ def _read_snapshot(part, k, radii, masses, species, lc, boundary) -> Snapshot:
     clock = part["position" if positions else "velocity"]
     return Snapshot(
         index=k,
-        time=float(clock["time"][k]),
-        step=int(clock["step"][k]),
-        positions=part["position/value"][k] if positions else None,
-        velocities=part["velocity/value"][k],
-        images=part["image/value"][k] if positions else None,
-        box=part["box/edges/value"][k],
+        time=float(_read(clock["time"], k)),
+        step=int(_read(clock["step"], k)),
+        positions=_read(part["position/value"], k) if positions else None,
+        velocities=_read(part["velocity/value"], k),
+        images=_read(part["image/value"], k) if positions else None,
+        box=_read(part["box/edges/value"], k),
         radii=radii,
         masses=masses,
         species=species,
@@ -722,12 +766,12 @@ def _read_snapshot(part, k, radii, masses, species, lc, boundary) -> Snapshot:
 
 def _static(f):
     part = f["particles/all"]
-    radii, masses = part["radius"][()], part["mass"][()]
+    radii, masses = _read(part["radius"]), _read(part["mass"])
     for name, values in (("radius", radii), ("mass", masses)):
         if not np.all(np.isfinite(values) & (values > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: particles/all/{name} holds non-finite or "
                                  "non-positive values")
-    return radii, masses, part["species"][()], read_boundary(f)
+    return radii, masses, _read(part["species"]), read_boundary(f)
 
 
 def read_boundary(f) -> tuple:
@@ -790,15 +834,16 @@ def read_state(path, index: int = -1) -> State:
             values = {}
             for fld in PARTICLE_FIELDS:
                 if fld.element in part:
-                    values[fld.name] = part[f"{fld.element}/value"][k] if fld.per_frame else part[fld.element][()]
+                    values[fld.name] = (_read(part[f"{fld.element}/value"], k) if fld.per_frame
+                                        else _read(part[fld.element]))
             clock = part[_clock_name(f)]
-            time, step = float(clock["time"][k]), int(clock["step"][k])
+            time, step = float(_read(clock["time"], k)), int(_read(clock["step"], k))
             counters = _counters_at(f, path, step, time, k)
             dsmc = None
             if "dsmc" in part:
                 g = part["dsmc"]
-                dsmc = DSMCContinuation(**{name: g[name]["value"][k] for name in DSMC_STATE})
-            return State(box=part["box/edges/value"][k], boundary=read_boundary(f), time=time, events=step,
+                dsmc = DSMCContinuation(**{name: _read(g[name]["value"], k) for name in DSMC_STATE})
+            return State(box=_read(part["box/edges/value"], k), boundary=read_boundary(f), time=time, events=step,
                          dsmc=dsmc, **{"positions": None, **values}, **counters)
 
 
@@ -810,7 +855,7 @@ def _counters_at(f, path, step: int, time: float, k: int) -> dict:
             raise InputFileError(f"{path}: damaged H5MD file: observables/{name} is missing")
     g = obs["collisions"]
     m = min(g["step"].shape[0], g["time"].shape[0], g["value"].shape[0])
-    hits = np.nonzero((g["step"][:m] == step) & (g["time"][:m] == time))[0]
+    hits = np.nonzero((_read(g["step"], slice(0, m)) == step) & (_read(g["time"], slice(0, m)) == time))[0]
     if len(hits) == 0:
         raise InputFileError(f"{path}: no observables sample at snapshot {k} (t = {time:g})")
     sample = int(hits[-1])
@@ -820,7 +865,7 @@ def _counters_at(f, path, step: int, time: float, k: int) -> dict:
             value = obs[name]["value"]
             if sample >= value.shape[0]:
                 raise InputFileError(f"{path}: damaged H5MD file: observables/{name} ends before snapshot {k}")
-            out[name] = dtype(value[sample]).item()
+            out[name] = dtype(_read(value, sample)).item()
     return out
 
 
@@ -828,7 +873,7 @@ def interrupted_frames(path) -> list[int]:
     """Indices of the frames at which a signal stopped the run (:meth:`H5MDWriter.mark_interrupted`)."""
     with open_run(path) as f, _damaged(path, "parameters/interrupted_frames"):
         g = f["parameters"]
-        return [int(k) for k in g["interrupted_frames"][()]] if "interrupted_frames" in g else []
+        return [int(k) for k in _read(g["interrupted_frames"])] if "interrupted_frames" in g else []
 
 
 def read_observables(path) -> dict:
@@ -849,7 +894,8 @@ def read_observables(path) -> dict:
                     raise InputFileError(f"{path}: damaged H5MD file: observables/{name} has step/time/value "
                                          f"of shapes {g['step'].shape}, {g['time'].shape}, {g['value'].shape}")
                 n = min(g["step"].shape[0], g["time"].shape[0], g["value"].shape[0])
-                out[name] = (g["step"][:n], g["time"][:n], g["value"][:n])
+                out[name] = (_read(g["step"], slice(0, n)), _read(g["time"], slice(0, n)),
+                             _read(g["value"], slice(0, n)))
                 values = out[name][2]
                 if not np.all(np.isfinite(out[name][1])) or (  # NaN: a sample the writer was not given
                         name in ("temperature", "kinetic_energy") and np.any((values < 0) | np.isinf(values))):
@@ -882,8 +928,10 @@ def _read_group(g) -> dict:
     for k, v in g.items():
         if isinstance(v, h5py.Group):
             out[k] = _read_group(v)
+        elif v.dtype.kind in "SO" and v.shape in ((), (1,)):
+            out[k] = read_text(v)
         elif v.dtype.kind in "SO":
-            out[k] = _decode(v[()])
+            out[k] = _decode(_read(v))
         else:
-            out[k] = v[()]
+            out[k] = _read(v)
     return out

@@ -44,6 +44,15 @@ advice predicts, with kinetic theory and no simulation
    among the config's particles (:func:`fastest_impact_bounds`) is beyond its table,
    which the run would refuse.
 
+Every line applies to the config's scene (:class:`granulargas.io.scene.Scene`,
+:data:`granulargas.io.scene.STATEMENTS`): steps 2-4 compare cooling curves and are
+made for cooling gases only; a driven gas is predicted by its relaxation towards the
+steady temperature of the driving (:func:`granulargas.run.validity.driven_end`, the
+theory ``granulargas analyze`` compares with) and told how many relaxation times the
+run lasts; an elastic gas keeps T0; step 5 needs space, so a DSMC config (whose box
+only sets the density) is told instead how long a box of its gas could be. The
+predicted temperature at the end is the run summary's (:func:`granulargas.run.validity.check_run`).
+
 For a constant-eps config the advice reports the config ``damping`` (beta at
 g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
@@ -60,7 +69,7 @@ Runner API: :func:`summary_line` ``(config, tolerance=DEFAULT_TOLERANCE) -> str 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
@@ -68,10 +77,12 @@ from scipy.optimize import brentq, minimize_scalar
 from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import ConfigError
+from granulargas.io.scene import Scene
 from granulargas.run import validity as V
 from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds, reduced_compression,
                                      reduced_prefactor)
-from granulargas.run.vibrated import is_vibrated, scene_lines
+from granulargas.run import vibrated as vibrated_scene
+from granulargas.theory.driven import RELAXATION_TIMES
 from granulargas.theory.gas import cooling_curve
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
@@ -81,6 +92,11 @@ __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_er
 
 #: default tolerance on the relative error of T(t)
 DEFAULT_TOLERANCE = 0.02
+
+#: T / T_theory at the end of ``granulargas run configs/polydisperse_3d.toml`` (diameters uniform in
+#: [0.7, 1.3], t = 100; ``granulargas analyze``, over the last 10 % of the time): the theory of
+#: identical particles of the mean diameter misses the mix's cooling by this much
+POLYDISPERSE_MEASURED = 0.917
 
 #: largest packing fraction for which advise recommends DSMC. Enskog's equation neglects the
 #: velocity correlations of a dense gas; at packing 0.02 the engine's T(t) and a2(t) agree
@@ -217,8 +233,10 @@ def dsmc_speedup(packing: float) -> float:
 
 def choose_method(config, instability_length: float = math.inf, duration: str | None = None) -> tuple[str, str]:
     """("dsmc" or "edmd", the reason in words) for a config's scene (module docstring, 6.);
-    ``duration``: the advised collision duration (:func:`choose_duration`), "resolved" or "dem"
-    rule DSMC out."""
+    ``instability_length``: L_c of a cooling gas, compared with the config's box (inf: no
+    such test, as for a driven or elastic gas, and for a DSMC config, whose box only sets
+    the sample size); ``duration``: the advised collision duration (:func:`choose_duration`),
+    "resolved" or "dem" rule DSMC out."""
     s, c = config.system, config.collision
     eta = s.packing_fraction
     if getattr(config, "gravity", None) is not None:
@@ -231,28 +249,36 @@ def choose_method(config, instability_length: float = math.inf, duration: str | 
         return "edmd", "collisions that take time need positions (DSMC's collisions are instantaneous)"
     if duration in ("resolved", "dem"):
         return "edmd", "the contacts last long enough to matter (duration below; DSMC's collisions are instantaneous)"
-    box = _box(config)
+    box = V.box_length(config)
     if box > instability_length:
         return "edmd", (f"the box {box:.4g} exceeds the instability length {instability_length:.4g}: "
                         "clusters and shear modes grow, which DSMC (no space) cannot show")
     if eta > DSMC_MAX_PACKING:
         return "edmd", (f"packing fraction {eta:g} > {DSMC_MAX_PACKING:g}: velocity correlations of a dense gas, "
                         "which the Enskog-Boltzmann equation of DSMC neglects, matter")
-    return "dsmc", (f"homogeneous and dilute (packing {eta:g} <= {DSMC_MAX_PACKING:g}, box below the "
-                    "instability length): DSMC solves the same Enskog-Boltzmann equation with the same "
-                    "collision rule")
+    below = ", box below the instability length" if math.isfinite(instability_length) else ""
+    return "dsmc", (f"homogeneous and dilute (packing {eta:g} <= {DSMC_MAX_PACKING:g}{below}): DSMC solves the same "
+                    "Enskog-Boltzmann equation with the same collision rule")
 
 
 @dataclass
 class Advice:
-    """The advice for one config (numbers; :meth:`lines` formats them).
+    """The advice for one config (numbers; :meth:`lines` formats them, :meth:`summary` gives JSON).
 
     Attributes
     ----------
     model : str
     tolerance : float
     t_end, T_end : float
-        Predicted run end time and final temperature.
+        Predicted run end time and the temperature then, in units of T0: the run summary's
+        prediction (:func:`granulargas.run.validity.check_run`).
+    scene : Scene
+        The kind of run (:class:`granulargas.io.scene.Scene`); every line applies to it.
+    T0 : float
+        The initial temperature (``initial.temperature``).
+    T_steady, relaxation_time : float
+        Driven runs: the steady temperature of the driving (units of T0) and the cooling time
+        1/zeta(T_ss) in which the gas relaxes to it; nan otherwise.
     spread : dict or None
         :func:`granulargas.run.validity.restitution_spread` over the run.
     eps_best : float or None
@@ -265,7 +291,10 @@ class Advice:
         gas has the same initial cooling rate.
     constant_ok : bool or None
     box, instability_length : float
-        Box edge and the shear-instability length at T0.
+        Box edge and the shear-instability length at T0 (cooling gases).
+    T_stable_instability : float
+        Viscoelastic gas in a box above L_c: the temperature (units of T0) at which the growing
+        L_c passes the box (:func:`granulargas.run.validity.stable_temperature`); nan otherwise.
     method, method_reason : str
         The model the scene needs (:func:`choose_method`) and why.
     speedup : float
@@ -275,6 +304,8 @@ class Advice:
     duration, duration_reason : str or None
         The collision duration the contact time needs (:func:`choose_duration`) and why;
         None off the material route.
+    validity : list of str
+        The run summary's checks that the lines above do not state (t_c/t_free, warnings).
     notes : list of str
     """
 
@@ -282,6 +313,10 @@ class Advice:
     tolerance: float
     t_end: float
     T_end: float
+    scene: Scene = field(default_factory=Scene)
+    T0: float = 1.0
+    T_steady: float = math.nan
+    relaxation_time: float = math.nan
     spread: dict | None = None
     eps_best: float | None = None
     error: float | None = None
@@ -289,38 +324,70 @@ class Advice:
     constant_ok: bool | None = None
     box: float = math.nan
     instability_length: float = math.nan
+    T_stable_instability: float = math.nan
     method: str = "edmd"
     method_reason: str = ""
     speedup: float = math.nan
     configured_method: str = "edmd"
     duration: str | None = None
     duration_reason: str = ""
+    validity: tuple = ()
     notes: tuple = ()
     #: a vibrated scene's lines (:func:`granulargas.run.vibrated.scene_lines`), in place of the cooling advice
-    scene: tuple = ()
+    vibrated: tuple = ()
+    #: a vibrated scene's numbers (:func:`granulargas.run.vibrated.scene`), for JSON
+    vibrated_numbers: dict = field(default_factory=dict)
+
+    def _run_line(self) -> str:
+        sc = self.scene
+        head = f"run          T 1 -> {self.T_end:.3g} T0 by t = {self.t_end:.4g}"
+        if sc.kind == "driven" and math.isfinite(self.T_steady):
+            return (f"{head}, relaxing to the steady state T_ss = {self.T_steady:.4g} T0 of the driving "
+                    "(Enskog theory, first Sonine)")
+        if sc.kind == "driven":
+            return f"{head} (elastic collisions heated by the driving: T0 + H t, no steady state)"
+        if sc.kind == "elastic":
+            return f"{head} (elastic collisions conserve the energy)"
+        return f"{head} (homogeneous cooling, kinetic theory)"
 
     def lines(self) -> list[str]:
-        if self.scene:
-            name = {"dsmc": "DSMC", "edmd": "EDMD"}[self.method]
-            return list(self.scene) + [f"method       {name}: {self.method_reason}"]
-        out = [f"run          T {1:g} -> {self.T_end:.3g} T0 by t = {self.t_end:.4g} (kinetic theory)"]
+        sc = self.scene
+        # a vibrated scene has no free cooling to predict: its own numbers instead
+        out = list(self.vibrated) if sc.kind == "vibrated" else [self._run_line()]
         if self.model == "elastic":
             out.append("advice       elastic collisions: nothing to choose")
-        if self.spread is not None:
+        if sc.kind == "driven" and math.isfinite(self.relaxation_time):
+            n = self.t_end / self.relaxation_time if math.isfinite(self.t_end) else math.nan
+            relaxed = RELAXATION_TIMES * self.relaxation_time
+            enough = ("" if not math.isfinite(n) or relaxed < self.t_end else
+                      f"; too short: granulargas analyze averages the steady state after {RELAXATION_TIMES:g} of "
+                      f"them (t = {relaxed:.4g})")
+            out.append(f"steady state relaxation time 1/zeta(T_ss) = {self.relaxation_time:.4g}; the run lasts "
+                       f"{n:.3g} of them{enough}")
+        if self.spread is not None and sc.shows("eps_spread"):
             sp = self.spread
+            span = "from T0 to the steady state" if sc.kind == "driven" else "start to end"
             out.append(f"eps spread   {sp['eps_min']:.4f} .. {sp['eps_max']:.4f} (beta {sp['beta_max']:.3g} .. "
-                       f"{sp['beta_min']:.3g}) over thermal impacts, start to end")
-        if self.model == "viscoelastic" and self.eps_best is not None:
-            verdict = "a constant eps will do" if self.constant_ok else "keep the viscoelastic rule"
-            out.append(f"best const.  eps = {self.eps_best:.4f}: T(t) off by up to {100 * self.error:.2g} % "
-                       f"(tolerance {100 * self.tolerance:g} %) -> {verdict}")
-        if self.model == "constant" and self.damping_equivalent is not None:
-            out.append(f"equivalent   damping = {self.damping_equivalent:.4g} cools at the same initial rate; "
-                       f"its T(t) departs from Haff's by up to {100 * self.error:.2g} % over this run")
-        if math.isfinite(self.instability_length):
+                       f"{sp['beta_min']:.3g}) over thermal impacts, {span}")
+        if sc.shows("constant_or_viscoelastic"):
+            if self.model == "viscoelastic" and self.eps_best is not None and self.spread is not None:
+                verdict = "a constant eps will do" if self.constant_ok else "keep the viscoelastic rule"
+                out.append(f"best const.  eps = {self.eps_best:.4f}: T(t) off by up to {100 * self.error:.2g} % "
+                           f"(tolerance {100 * self.tolerance:g} %) -> {verdict}")
+            if self.model == "constant" and self.damping_equivalent is not None:
+                out.append(f"equivalent   damping = {self.damping_equivalent:.4g} cools at the same initial rate; "
+                           f"its T(t) departs from Haff's by up to {100 * self.error:.2g} % over this run")
+        if sc.shows("instability") and math.isfinite(self.instability_length):
             rel = "above" if self.box > self.instability_length else "below"
+            until = (f" until T = {self.T_stable_instability:.3g} T0, where the growing L_c passes the box"
+                     if math.isfinite(self.T_stable_instability) else "")
             out.append(f"clustering   box {self.box:.4g} is {rel} the shear-instability length "
-                       f"{self.instability_length:.4g} (homogeneous cooling {'un' if rel == 'above' else ''}stable)")
+                       f"{self.instability_length:.4g} at T0 (homogeneous cooling {'un' if rel == 'above' else ''}stable"
+                       f"{until})")
+        if sc.shows("homogeneous_by_construction") and math.isfinite(self.instability_length):
+            out.append(f"homogeneous  DSMC has no space: it simulates the homogeneous gas, whatever the sample size; "
+                       f"a box of this gas in space clusters if longer than L_c = {self.instability_length:.4g} "
+                       "(at T0)")
         if self.method_reason:
             name = {"dsmc": "DSMC", "edmd": "EDMD"}[self.method]
             speed = (f"; about x{self.speedup:.3g} the collisions per CPU second of EDMD (scripts/bench_dsmc.py, "
@@ -331,7 +398,42 @@ class Advice:
         if self.duration is not None:
             out.append(f"duration     {self.duration}: {self.duration_reason}")
         out += [f"note         {n}" for n in self.notes]
+        out += list(self.validity)
         return out
+
+    def summary(self) -> dict:
+        """The advice as a flat, JSON-ready dict (``granulargas advise --json``): the scene, the
+        predicted end (``temperature_end`` in the config's units, ``temperature_end_ratio`` = T/T0)
+        and every number of the lines."""
+        sp = self.spread or {}
+        out = {
+            "scene": {**self.scene.as_dict(), "text": self.scene.describe()},
+            "model": self.model,
+            "t_end": self.t_end,
+            "temperature_start": self.T0,
+            "temperature_end": self.T_end * self.T0,
+            "temperature_end_ratio": self.T_end,
+            "temperature_steady": self.T_steady * self.T0,
+            "relaxation_time": self.relaxation_time,
+            "eps_min": sp.get("eps_min"),
+            "eps_max": sp.get("eps_max"),
+            "eps_best": self.eps_best if self.scene.shows("constant_or_viscoelastic") else None,
+            "constant_error": self.error if self.scene.shows("constant_or_viscoelastic") else None,
+            "constant_ok": self.constant_ok if self.scene.shows("constant_or_viscoelastic") else None,
+            "damping_equivalent": self.damping_equivalent,
+            "tolerance": self.tolerance,
+            "box": self.box if self.scene.space else None,
+            "instability_length": self.instability_length,
+            "method": self.method,
+            "method_reason": self.method_reason,
+            "configured_method": self.configured_method,
+            "dsmc_speedup": self.speedup if self.method == "dsmc" else None,
+            "duration": self.duration,
+            "notes": list(self.notes),
+            "validity": list(self.validity),
+            "vibrated": self.vibrated_numbers or None,
+        }
+        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
 
 
 def _haff(gas: V.Gas, eps: float, t):
@@ -362,13 +464,6 @@ def best_constant(gas: V.Gas, curve: V.CoolingCurve, t_end: float):
     return math.sqrt(1.0 - q), min(float(res.fun), float(errs[k]))
 
 
-def _box(config) -> float:
-    """Box edge of the config's gas (particles of the mean diameter)."""
-    s = config.system
-    sigma, _ = mean_particle(config)
-    return (s.particles * float(theory.particle_volume(sigma, s.dimension)) / s.packing_fraction) ** (1.0 / s.dimension)
-
-
 def _equivalent_prefactor(gas: V.Gas, eps: float) -> float | None:
     """Prefactor k whose viscoelastic gas has (1 - eps^2)_eff(T0) = 1 - eps^2; None if no beta
     at the thermal impact speed up to 20 gives it (eps below what the table's range reaches)."""
@@ -397,30 +492,44 @@ def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.Cooling
 
 
 def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
-    """Advice on the collision rule for a config (module doc)."""
+    """Advice on the collision rule for a config (module doc); every line applies to the
+    config's scene (:class:`granulargas.io.scene.Scene`)."""
     gas = V.gas_from_config(config)
     table = V.table_range_error(gas)
     if table:
         raise ConfigError(table)
-    if is_vibrated(config):  # no free cooling: the scene's numbers (granulargas.run.vibrated)
-        adv = Advice(gas.model, tolerance, math.nan, math.nan, box=_box(config), scene=tuple(scene_lines(config)))
-        _set_method(adv, config)
-        return adv
-    t_end, T_end = V.run_temperature_range(gas)
-    adv = Advice(gas.model, tolerance, t_end, T_end / gas.temperature, box=_box(config))
+    scene = Scene.from_config(config)
+    rv = V.check_run(config)  # the run summary's prediction: one predicted end for both
+    T0 = gas.temperature
+    t_end = rv.t_end
+    adv = Advice(gas.model, tolerance, t_end, rv.T_end / T0, scene=scene, T0=T0, box=V.box_length(config),
+                 spread=rv.spread)
+    if scene.kind == "vibrated":  # the scene's lines lead; the checks after them
+        adv.vibrated = tuple(rv.vibrated)
+        adv.vibrated_numbers = vibrated_scene.scene(config)
+        checks = [ln for ln in rv.lines() if ln not in rv.vibrated]
+    else:
+        checks = rv.lines()[1:]
+    adv.validity = tuple(ln for ln in checks
+                         if not ln.startswith("validity     beta") and ln != f"warning: {rv.instability_warning}")
     notes = []
+    if scene.kind == "driven":
+        adv.T_steady = rv.T_steady / T0
+        if math.isfinite(rv.T_steady):
+            adv.relaxation_time = rv.T_steady / config.driving.heating_rate  # 1/zeta(T_ss) = T_ss / H
+    if scene.shows("instability") or scene.shows("homogeneous_by_construction"):
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+            adv.instability_length = gas.instability_length()
+        adv.T_stable_instability = rv.T_stable / T0
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
-        curve = V.viscoelastic_cooling(gas)
-        t_end, T_end = V.run_temperature_range(gas, curve)
-        curve = _curve_through(gas, curve, t_end)
-        adv.t_end, adv.T_end = t_end, T_end / gas.temperature
-        adv.spread = V.restitution_spread(gas, gas.temperature, T_end)
-        adv.eps_best, adv.error = best_constant(gas, curve, t_end)
-        adv.constant_ok = adv.error <= tolerance
-        adv.instability_length = gas.instability_length()
         chosen = choose_duration(config, tolerance)
         if chosen is not None:
             adv.duration, adv.duration_reason = chosen
+    if scene.shows("constant_or_viscoelastic") and gas.model == "viscoelastic":
+        curve = V.viscoelastic_cooling(gas)
+        curve = _curve_through(gas, curve, t_end)
+        adv.eps_best, adv.error = best_constant(gas, curve, t_end)
+        adv.constant_ok = adv.error <= tolerance
         if config.collision.duration == "resolved" or adv.duration in ("resolved", "dem"):
             ratio = V.contact_time_ratio(config)
             share = "" if ratio is None else (f"; of the order of {100 * (1 - math.exp(-2 * ratio)):.2g} % of the collisions "
@@ -430,50 +539,52 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         elif adv.constant_ok:
             notes.append(f'use [collision] model = "constant", restitution = {adv.eps_best:.4f} '
                          "(cost per collision is nearly the same; the gain is a closed-form reference, Haff's law)")
-    elif gas.model == "viscoelastic":
+    elif gas.model == "viscoelastic" and not gas.pair_constant > 0:
         adv.constant_ok = True
         adv.eps_best, adv.error = 1.0, 0.0
         notes.append("damping = 0: the collisions are elastic; use model = \"elastic\"")
-    elif gas.model == "constant" and gas.restitution < 1.0:
+    elif scene.shows("constant_or_viscoelastic") and gas.model == "constant":
         eps = gas.restitution
+        adv.eps_best = eps
         k = _equivalent_prefactor(gas, eps)
-        adv.eps_best = eps
         if k is None:
-            adv.notes = (f"eps = {eps:g}: no viscoelastic damping within the restitution table's range cools "
-                         "at this rate",)
-            _set_method(adv, config)
-            return adv
-        ve = replace(gas, model="viscoelastic", prefactor=k)
-        curve = V.viscoelastic_cooling(ve)
-        curve = _curve_through(ve, curve, t_end)
-        adv.damping_equivalent = damping_from_prefactor(k)
-        adv.eps_best = eps
-        adv.error = constant_error(ve, eps, curve, t_end)
-        adv.constant_ok = adv.error <= tolerance
-        adv.instability_length = gas.instability_length()
-        if gas.tc_time is None and (eps <= 0.7 or (gas.dimension == 2 and gas.packing_fraction >= 0.3)):
-            notes.append(f"eps = {eps:g} without tc_time: dense or strongly inelastic regions can collapse "
-                         "(InelasticCollapseError); set [collision] tc_time (TC model) or use the viscoelastic "
-                         "rule (scripts/collapse_demo.py)")
+            notes.append(f"eps = {eps:g}: no viscoelastic damping within the restitution table's range cools "
+                         "at this rate")
+        else:
+            ve = replace(gas, model="viscoelastic", prefactor=k)
+            curve = _curve_through(ve, V.viscoelastic_cooling(ve), t_end)
+            adv.damping_equivalent = damping_from_prefactor(k)
+            adv.error = constant_error(ve, eps, curve, t_end)
+            adv.constant_ok = adv.error <= tolerance
+    if scene.shows("collapse") and (gas.restitution <= 0.7 or (gas.dimension == 2 and gas.packing_fraction >= 0.3)):
+        notes.append(f"eps = {gas.restitution:g} without tc_time: dense or strongly inelastic regions can collapse "
+                     "(InelasticCollapseError); set [collision] tc_time (TC model) or use the viscoelastic "
+                     "rule (scripts/collapse_demo.py)")
+    if scene.shows("polydisperse_theory"):
+        notes.append(f"polydisperse: the predictions are those of identical particles of the mean diameter "
+                     f"{gas.sigma:.4g} (mass {gas.mass:.4g}) at the config's number density (packing "
+                     f"{gas.packing_fraction:.4g}), as granulargas analyze compares; the mix cools at a rate of "
+                     f"its own (configs/polydisperse_3d.toml ends at {POLYDISPERSE_MEASURED:g} of them)")
     adv.notes = tuple(notes)
     _set_method(adv, config)
     return adv
 
 
 def _set_method(adv: Advice, config):
-    length = adv.instability_length if math.isfinite(adv.instability_length) else math.inf
+    length = adv.instability_length if adv.scene.shows("instability") else math.inf
     adv.method, adv.method_reason = choose_method(config, length, adv.duration)
     adv.speedup = dsmc_speedup(config.system.packing_fraction)
     adv.configured_method = config.run.method
 
 
 def method_line(config) -> str | None:
-    """One line for the run summary of a DSMC config whose scene needs positions (box above
-    the instability length, dense gas): the DSMC answer is that of a homogeneous Enskog gas.
-    None otherwise (walls and the TC model are refused by the config rules)."""
+    """One line for the run summary of a DSMC config whose scene needs positions (a dense
+    gas): the DSMC answer is that of a homogeneous Enskog gas. None otherwise (walls and the
+    TC model are refused by the config rules; the box of a DSMC config only sets its sample
+    size, so it is not compared with the instability length)."""
     if config.run.method != "dsmc":
         return None
-    method, reason = choose_method(config, V.gas_from_config(config).instability_length())
+    method, reason = choose_method(config)
     if method == "dsmc":
         return None
     return (f"warning      run.method = \"dsmc\": {reason}; this run shows the homogeneous Enskog-Boltzmann gas "
@@ -483,17 +594,13 @@ def method_line(config) -> str | None:
 def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
     """One line for the run summary: the eps spread and whether a constant eps would do.
 
-    Returns None for elastic and driven runs (the advice compares cooling curves).
+    Returns None where the scene has no such comparison (elastic and driven runs: the advice
+    compares cooling curves).
     """
-    driving = getattr(config, "driving", None)
-    if driving is not None and driving.heating_rate > 0.0:
-        return None
-    if is_vibrated(config):  # no free cooling to compare (the run summary shows the scene)
+    if not Scene.from_config(config).shows("constant_or_viscoelastic"):
         return None
     adv = advise(config, tolerance)
-    if adv.model == "elastic" or adv.eps_best is None:
-        return None
-    if adv.model == "viscoelastic" and adv.spread is not None:
+    if adv.model == "viscoelastic" and adv.spread is not None and adv.eps_best is not None:
         sp = adv.spread
         verdict = "would do" if adv.constant_ok else "would not do"
         return (f"advice       eps {sp['eps_min']:.3f}..{sp['eps_max']:.3f} over the run; best constant "

@@ -56,12 +56,12 @@ from granulargas._numba import CompileWatch, announcement
 from granulargas.engine import Simulation
 from granulargas.errors import ConfigError, InelasticCollapseError, InputFileError, SimulationError, UserError
 from granulargas.io.config import RunConfig, parse_config
-from granulargas.io.h5md import H5MDWriter, read_parameters
+from granulargas.io.h5md import H5MDWriter, read_parameters, read_text
 from granulargas.io.paths import existing_directory, output_file
-from granulargas.observables import sonine_coefficients
 from granulargas.run.advise import RESOLVED_THREE_BODY_CHECKED
 from granulargas.run.dsmc_run import make_dsmc
 from granulargas.run.prepare import prepare
+from granulargas.run.record import observables as _observables  # one sample, as RunWriter takes it
 from granulargas.run.variants import describe, variants_for
 from granulargas.run.schedule import (  # noqa: F401  (re-exported: the runner's public names)
     DEFAULT_OBSERVABLE_SAMPLES,
@@ -327,38 +327,6 @@ def stored_fields(config: RunConfig, sim) -> tuple:
         return ()
     tc = config.collision.model == "constant" and config.collision.tc_time is not None
     return (("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if sim.rule.resolved else ())
-
-
-def _observables(sim, pressure: bool) -> dict:
-    if hasattr(sim, "observables"):  # a DSMC run (run.dsmc_run.DSMCRun)
-        return sim.observables()
-    a2, a3 = sonine_coefficients(sim.velocities, sim.masses)
-    out = {
-        "temperature": float(sim.temperature),
-        "kinetic_energy": float(sim.kinetic_energy),
-        "collisions": int(sim.collisions),
-        "events": int(sim.events),
-        "dissipated_energy": float(sim.dissipated_energy),
-        "momentum": np.asarray(sim.momentum, dtype=np.float64),
-        "pressure": float(sim.pressure_window()) if pressure else math.nan,
-        "sonine_a2": float(a2),
-        "sonine_a3": float(a3),
-    }
-    if sim.gravity is not None:
-        out["potential_energy"] = float(sim.potential_energy)
-    if "wall" in sim.boundary:
-        out["wall_collisions"] = int(sim.wall_collisions)
-        if (sim.walls is not None and sim.walls.moving) or sim.gravity is not None:  # a vibrated scene
-            out["wall_work"] = float(sim.wall_work)
-            # the momentum per wall over the interval (read before the wall pressure resets it)
-            out["wall_impulse"] = sim.wall_impulse() if pressure else np.full((sim.dimension, 2), math.nan)
-        out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
-    if sim.driving is not None:
-        out["injected_energy"] = float(sim.injected_energy)
-        out["kick_step"] = int(sim.kick_step)
-    if sim.rule.resolved:
-        out["three_body_contacts"] = int(sim.three_body_contacts)
-    return out
 
 
 def collapse_message(config: RunConfig, where: str) -> str:
@@ -630,8 +598,7 @@ def _continuation_record(writer, config: RunConfig, setup, st) -> dict:
     (``config``) and, under ``continuations/<k>``, where it started and the config it replaced."""
     g = writer.file["parameters"]
     k = len(g["continuations"]) if "continuations" in g else 0
-    previous = g["config"][()] if "config" in g else b""
-    previous = previous.decode() if isinstance(previous, bytes) else str(previous)
+    previous = read_text(g["config"]) if "config" in g else ""
     return {
         "config": setup.parameters["config"],
         "config_source": setup.parameters["config_source"],

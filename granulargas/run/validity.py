@@ -48,15 +48,21 @@ same float (zero-time events). For an elastic gas this bounds the run to about
 ``1e-6 2^52 = 4.5e9`` mean free times; a cooling gas, whose event spacing grows
 with t, stays resolved much longer.
 
-Centre-of-mass drift
---------------------
-Zero total momentum holds only to round-off: the centre-of-mass velocity stays
-at ~1e-16 of the *initial* thermal speed (measured: 7e-17 for 300 particles).
-When the thermal speed falls below it (T/T0 ~ 1e-32) the whole gas drifts,
-neighbour-list events per collision grow without bound (x500 by T/T0 = 1e-40,
-``tests/engine/test_stability.py``), though collisions stay right. We warn when
-the predicted ``T_end / T0 < DRIFT_T_RATIO = 1e-30``; the remedy is a restart
-with the centre-of-mass velocity removed.
+The shear instability
+---------------------
+A homogeneous cooling gas in a periodic box longer than the shear-instability
+length ``L_c`` (:meth:`granulargas.theory.gas.Gas.instability_length`, at T0)
+develops shear modes and then clusters (Goldhirsch & Zanetti 1993); its T(t) then
+leaves the homogeneous prediction (T/T_theory grew to 6 by 100 collisions per
+particle for 1000 disks at packing 0.05, eps = 0.8, box 1.4 L_c). The run summary
+warns for such an engine run (:class:`granulargas.io.scene.Scene`: cooling, with
+space); a viscoelastic gas's L_c grows as it cools, so its clusters may dissolve
+later. DSMC has no space and stays homogeneous; a driven or elastic gas has no
+such instability.
+
+The engine and DSMC both remove the centre-of-mass velocity that round-off leaves
+(:meth:`granulargas.engine.Simulation.run`, :class:`granulargas.dsmc.DSMC`), so a
+gas cooling by many decades needs no restart for it.
 
 Runner API (one line each, for the run summary)
 -----------------------------------------------
@@ -78,9 +84,10 @@ from granulargas.contact import restitution_table
 from granulargas.contact.material import damping_from_prefactor, rho_from_material
 from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX, RunConfig
+from granulargas.io.scene import Scene
 from granulargas.theory.moments import speed_quadrature
 from granulargas.run.prepare import mean_particle, reduced_prefactor
-from granulargas.run.vibrated import is_vibrated, scene_lines
+from granulargas.run.vibrated import scene_lines
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -108,6 +115,9 @@ __all__ = [
     "viscoelastic_cooling",
     "run_temperature_range",
     "contact_time_ratio",
+    "box_length",
+    "mean_particle_volume",
+    "driven_end",
     "check_run",
     "summary_lines",
     "raise_if_invalid",
@@ -117,9 +127,6 @@ __all__ = [
 TC_RATIO_WARN = 0.01
 #: refuse runs whose predicted final temperature (in units of m, reduced) falls below this
 UNDERFLOW_T = 1e-250
-#: warn when the predicted T_end / T0 falls below this: the centre-of-mass velocity left by
-#: round-off (~1e-16 of the initial thermal speed) then overtakes the thermal speed
-DRIFT_T_RATIO = 1e-30
 #: the float64 clock must resolve this fraction of the time between a particle's events
 CLOCK_RESOLUTION = 1e-6
 #: beta above which the viscoelastic force is questionable (contact.material.BETA_VALID_MAX)
@@ -137,16 +144,33 @@ class RunGas(Gas):
     duration: str = "instantaneous"
 
 
+def mean_particle_volume(config) -> float:
+    """Mean volume of the config's particles: that of the diameter for identical ones; for
+    diameters uniform in [a, b], ``<sigma^d> = (b^(d+1) - a^(d+1)) / ((d + 1)(b - a))`` times
+    the volume prefactor."""
+    s, p = config.system, config.particles
+    d = s.dimension
+    if not p.polydisperse or p.diameter_max <= p.diameter_min:
+        return float(theory.particle_volume(p.diameter, d))
+    a, b = p.diameter_min, p.diameter_max
+    moment = (b ** (d + 1) - a ** (d + 1)) / ((d + 1) * (b - a))
+    return float(theory.particle_volume(1.0, d)) * moment
+
+
 def gas_from_config(config) -> RunGas:
     """The gas of a :class:`~granulargas.io.config.RunConfig`: particles of the mean
-    diameter (:func:`granulargas.run.prepare.mean_particle`), the reduced prefactor
+    diameter (:func:`granulargas.run.prepare.mean_particle`) at the config's number density
+    (``system.packing_fraction`` over the mean particle volume, :func:`mean_particle_volume`;
+    the gas's packing fraction is that of mean-diameter particles at that density, as
+    ``granulargas analyze`` takes it), the reduced prefactor
     (:func:`granulargas.run.prepare.reduced_prefactor`), the stop conditions."""
     s, c = config.system, config.collision
     d = s.dimension
     sigma, mass = mean_particle(config)
     k = float(reduced_prefactor(config)) if c.model == "viscoelastic" else None
+    density = s.packing_fraction / mean_particle_volume(config)
     return RunGas(
-        dimension=d, packing_fraction=s.packing_fraction, density=float(theory.number_density(s.packing_fraction, d, sigma)),
+        dimension=d, packing_fraction=float(theory.packing_fraction(density, d, sigma)), density=float(density),
         sigma=sigma, mass=mass, temperature=config.initial.temperature, model=c.model, restitution=c.restitution,
         prefactor=k, end=c.contact_end, end_time=config.run.end_time,
         collisions_per_particle=config.run.collisions_per_particle,
@@ -202,12 +226,23 @@ class RunValidity:
 
     Attributes
     ----------
-    t_end, t_start, T_end : float
-        Predicted end time, T0 and final temperature.
+    t_end, T_start, T_end : float
+        Predicted end time, T0 and the temperature at the end (a driven run: on its way
+        from T0 to the steady temperature ``T_steady``).
     spread : dict or None
         :func:`restitution_spread` over the run (viscoelastic only).
     tc_ratio : float or None
         :func:`contact_time_ratio` at T0.
+    scene : Scene
+        The kind of run (:class:`granulargas.io.scene.Scene`): which checks apply.
+    box, instability_length : float
+        Longest box edge and the shear-instability length at T0 (cooling engine runs;
+        otherwise nan).
+    T_stable : float
+        A viscoelastic gas in a box above L_c at T0: the temperature at which its growing
+        L_c passes the box (nan if it does not during the run, or for other gases).
+    T_steady : float
+        Driven runs: the steady temperature of the driving (nan otherwise).
     warnings, errors : list of str
         One-line messages; errors mean the run cannot be right.
     """
@@ -220,21 +255,39 @@ class RunValidity:
     tc_ratio: float | None = None
     warnings: list = field(default_factory=list)
     errors: list = field(default_factory=list)
-    driven: bool = False
+    scene: Scene = field(default_factory=Scene)
+    box: float = math.nan
+    instability_length: float = math.nan
+    T_steady: float = math.nan
+    instability_warning: str | None = None
+    T_stable: float = math.nan
     #: a vibrated scene's lines (gravity, thermal or vibrating walls: :mod:`granulargas.run.vibrated`),
     #: in place of the homogeneous gas's temperature range
-    scene: list = field(default_factory=list)
+    vibrated: list = field(default_factory=list)
+
+    @property
+    def driven(self) -> bool:
+        return self.scene.kind == "driven"
+
+    @property
+    def unstable(self) -> bool:
+        """A cooling engine run in a box longer than the shear-instability length."""
+        return self.box > self.instability_length
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
-        if self.scene:
-            out = [x for x in self.scene if not x.startswith("warning: ")]
+        if self.vibrated:
+            out = [x for x in self.vibrated if not x.startswith("warning: ")]
             out += [f"warning: {w}" for w in self.warnings]
             out += [f"error: {e}" for e in self.errors]
             return out
-        if self.driven:
-            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady state of the driving, "
-                   "Enskog theory)"]
+        if self.driven and math.isfinite(self.T_steady):
+            at = f"at t = {self.t_end:.4g}; " if math.isfinite(self.t_end) else ""
+            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} ({at}steady state of the driving "
+                   f"{self.T_steady:.4g}, Enskog theory)"]
+        elif self.driven:
+            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (elastic collisions heated by the "
+                   f"driving, T0 + H t; predicted by t = {self.t_end:.4g})"]
         else:
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (predicted by t = {self.t_end:.4g})"]
         if self.spread is not None:
@@ -243,7 +296,7 @@ class RunValidity:
                        f"eps {sp['eps_min']:.4f}..{sp['eps_max']:.4f} over thermal impacts")
         if self.tc_ratio is not None:
             out.append(f"validity     t_c/t_free = {self.tc_ratio:.3g} at T0 (warn above {TC_RATIO_WARN:g})")
-        elif self.gas.model == "viscoelastic":
+        elif self.scene.shows("contact_time_unknown"):
             out.append("validity     t_c/t_free not determined (damping fixes beta only; "
                        "give [collision.material] to check)")
         out += [f"warning: {w}" for w in self.warnings]
@@ -268,24 +321,40 @@ def table_range_error(gas: RunGas) -> str | None:
             "below 3)")
 
 
-def _check_driven(config, gas) -> RunValidity:
+def box_length(config) -> float:
+    """Box edge of a config's gas: its particles (of the mean volume, :func:`mean_particle_volume`)
+    at the config's packing fraction."""
+    s = config.system
+    return (s.particles * mean_particle_volume(config) / s.packing_fraction) ** (1.0 / s.dimension)
+
+
+def driven_end(gas: Gas, heating_rate: float, t_end: float | None) -> tuple[float, float]:
+    """(T at ``t_end``, steady temperature) of a driven gas starting at T0: the steady state of
+    the moment equations with the heating term (:func:`granulargas.theory.driven_state`, what
+    ``granulargas analyze`` compares with) and the relaxation towards it
+    (:func:`granulargas.theory.relaxation_temperature`); elastic collisions: ``T0 + H t``
+    and no steady state (inf). Without ``t_end`` the steady temperature."""
+    if gas.model == "elastic" or (gas.model == "viscoelastic" and not gas.pair_constant > 0):
+        T_ss = math.inf
+    else:
+        T_ss = float(theory.driven_state(gas, heating_rate)[0])
+    if t_end is None or not math.isfinite(t_end):
+        return T_ss, T_ss
+    T = theory.relaxation_temperature([0.0, float(t_end)], gas.temperature, heating_rate, T_ss)
+    return float(T[-1]), T_ss
+
+
+def _check_driven(config, gas, scene) -> RunValidity:
     """Checks of a driven run: it heads for the steady temperature of the driving
     (:mod:`granulargas.theory.driven`) instead of cooling."""
     h = config.driving.heating_rate
-    if gas.model == "elastic":  # no steady state: T grows as T0 + H t
-        t_end = gas.temperature + h * (gas.end_time if gas.end_time is not None else 0.0)
-    elif gas.model == "constant":
-        t_end = float(theory.driven_temperature(h, gas.restitution, gas.density, gas.dimension, gas.sigma,
-                                                gas.mass))
-    else:
-        t_end = theory.viscoelastic_driven_state(h, gas.prefactor, gas.density, gas.dimension, gas.sigma,
-                                                 gas.mass, end=gas.end)[0]
+    T_end, T_ss = driven_end(gas, h, gas.end_time)
     spread = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
-        spread = restitution_spread(gas, max(gas.temperature, t_end), min(gas.temperature, t_end))
-    rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, float(t_end), spread,
-                     driven=True)
-    rv.tc_ratio = contact_time_ratio(gas, max(gas.temperature, t_end))
+        spread = restitution_spread(gas, max(gas.temperature, T_ss), min(gas.temperature, T_ss))
+    rv = RunValidity(gas, float(gas.end_time if gas.end_time is not None else math.nan), gas.temperature,
+                     float(T_end), spread, scene=scene, T_steady=T_ss)
+    rv.tc_ratio = contact_time_ratio(gas, max(gas.temperature, T_ss if math.isfinite(T_ss) else T_end))
     _warn_contact(rv, gas, spread)
     return rv
 
@@ -310,22 +379,49 @@ def _warn_contact(rv: RunValidity, gas: RunGas, spread) -> None:
             "quasi-static viscoelastic force needs the dissipative time A well below the contact time")
 
 
+def stable_temperature(gas: Gas, box: float, T_end: float) -> float:
+    """Temperature at which the instability length of a cooling gas grows past ``box``: L_c(T) =
+    box for a viscoelastic gas (whose effective restitution rises as it cools); nan if L_c stays
+    below the box down to ``T_end``, or does not depend on T (constant eps)."""
+    if gas.model != "viscoelastic" or not gas.pair_constant > 0 or not T_end > 0:
+        return math.nan
+    if gas.instability_length(T_end) <= box:
+        return math.nan
+    from scipy.optimize import brentq
+
+    f = lambda log_t: gas.instability_length(math.exp(log_t)) - box  # noqa: E731
+    return math.exp(brentq(f, math.log(T_end), math.log(gas.temperature), xtol=1e-6))
+
+
+def _scene(config, gas: RunGas) -> Scene:
+    """The scene of a config (or, given only its gas, of a periodic engine run of that gas)."""
+    if not isinstance(config, RunGas):
+        return Scene.from_config(config)
+    damping = 1.0 if gas.prefactor is None else gas.prefactor
+    return Scene(dimension=gas.dimension, model=gas.model,
+                 kind=("cooling" if (gas.model == "constant" and gas.restitution < 1.0) or (
+                     gas.model == "viscoelastic" and damping > 0.0) else "elastic"),
+                 tc_model=gas.tc_time is not None, material=gas.material is not None,
+                 resolved=gas.duration == "resolved")
+
+
 def check_run(config) -> RunValidity:
     """All run-level checks for a config (module doc); no simulation."""
     gas = config if isinstance(config, RunGas) else gas_from_config(config)
+    scene = _scene(config, gas)
     table = table_range_error(gas)
     if table:  # the predictions below would need the table beyond its range
-        rv = RunValidity(gas, math.nan, gas.temperature, math.nan)
+        rv = RunValidity(gas, math.nan, gas.temperature, math.nan, scene=scene)
         rv.errors.append(table)
         return rv
-    driving = getattr(config, "driving", None)
-    if driving is not None and driving.heating_rate > 0.0:
-        return _check_driven(config, gas)
-    if isinstance(config, RunConfig) and is_vibrated(config):
+    if scene.kind == "driven":
+        return _check_driven(config, gas, scene)
+    if scene.kind == "vibrated" and isinstance(config, RunConfig):
         # the walls put energy in (or, under gravity alone, the gas comes to rest on the floor): no
         # cooling curve to predict; the scene's numbers instead
         lines = scene_lines(config)
-        rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, math.nan, scene=lines)
+        rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, math.nan, scene=scene,
+                         vibrated=lines)
         rv.tc_ratio = contact_time_ratio(gas)
         _warn_contact(rv, gas, None)
         rv.warnings += [x[len("warning: "):] for x in lines if x.startswith("warning: ")]
@@ -338,15 +434,25 @@ def check_run(config) -> RunValidity:
     T_end = math.exp(ln_T_end)
     if curve is not None:
         spread = restitution_spread(gas, gas.temperature, max(T_end, 1e-300))
-    rv = RunValidity(gas, float(t_end), gas.temperature, float(T_end), spread)
+    rv = RunValidity(gas, float(t_end), gas.temperature, float(T_end), spread, scene=scene)
     rv.tc_ratio = contact_time_ratio(gas)
     _warn_contact(rv, gas, spread)
-    if ln_T_end - math.log(gas.temperature) < math.log(DRIFT_T_RATIO) and not (
-            ln_T_end - math.log(gas.mass) < math.log(UNDERFLOW_T)):
-        rv.warnings.append(
-            f"{src}: T falls below {DRIFT_T_RATIO:g} T0: the centre-of-mass velocity left by round-off "
-            "(~1e-16 of the initial thermal speed) overtakes the thermal speed and the event cost per "
-            "collision grows; restart from a snapshot with the centre-of-mass velocity removed")
+    if scene.shows("instability") and not isinstance(config, RunGas):
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):  # absurdly dilute configs: inf
+            rv.box, rv.instability_length = box_length(config), gas.instability_length()
+        if rv.unstable and math.isfinite(rv.instability_length):
+            rv.T_stable = stable_temperature(gas, rv.box, T_end)
+            grows = ""
+            if gas.model == "viscoelastic":
+                grows = (f" (L_c grows as a viscoelastic gas cools and passes the box at T = {rv.T_stable:.3g}: "
+                         "clusters seeded before may dissolve later)" if math.isfinite(rv.T_stable) else
+                         " (it grows as a viscoelastic gas cools, but stays below the box over this run)")
+            rv.instability_warning = (
+                f"{src}: box length {rv.box:.4g} is above the shear-instability length L_c = "
+                f"{rv.instability_length:.4g} at T0{grows}: shear modes and clusters can grow, and T(t) then "
+                "leaves the homogeneous prediction above; a box below L_c (fewer particles, or run.method = \"dsmc\" for "
+                "the homogeneous gas) keeps it")
+            rv.warnings.append(rv.instability_warning)
     key = "run.collisions_per_particle" if gas.collisions_per_particle is not None and (
         gas.end_time is None) else "run.end_time"
     if ln_T_end - math.log(gas.mass) < math.log(UNDERFLOW_T):

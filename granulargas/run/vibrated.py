@@ -30,7 +30,8 @@ _OMEGA = 2.0 * math.pi
 
 def is_vibrated(config: RunConfig) -> bool:
     """Whether the run has gravity or thermal or vibrating walls."""
-    return config.gravity is not None or (config.walls is not None and config.walls.moving)
+    gravity = config.gravity is not None and any(config.gravity.vector)
+    return gravity or (config.walls is not None and config.walls.moving)
 
 
 def _box(config: RunConfig) -> float:

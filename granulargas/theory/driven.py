@@ -31,12 +31,17 @@ from granulargas.theory.enskog import (_check_dim, contact_value, enskog_cooling
                                        packing_fraction)
 from granulargas.theory.gas import Gas, effective_inelasticity
 
+#: cooling times 1/zeta(T_ss) after which a driven gas that starts far from it is taken to be in
+#: its steady state (the relaxation ``T_ss - T ~ exp(-3 zeta t / 2)`` near it leaves exp(-7.5))
+RELAXATION_TIMES = 5.0
+
 __all__ = [
     "driven_state",
     "driven_sonine_a2",
     "driven_temperature",
     "driving_interval",
     "effective_restitution",
+    "relaxation_temperature",
     "viscoelastic_driven_state",
 ]
 
@@ -182,3 +187,24 @@ def driven_state(gas, heating_rate):
         hi += 2.0
     T = math.exp(brentq(balance, lo, hi, xtol=1e-13, rtol=1e-13))
     return T, a2_at(T)
+
+
+def relaxation_temperature(t, T0, heating_rate, T_steady):
+    """T(t) of a driven gas relaxing from ``T0`` towards its steady temperature ``T_steady``.
+
+    ``dT/dt = H - zeta(T) T`` with ``zeta(T) ~ sqrt(T)`` at the steady state's a2 and
+    eps, so that ``zeta(T) T = H (T / T_ss)^(3/2)``, integrated from ``T(t[0]) = T0``
+    (``t`` increasing). Without a steady state (``T_steady`` infinite: elastic
+    collisions) ``T = T0 + H (t - t[0])``.
+    """
+    from scipy.integrate import solve_ivp
+
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    h, T0 = float(heating_rate), float(T0)
+    if not math.isfinite(T_steady):
+        return T0 + h * (t - t[0])
+    if t[-1] == t[0]:
+        return np.full(t.shape, T0)
+    sol = solve_ivp(lambda _, y: [h * (1.0 - (y[0] / T_steady) ** 1.5)], (t[0], t[-1]), [T0], t_eval=t,
+                    rtol=1e-10, atol=1e-14 * min(T0, T_steady), method="LSODA")
+    return sol.y[0]

@@ -139,3 +139,44 @@ def test_summary_lines_are_single_lines():
                  'model = "viscoelastic"\ndamping = 0.05'):
         lines = V.summary_lines(config(coll))
         assert lines and all("\n" not in ln for ln in lines)
+
+
+CONFIGS = __import__("pathlib").Path(__file__).resolve().parents[2] / "configs"
+
+
+def test_a_cooling_engine_run_in_a_box_above_the_instability_length_is_warned(tmp_path, capsys):
+    from granulargas.cli import main
+
+    # 1000 disks at packing 0.05: box sqrt(1000 (pi/4) / 0.05) = 125.3; eps = 0.8 clusters (L_c ~ 91),
+    # eps = 0.95 (the config's) stays homogeneous (L_c ~ 174)
+    box = math.sqrt(1000 * math.pi / 4 / 0.05)
+    args = ["run", str(CONFIGS / "haff_2d.toml"), "--quiet", "--set", "run.collisions_per_particle=2"]
+    assert main(args + ["-o", str(tmp_path / "a.h5"), "--set", "collision.restitution=0.8"]) == 0
+    (line,) = [ln for ln in capsys.readouterr().out.splitlines() if "instability length" in ln]
+    assert line.startswith("warning: ") and f"box length {box:.4g} is above" in line
+    assert main(args + ["-o", str(tmp_path / "b.h5")]) == 0
+    assert "instability length" not in capsys.readouterr().out
+
+
+def test_a_dsmc_run_gets_no_space_or_drift_warning():
+    from granulargas.io.config import load_config
+    from granulargas.run.advise import advise, method_line
+
+    # the full example: 10^5 velocities, whose notional box (137.8) exceeds L_c (127.9)
+    cfg = load_config(CONFIGS / "hcs_dsmc_3d.toml")
+    rv = V.check_run(cfg)
+    assert rv.warnings == [] and method_line(cfg) is None
+    assert V.box_length(cfg) == pytest.approx((1e5 * math.pi / 6 / 0.02) ** (1 / 3))
+    assert V.box_length(cfg) > V.gas_from_config(cfg).instability_length()
+    lines = advise(cfg).lines()
+    assert not any(ln.startswith("clustering") for ln in lines)
+    assert any(ln.startswith("homogeneous  DSMC has no space") for ln in lines)
+    # a constant eps = 0.5 cooling by 40 decades: no centre-of-mass warning (DSMC and the engine remove
+    # the round-off drift themselves)
+    for method in ("dsmc", "edmd"):
+        cold = config('model = "constant"\nrestitution = 0.5',
+                      run=f'collisions_per_particle = 400\nmethod = "{method}"',
+                      system="dimension = 3\nparticles = 2000\npacking_fraction = 0.02")
+        rv = V.check_run(cold)
+        assert rv.T_end < 1e-35 and not rv.errors
+        assert not any("centre-of-mass" in w for w in rv.warnings)
