@@ -12,8 +12,8 @@ the run summary and ``granulargas advise`` (:func:`scene_lines`):
   of the dilute bed (Kumaran 1998; :func:`granulargas.theory.vibrated.vibrated_bed_temperature`)
   with its small parameters, each of which must be << 1 for it to hold;
 * each thermal wall: T_w;
-* the Zeno-trap risk: a constant e < 1 under gravity without ``elastic_below`` or
-  ``tc_time`` (a grain coming to rest on the floor bounces infinitely often).
+* the Zeno-trap risk: a constant e < 1 under gravity with a wall across it, without
+  ``elastic_below`` or ``tc_time`` (a grain coming to rest on the floor bounces infinitely often).
 """
 
 from __future__ import annotations
@@ -54,9 +54,12 @@ def scene(config: RunConfig) -> dict:
     g = config.gravity.vector if config.gravity is not None else (0.0,) * d
     gnorm = math.sqrt(sum(x * x for x in g))
     axis = max(range(d), key=lambda a: abs(g[a])) if gnorm > 0 else None
+    boundary = s.boundary or ("periodic",) * d
+    floor = gnorm > 0 and any(boundary[a] == "wall" and g[a] != 0.0 for a in range(d))
     if gnorm > 0:
         out["gravity"] = gnorm
         out["height"] = config.initial.temperature / (mass * gnorm)
+        out["floor"] = floor
     e = c.restitution if c.model == "constant" else (1.0 if c.model == "elastic" else None)
     e_wall = c.wall_restitution if c.model == "constant" and c.wall_restitution is not None else e
     for name in ("x_low", "x_high", "y_low", "y_high", "z_low", "z_high"):
@@ -82,7 +85,7 @@ def scene(config: RunConfig) -> dict:
                     item["bed"] = V.bed_parameters(column, e, w.amplitude, wall.mean_square_velocity, abs(g[a]), d,
                                                    config.particles.diameter, mass)
         out["walls"].append(item)
-    out["zeno"] = (gnorm > 0 and c.model in ("constant", "viscoelastic") and c.elastic_below is None
+    out["zeno"] = (floor and c.model in ("constant", "viscoelastic") and c.elastic_below is None
                    and c.tc_time is None and (c.model != "constant" or c.restitution < 1.0))
     return out
 
@@ -93,9 +96,12 @@ def scene_lines(config: RunConfig) -> list[str]:
     if not sc:
         return []
     out = []
-    if "gravity" in sc:
+    if "gravity" in sc and sc["floor"]:
         out.append(f"scene        gravity |g| = {sc['gravity']:.4g}: T0 fills a height T0/(m g) = {sc['height']:.3g} "
                    f"of the box side {sc['box']:.3g}")
+    elif "gravity" in sc:
+        out.append(f"scene        gravity |g| = {sc['gravity']:.4g} along periodic axes only: the gas falls freely "
+                   "(no floor)")
     for w in sc["walls"]:
         if w["kind"] == "thermal":
             out.append(f"scene        {w['side']}: thermal wall at T_w = {w['temperature']:.4g}")
