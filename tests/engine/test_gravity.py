@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from granulargas.engine import CollisionRule, Simulation, Wall, Walls
+from granulargas.engine import CollisionRule, Simulation, Wall, Walls, WhiteNoise
 from granulargas.engine.invariants import check
 from granulargas.initial import random_state
 from tests.engine.factories import hermite_table, pade_eps
@@ -52,6 +52,24 @@ def test_gravity_leaves_the_pair_collisions_of_a_periodic_box_unchanged(d, rule,
                                    rtol=0, atol=1e-8)
         t_prev = t
     assert check(fall) == []
+
+
+@pytest.mark.parametrize("neighbours", ["lists", "cells"])
+def test_gravity_leaves_a_driven_periodic_box_unchanged(neighbours):
+    """White-noise kicks add the same velocities with and without gravity (they depend on the
+    step and the particle only), so the driven runs differ by g t and g t^2 / 2 too."""
+    st = random_state(40, 0.2, 3, seed=5)
+    drive = WhiteNoise(0.5, 0.05, seed=3)
+    plain = Simulation(st, RULES["constant"], neighbours=neighbours, remove_drift=False, driving=drive)
+    fall = Simulation(st, RULES["constant"], neighbours=neighbours, remove_drift=False, driving=drive, gravity=G3)
+    plain.run(3.0)
+    fall.run(3.0)
+    assert fall.collisions == plain.collisions > 50 and fall.injected_energy == pytest.approx(
+        plain.injected_energy, rel=1e-9)
+    t = fall.time
+    np.testing.assert_allclose(fall.velocities, plain.velocities + G3 * t, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(fall.unwrapped_positions, plain.unwrapped_positions + 0.5 * G3 * t * t,
+                               rtol=0, atol=1e-7)
 
 
 @pytest.mark.parametrize("neighbours", ["lists", "cells"])
