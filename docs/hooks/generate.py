@@ -67,6 +67,9 @@ SECTION_TEXT = {
              "is a hard wall at rest.",
     "walls.<side>": "The keys of each side's table in `[walls]` (`x_low`, ..., `z_high`), e.g. "
                     "`walls.z_low.amplitude`.",
+    "species": "Optional, in place of `[particles]`: an array of tables `[[species]]`, one per species of "
+               "a mixture ([Mixtures](mixtures.md)). Each key below is checked per species and named "
+               "`species.<name>.<key>` in messages and overrides.",
     "run": "When to stop (at least one key).",
     "output": "The output file and its schedule.",
 }
@@ -118,7 +121,8 @@ def config_reference_markdown() -> str:
     lines = []
     for section in dict.fromkeys(e.section for e in entries):
         anchor = section.replace(".", "-").replace("<", "").replace(">", "")
-        lines += [f"## `[{section}]` {{ #{anchor} }}", ""]
+        shown = f"[[{section}]]" if section == "species" else f"[{section}]"  # an array of tables
+        lines += [f"## `{shown}` {{ #{anchor} }}", ""]
         if section in SECTION_TEXT:
             lines += [SECTION_TEXT[section], ""]
         lines += ["| key | type | default | unit | allowed | meaning |", "|---|---|---|---|---|---|"]

@@ -552,7 +552,8 @@ MAX_MASS_TYPES = 32
 def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefactor, *, end="overlap",
                      end_time, thermo_interval=None, contact_fraction=0.01, steps_per_contact=50,
                      poisson_ratio=DEFAULT_POISSON, name="granulargas", source="", time_origin=0.0,
-                     boundary=None, young_modulus=None, pressure=False, contact_pairs=False) -> LammpsExport:
+                     boundary=None, young_modulus=None, pressure=False, contact_pairs=False,
+                     species=None) -> LammpsExport:
     """Write a LAMMPS data file and input script equivalent to one of our runs.
 
     Parameters
@@ -565,8 +566,9 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     radii, masses : float arrays (N,)
     box : float array (d,)
         Box edges.
-    prefactor : float
-        Our pair prefactor k (beta = k (R_eff g / m_eff^2)^{1/5}).
+    prefactor : float or array (S, S)
+        Our pair prefactor k (beta = k (R_eff g / m_eff^2)^{1/5}); a mixture (``species``):
+        one per pair of species.
     end : {"overlap", "force"}
         End of contact; ``force`` adds LAMMPS's ``limit_damping``.
     end_time : float
@@ -598,13 +600,19 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         at every step to ``contacts.<name>`` (``compute property/local`` and
         ``compute pair/local ... cutoff radius``); :func:`read_contacts` turns it
         into the number of collisions and the elastic energy stored in the contacts.
+    species : int array (N,), optional
+        A mixture: atom type s + 1 for species s, each with its own mass, and one
+        ``pair_coeff`` per pair of species with that pair's prefactor and stiffness
+        (``young_modulus`` may then be an (S, S) table of the pairs' Y / (1 - nu^2) = 2 Y*,
+        Y* the effective modulus of the two materials; LAMMPS's explicit ``pair_coeff i j``
+        of ``hertz/material`` takes E / (2 (1 - nu^2)) as the pair's effective modulus).
 
     Notes
     -----
     Atom types are the distinct masses (eta_n0 depends on the pair's m_eff
     but not on the radii), so a continuously polydisperse gas of equal masses
     is exported exactly; more than :data:`MAX_MASS_TYPES` distinct masses
-    are refused. Per-atom diameters go to the data file.
+    are refused. Per-atom diameters go to the data file. A mixture's types are its species.
     """
     positions = np.asarray(positions, dtype=float)
     velocities = np.asarray(velocities, dtype=float)
@@ -620,7 +628,14 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         raise UserError(f"steps per contact = {steps_per_contact}: must be an integer >= 2")
     if not end_time > 0.0:
         raise UserError(f"end time = {end_time}: must be > 0 (LAMMPS runs for a fixed time)")
-    type_masses, typeid = np.unique(masses, return_inverse=True)
+    if species is not None:
+        typeid = np.asarray(species, dtype=np.int64)
+        ntypes = int(np.asarray(prefactor).shape[0]) if np.ndim(prefactor) == 2 else int(typeid.max()) + 1
+        type_masses = np.array([masses[typeid == s][0] if np.any(typeid == s) else 1.0 for s in range(ntypes)])
+        if np.any(masses != type_masses[typeid]):
+            raise UserError("species: every particle of a species needs its species' mass (one LAMMPS atom type each)")
+    else:
+        type_masses, typeid = np.unique(masses, return_inverse=True)
     if len(type_masses) > MAX_MASS_TYPES:
         raise UserError(
             f"{len(type_masses)} distinct particle masses: LAMMPS export supports at most {MAX_MASS_TYPES} "
@@ -639,16 +654,25 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     tau_free = enskog_mean_free_time(d, packing, sigma, mass, temperature)
     r_eff, m_eff = sigma / 4.0, mass / 2.0
     g_thermal = math.sqrt(2.0 * temperature / m_eff)
+    ntypes = len(type_masses)
+    k_pairs = np.broadcast_to(np.asarray(prefactor, dtype=float), (ntypes, ntypes))
     if young_modulus is None:
         t_contact = contact_fraction * tau_free
         young = stiffness_for_contact_time(t_contact, g_thermal, r_eff, m_eff, poisson_ratio)
+        y_pairs = np.full((ntypes, ntypes), young)
     else:
-        if not young_modulus > 0.0:
+        y_pairs = np.broadcast_to(np.asarray(young_modulus, dtype=float), (ntypes, ntypes))
+        if not np.all(y_pairs > 0.0):
             raise UserError(f"Young modulus = {young_modulus}: must be > 0")
-        young = float(young_modulus)
+        # the mean pair's stiffness for the reference contact time
+        x = np.bincount(typeid, minlength=ntypes) / n
+        young = float(x @ y_pairs @ x)
         t_contact = DemContact(young, poisson_ratio, 0.0).hertz_contact_time(g_thermal, r_eff, m_eff)
         contact_fraction = t_contact / tau_free
-    contact = DemContact.from_prefactor(prefactor, young, poisson_ratio, end)
+    pair_contact = {(i, j): DemContact.from_prefactor(float(k_pairs[i, j]), float(y_pairs[i, j]), poisson_ratio, end)
+                    for i in range(ntypes) for j in range(ntypes)}
+    contact = pair_contact[(0, 0)] if species is not None else DemContact.from_prefactor(
+        float(k_pairs[0, 0]), young, poisson_ratio, end)
     # timestep <= t_contact / steps_per_contact, and a whole number of steps to end_time
     steps = end_time * steps_per_contact / t_contact
     if not (1.0 - 1e-9 <= steps <= 2**53):  # at least one whole time step, an exact step count
@@ -664,12 +688,11 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     directory.mkdir(parents=True, exist_ok=True)
     data_file = directory / f"data.{name}"
     input_file = directory / f"in.{name}"
-    ntypes = len(type_masses)
     eta = {}
     for i in range(ntypes):
         for j in range(i, ntypes):
             mi, mj = type_masses[i], type_masses[j]
-            eta[(i + 1, j + 1)] = float(contact.eta_n0(mi * mj / (mi + mj)))
+            eta[(i + 1, j + 1)] = float(pair_contact[(i, j)].eta_n0(mi * mj / (mi + mj)))
 
     _write_data_file(data_file, positions, velocities, radii, masses, typeid + 1, ntypes, box, source)
     boundary = ("periodic",) * d if boundary is None else tuple(boundary)
@@ -680,7 +703,9 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         "# Same contact law as granulargas (Schwager & Pöschel (1997), eq. (2)): hertz/material + damping viscoelastic,",
         "# E = Y, nu = nu, eta_n0 = A Y / ((1 - nu^2) m_eff) per pair of atom types;",
         f"# end of contact '{end}'" + (" -> limit_damping" if end == "force" else " (no limit_damping)") + ".",
-        f"# Dissipation time A = {contact.dissipation_time:.6g}, pair prefactor k = {prefactor:.6g}.",
+        (f"# Dissipation time A = {contact.dissipation_time:.6g}, pair prefactor k = {float(k_pairs[0, 0]):.6g}."
+         if species is None else f"# A mixture of {ntypes} species = atom types 1..{ntypes}: prefactor k, stiffness "
+                                 "and A per pair of types (pair_coeff lines)."),
         f"# Stiffness: elastic Hertz contact time {t_contact:.6g} at the thermal impact speed "
         f"{g_thermal:.6g} = {contact_fraction:g} x Enskog mean free time {tau_free:.6g}.",
         f"# Timestep {dt:.6g} <= contact time / {steps_per_contact}; {steps} steps to t = {end_time:.6g}.",
@@ -698,12 +723,13 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     lines.append("pair_style granular")
     for (i, j), _ in eta.items():
         mi, mj = type_masses[i - 1], type_masses[j - 1]
-        lines.append(contact.pair_coeff(i, j, mi * mj / (mi + mj)))
+        lines.append(pair_contact[(i - 1, j - 1)].pair_coeff(i, j, mi * mj / (mi + mj)))
     for k, m in enumerate(type_masses):
         if walls:
             lines.append(f"group type{k + 1} type {k + 1}")
-        for a in walls:
-            lines.append(contact.wall_fix(f"wall{k + 1}{'xyz'[a]}", f"type{k + 1}", float(m), a, float(box[a])))
+        for a in walls:  # a wall of the type's own material
+            lines.append(pair_contact[(k, k)].wall_fix(f"wall{k + 1}{'xyz'[a]}", f"type{k + 1}", float(m), a,
+                                                       float(box[a])))
     skin = 0.3 * float(np.max(2.0 * radii))
     lines += [
         f"neighbor {skin:.6g} bin",
@@ -738,6 +764,10 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     export = LammpsExport(input_file, data_file, contact, dt, steps, thermo_every, t_contact, tau_free,
                           contact_fraction, steps_per_contact, g_thermal, eta, tuple(float(m) for m in type_masses))
     summary = {**export.summary(), "time_origin": float(time_origin)}
+    if species is not None:
+        summary["pairs"] = {f"{i + 1} {j + 1}": {"prefactor": float(k_pairs[i, j]), "young_modulus": c.young_modulus,
+                                                 "dissipation_time": c.dissipation_time}
+                            for (i, j), c in pair_contact.items() if i <= j}
     (directory / "granulargas_lammps.json").write_text(json.dumps(summary, indent=2) + "\n")
     return export
 

@@ -120,13 +120,23 @@ GRAVITY_OBSERVABLES = ("potential_energy",)
 #: observables of runs with thermal or vibrating walls, or with gravity and walls
 WALL_KIND_OBSERVABLES = ("wall_work", "wall_impulse")
 RESOLVED_OBSERVABLES = ("three_body_contacts",)
+#: observables of a mixture of S species: one value per species, the collisions (S, S) per pair
+SPECIES_OBSERVABLES = ("species_temperature", "species_sonine_a2", "species_collisions")
+_SPECIES_DESCRIPTIONS = {
+    "species_temperature": "temperature T_s = <m c^2>_s / d of each species (index = particles/all/species; "
+                           "c the peculiar velocity of the whole gas)",
+    "species_sonine_a2": "second Sonine coefficient d/(d+2) <e^2>_s/<e>_s^2 - 1, e = m c^2, of each species",
+    "species_collisions": "pair collisions so far per pair of species (S, S), symmetric: (a, b) counts the "
+                          "collisions between species a and b",
+}
 #: per-frame fields every frame of an EDMD / a DSMC file holds; the other per-frame fields of
 #: granulargas.state.PARTICLE_FIELDS are stored when a run asks for them (``fields``)
 CORE_FIELDS = ("positions", "velocities", "images")
 CORE_FIELDS_DSMC = ("velocities",)
 #: per-frame fields a run may store besides the core ones (restart state of its model)
 OPTIONAL_FIELDS = tuple(x for x in PARTICLE_FIELDS if x.per_frame and x.name not in CORE_FIELDS)
-_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts")
+_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts",
+                    "species_collisions")
 #: H5MD box boundary of each axis kind
 _H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
 
@@ -204,10 +214,12 @@ class H5MDWriter:
     gravity, wall_kinds : bool
         A run under gravity (``potential_energy``) / with thermal or vibrating walls
         (``wall_work``, ``wall_impulse``; with gravity and walls too).
+    species : int
+        A mixture of that many species: also :data:`SPECIES_OBSERVABLES` (0: none).
     """
 
     def __init__(self, path, state: State, *, fields=(), parameters=None, overwrite=False, author=None,
-                 driven=False, gravity=False, wall_kinds=False):
+                 driven=False, gravity=False, wall_kinds=False, species: int = 0):
         self.path = Path(path)
         self.d, self.n = state.dimension, state.n
         self.positions = state.positions is not None
@@ -223,7 +235,9 @@ class H5MDWriter:
         extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
                  + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ())
                  + (GRAVITY_OBSERVABLES if gravity else ())
-                 + (WALL_KIND_OBSERVABLES if wall_kinds or (gravity and "wall" in self.boundary) else ()))
+                 + (WALL_KIND_OBSERVABLES if wall_kinds or (gravity and "wall" in self.boundary) else ())
+                 + (SPECIES_OBSERVABLES if species else ()))
+        self.species = int(species)
         names = SCALAR_OBSERVABLES + ("momentum",) + extra
         if not self.positions:  # DSMC: no pair virial, no pressure
             names = tuple(x for x in names if x != "pressure")
@@ -364,6 +378,8 @@ class H5MDWriter:
         step = time = None
         for name in names:
             shape = (d,) if name == "momentum" else (d, 2) if name == "wall_impulse" else ()
+            if name in SPECIES_OBSERVABLES:
+                shape = (self.species,) * (2 if name == "species_collisions" else 1)
             dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
             g = obs.create_group(name)
             if step is None:
@@ -385,11 +401,13 @@ class H5MDWriter:
             "(mass-weighted; granulargas.observables)")
         obs["sonine_a3"].attrs["description"] = (
             "third Sonine coefficient of the peculiar velocities (granulargas.observables)")
-        for name, text in (("potential_energy", "potential energy -sum m g . r in the uniform field (unwrapped "
-                                                  "positions)"),
-                           ("wall_work", "energy the thermal and vibrating walls have given the gas (cumulative, net)"),
-                           ("wall_impulse", "normal momentum delivered to the lower / upper wall of each axis over "
-                                            "the sampling interval ending at time (d, 2); NaN at the first sample")):
+        described = {
+            "potential_energy": "potential energy -sum m g . r in the uniform field (unwrapped positions)",
+            "wall_work": "energy the thermal and vibrating walls have given the gas (cumulative, net)",
+            "wall_impulse": "normal momentum delivered to the lower / upper wall of each axis over the sampling "
+                            "interval ending at time (d, 2); NaN at the first sample",
+            **_SPECIES_DESCRIPTIONS}
+        for name, text in described.items():
             if name in obs:
                 obs[name].attrs["description"] = text
         if "wall_pressure" in obs:
@@ -542,6 +560,8 @@ def _write_parameters(group, params: dict):
             write_text(group, key, value)
         elif isinstance(value, np.ndarray):
             group.attrs[key] = value.item()
+        elif isinstance(value, (list, tuple)) and value and all(isinstance(x, str) for x in value):
+            group.attrs.create(key, [str(x) for x in value], dtype=h5py.string_dtype())
         elif isinstance(value, (list, tuple)):
             group.attrs[key] = np.asarray(value)
         else:
@@ -866,6 +886,11 @@ def _counters_at(f, path, step: int, time: float, k: int) -> dict:
             if sample >= value.shape[0]:
                 raise InputFileError(f"{path}: damaged H5MD file: observables/{name} ends before snapshot {k}")
             out[name] = dtype(_read(value, sample)).item()
+    if "species_collisions" in obs:
+        value = obs["species_collisions"]["value"]
+        if sample >= value.shape[0]:
+            raise InputFileError(f"{path}: damaged H5MD file: observables/species_collisions ends before snapshot {k}")
+        out["species_collisions"] = np.asarray(_read(value, sample), dtype=np.int64)
     return out
 
 

@@ -453,7 +453,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
                             driven=sim.driving is not None, gravity=setup.gravity is not None,
-                            wall_kinds=setup.walls is not None and setup.walls.moving)
+                            wall_kinds=setup.walls is not None and setup.walls.moving, species=setup.rule.species)
     try:
         if stop is not None:
             stop.arm()  # from here on a signal keeps the state reached

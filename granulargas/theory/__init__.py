@@ -16,9 +16,12 @@ import theory; theory.haff_tau0(...)``):
   (temperature, a2, kick interval; viscoelastic: effective restitution);
 * :mod:`~granulargas.theory.vibrated` -- gases under gravity and on vibrating walls:
   hydrostatic and barometric profiles, the bouncing ball, the dilute vibrofluidized bed.
+* :mod:`~granulargas.theory.mixture` -- mixtures of species: cooling rates and the
+  temperature of each species in the homogeneous cooling and the driven states
+  (Garzó & Dufty 1999), contact values of a mixture (import it from there).
 """
 
-from granulargas.theory import driven, enskog, gas, vibrated, viscoelastic  # noqa: F401
+from granulargas.theory import driven, enskog, gas, mixture, vibrated, viscoelastic  # noqa: F401
 from granulargas.theory.driven import *  # noqa: F401,F403
 from granulargas.theory.enskog import *  # noqa: F401,F403
 from granulargas.theory.vibrated import *  # noqa: F401,F403

@@ -143,15 +143,41 @@ def collide_resolved(pos, vel, radii, masses, box, i, j, rule):
     return out.duration
 
 
-def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None, rule=None):
+def pair_restitution(eps, species, i, j, un, radii, masses):
+    """eps of a collision of i and j: ``eps`` one number, a table (S, S) indexed by the two
+    particles' ``species``, or a function ``eps(s_i, s_j, g_n, r_eff, m_eff)``."""
+    si, sj = (0, 0) if species is None else (int(species[i]), int(species[j]))
+    if callable(eps):
+        r_eff = radii[i] * radii[j] / (radii[i] + radii[j])
+        m_eff = masses[i] * masses[j] / (masses[i] + masses[j])
+        return float(eps(si, sj, abs(un), r_eff, m_eff))
+    return float(eps) if np.ndim(eps) == 0 else float(np.asarray(eps)[si, sj])
+
+
+def wall_restitution(wall_eps, species, i, vn, radii, masses):
+    """eps of particle i against a wall: one number, one per species, or a function
+    ``wall_eps(s_i, |v_n|, R_i, m_i)``."""
+    si = 0 if species is None else int(species[i])
+    if callable(wall_eps):
+        return float(wall_eps(si, abs(vn), radii[i], masses[i]))
+    return float(wall_eps) if np.ndim(wall_eps) == 0 else float(np.asarray(wall_eps)[si])
+
+
+def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None, rule=None,
+                  species=None):
     """Event sequence [(time, i, j)] of the first ``ncoll`` events, global clock; a wall
     collision of particle i with a wall of axis a appears as (time, i, -1 - a).
 
     ``rule``: a resolved CollisionRule (collisions that take time; no walls): a pair in
-    contact is not predicted until its contact ends."""
+    contact is not predicted until its contact ends.
+    ``species`` (N,) ints: a mixture; ``eps`` is then a table (S, S) or a function of the
+    pair (:func:`pair_restitution`), ``wall_eps`` one per species (:func:`wall_restitution`)."""
     pos = pos.copy()
     vel = vel.copy()
-    wall_eps = eps if wall_eps is None else wall_eps
+    if wall_eps is None:
+        wall_eps = eps if species is None else (
+            np.diagonal(np.asarray(eps)) if not callable(eps) else
+            (lambda s, g, r, m: eps(s, s, g, r, m)))
     t = 0.0
     out = []
     n = len(pos)
@@ -181,10 +207,16 @@ def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_e
                 pos[:, a] %= box[a]
         t += dt
         if kind == "pair":
-            collide(pos, vel, radii, masses, box, i, j, eps, walls)
+            dr = pos[i] - pos[j]
+            for a in range(len(box)):
+                if a not in walls:
+                    dr[a] -= box[a] * np.round(dr[a] / box[a])
+            un = float(np.dot(vel[i] - vel[j], dr / np.linalg.norm(dr)))
+            e = pair_restitution(eps, species, i, j, un, radii, masses)
+            collide(pos, vel, radii, masses, box, i, j, e, walls)
             out.append((t, min(i, j), max(i, j)))
         else:
-            bounce(vel, i, j, wall_eps)
+            bounce(vel, i, j, wall_restitution(wall_eps, species, i, vel[i, j], radii, masses))
             out.append((t, i, -1 - j))
     return out, pos, vel
 
@@ -311,18 +343,20 @@ def next_wall_event(pos, vel, radii, box, walls, t, gravity, kinds, horizon):
 
 
 def run_scene(pos, vel, radii, masses, box, nevents, *, walls=(), gravity=None, kinds=None, eps=1.0,
-              wall_eps=None, elastic_below=0.0, seed=0, t0=0.0, wall_count=0):
+              wall_eps=None, elastic_below=0.0, seed=0, t0=0.0, wall_count=0, species=None):
     """Event sequence under gravity with walls of any kind, global clock: [(time, i, j)] with
     j >= 0 for a pair (i < j) and j = -1 - (2 axis + side) for a wall; returns (events, pos,
     vel, wall_work). ``kinds``: {(axis, side): {"kind": "hard" | "thermal" | "vibrating",
     "amplitude", "frequency", "waveform", "phase" (radians), "temperature"}}; ``seed`` and
-    ``wall_count`` (the wall collisions so far) key the thermal draws."""
+    ``wall_count`` (the wall collisions so far) key the thermal draws. ``species``: a mixture
+    (``eps`` a table (S, S), ``wall_eps`` one per species, as in :func:`run_reference`)."""
     pos = np.array(pos, dtype=float)
     vel = np.array(vel, dtype=float)
     d = pos.shape[1]
     g = None if gravity is None else np.asarray(gravity, dtype=float)
     kinds = kinds or {}
-    wall_eps = eps if wall_eps is None else wall_eps
+    if wall_eps is None:
+        wall_eps = eps if species is None else np.diagonal(np.asarray(eps))
     t = t0
     out = []
     work = 0.0
@@ -343,7 +377,8 @@ def run_scene(pos, vel, radii, masses, box, nevents, *, walls=(), gravity=None, 
                 if b not in walls:
                     dr[b] -= box[b] * np.round(dr[b] / box[b])
             un = float(np.dot(vel[i] - vel[j], dr / np.linalg.norm(dr)))
-            collide(pos, vel, radii, masses, box, i, j, 1.0 if -un < elastic_below else eps, walls)
+            e = 1.0 if -un < elastic_below else pair_restitution(eps, species, i, j, un, radii, masses)
+            collide(pos, vel, radii, masses, box, i, j, e, walls)
             out.append((t, min(i, j), max(i, j)))
             continue
         w = kinds.get((a, side), {"kind": "hard"})
@@ -367,7 +402,7 @@ def run_scene(pos, vel, radii, masses, box, nevents, *, walls=(), gravity=None, 
             if w["kind"] == "vibrating":
                 wv = float(wall_velocity(w["waveform"], t, w["amplitude"], w["frequency"], w.get("phase", 0.0)))
             u = vn - wv
-            e = 1.0 if abs(u) < elastic_below else wall_eps
+            e = 1.0 if abs(u) < elastic_below else wall_restitution(wall_eps, species, k, u, radii, masses)
             vel[k, a] = wv - e * u
             if w["kind"] == "vibrating":
                 work += 0.5 * masses[k] * float(vel[k] @ vel[k]) - e0 + 0.5 * (1 - e * e) * masses[k] * u * u
