@@ -480,7 +480,8 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
     return Outcome(code, out.getvalue(), err.getvalue(), time.perf_counter() - start, fired.is_set(), exc)
 
 
-KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|gravity|walls|run|output)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
+KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|gravity|walls|run|output|species)(\.[A-Za-z_0-9]+)+"
+                    r"|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
 
 
 def check_outcome(o: Outcome, before: dict, after: dict, *, output_made: bool = True, long_runs: bool = False):
