@@ -48,7 +48,7 @@ def test_engine_smallest_box_boundary():
         if ok:
             sim = Simulation(*args)
             sim.run(until=0.1)
-            assert sim.shell >= 0.05 * (1.0 - 1e-10)  # the fit keeps a margin of 1e-12 of L / 3
+            assert sim.shell >= 0.05 * (1.0 - 1e-12)
         else:
             with pytest.raises(ConfigError, match="3.15 largest diameters"):
                 Simulation(*args)
