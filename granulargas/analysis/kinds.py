@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from granulargas.analysis.driven import analyze_driven
 from granulargas.analysis.elastic import analyze_elastic
+from granulargas.analysis.rough import analyze_rough
 from granulargas.analysis.run import RunInfo, analyze_cooling
 from granulargas.analysis.vibrated import analyze_vibrated
 from granulargas.errors import InputFileError
@@ -29,6 +30,7 @@ ANALYSES = {
     "elastic": analyze_elastic,
     "driven": analyze_driven,
     "vibrated": analyze_vibrated,
+    "rough": analyze_rough,
 }
 
 

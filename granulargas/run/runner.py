@@ -323,10 +323,12 @@ def stored_fields(config: RunConfig, sim) -> tuple:
     """The per-frame fields of :data:`granulargas.state.PARTICLE_FIELDS` a run stores besides
     positions, velocities and images: the restart state its model needs
     (:class:`granulargas.io.h5md.H5MDWriter`)."""
+    rough = ("angular_velocities",) if config.collision.rough else ()
     if config.run.method == "dsmc":
-        return ()
+        return rough
     tc = config.collision.model == "constant" and config.collision.tc_time is not None
-    return (("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if sim.rule.resolved else ())
+    return ((("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if sim.rule.resolved else ())
+            + rough)
 
 
 def collapse_message(config: RunConfig, where: str) -> str:
@@ -430,7 +432,7 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
         sim = make_dsmc(config, setup)
     else:
         sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
-                         gravity=setup.gravity, walls=setup.walls)
+                         gravity=setup.gravity, walls=setup.walls, tangential=setup.tangential)
     if not dsmc:  # the engine's own choice of neighbour mode ("auto" at the state's packing)
         what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     # a zero-length run compiles (or loads) the engine and builds its queue before

@@ -13,7 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from granulargas.engine import CollisionRule, Simulation, Wall, Walls, WhiteNoise
+from granulargas.engine import CollisionRule, Simulation, TangentialRule, Wall, Walls, WhiteNoise
+from granulargas.errors import ConfigError
 from granulargas.engine.invariants import check
 from granulargas.initial import random_state
 from tests.engine.factories import hermite_table, pade_eps
@@ -222,3 +223,34 @@ def test_a_mixture_under_gravity_against_the_reference(scene, neighbours):
     np.testing.assert_allclose(sim.velocities, vel + gv, rtol=1e-6, atol=1e-7)
     assert sim.wall_work == pytest.approx(work, rel=1e-6, abs=1e-9)
     assert np.triu(sim.species_collisions).sum() == sim.collisions  # symmetric: each pair once
+
+
+@pytest.mark.parametrize("neighbours", ["lists", "cells"])
+@pytest.mark.parametrize("d", [2, 3])
+def test_gravity_leaves_rough_collisions_unchanged(d, neighbours):
+    """Rough particles (Walton's Coulomb model): gravity moves every centre alike and turns no
+    spin, so the collisions are those of the run without it, velocities shifted by g t,
+    positions by g t^2 / 2, spins the same."""
+    st = random_state(40, 0.2, d, seed=4 + d)
+    tangential = TangentialRule.coulomb(0.4, 0.3)
+    g = G3[:d]
+    plain = Simulation(st, RULES["constant"], neighbours=neighbours, remove_drift=False, tangential=tangential)
+    fall = Simulation(st, RULES["constant"], neighbours=neighbours, remove_drift=False, tangential=tangential,
+                      gravity=g)
+    for k in range(60):
+        plain.run(np.inf, max_collisions=1)
+        fall.run(np.inf, max_collisions=1)
+        t = fall.time
+        assert t == pytest.approx(plain.time, rel=1e-10, abs=1e-12), k
+        np.testing.assert_allclose(fall.velocities, plain.velocities + g * t, rtol=0, atol=1e-8)
+        np.testing.assert_allclose(fall.angular_velocities, plain.angular_velocities, rtol=0, atol=1e-8)
+        np.testing.assert_allclose(fall.unwrapped_positions, plain.unwrapped_positions + 0.5 * g * t * t,
+                                   rtol=0, atol=1e-8)
+    assert fall.dissipated_energy == pytest.approx(plain.dissipated_energy, rel=1e-9)
+
+
+def test_rough_particles_take_no_moving_walls():
+    st = random_state(30, 0.1, 2, seed=1, boundary=("periodic", "wall"), margins=[[0, 0], [0.2, 0]])
+    with pytest.raises(ConfigError, match="hard walls at rest"):
+        Simulation(st, CollisionRule.constant(0.9), walls=Walls(y_low=Wall.vibrating(0.1, 1.0)),
+                   tangential=TangentialRule.constant(0.5))

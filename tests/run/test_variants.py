@@ -34,8 +34,12 @@ EXAMPLES = {
     "vibrated_bed_2d.toml": ["placement", "lists-gravity-walls"],
     "vibrated_bed_3d.toml": ["placement", "cells-gravity-walls"],
     "shaken_cell_3d.toml": ["placement", "cells-walls"],
+    "rough_hcs_3d.toml": ["placement", "cells-rough"],
+    "rough_driven_2d.toml": ["placement", "lists-rough", "lists-rough-driven"],
+    "rough_mpemba_hot.toml": ["placement", "cells-rough", "cells-rough-driven"],
     "mixture_hcs_3d.toml": ["dsmc-mixture"],
     "glass_steel_3d.toml": ["placement", "cells-mixture"],
+
 }
 
 
@@ -49,8 +53,8 @@ def test_every_example_config_compiles_a_named_variant():
     for path in (ROOT / "configs").glob("*.toml"):
         names = [v.name for v in variants_for(load_config(path))]
         assert any(n in ("lists", "cells", "resolved", "dsmc", "lists-walls", "cells-walls", "lists-gravity",
-                         "cells-gravity", "lists-gravity-walls", "cells-gravity-walls", "lists-mixture",
-                         "cells-mixture", "dsmc-mixture") for n in names), (path.name, names)
+                         "cells-gravity", "lists-gravity-walls", "cells-gravity-walls", "lists-rough", "cells-rough",
+                         "dsmc-rough", "lists-mixture", "cells-mixture", "dsmc-mixture") for n in names), (path.name, names)
 
 
 def test_each_variant_tiny_run_selects_it(tmp_path):
