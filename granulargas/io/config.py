@@ -1622,11 +1622,11 @@ def _nearest_key(parts: list[str]) -> str | None:
     if not close:
         return None
     section = close[0]
-    in_section = [k.dotted[len(section) + 1:] for k in SCHEMA if k.section.split(".")[0] == section]
+    in_section = [k.dotted[len(section) + 1:] for k in SCHEMA if k.section.split(".")[0] == section and not k.template]
     key = difflib.get_close_matches(".".join(parts[1:]), in_section, n=1, cutoff=0.6)
     if key:
         return f"{section}.{key[0]}"
-    by_name = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA}
+    by_name = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA if not k.template}  # not walls.<side>.*
     name = difflib.get_close_matches(parts[-1], list(by_name), n=1, cutoff=0.75)
     return by_name[name[0]] if name else section
 
