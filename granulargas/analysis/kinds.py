@@ -19,6 +19,7 @@ from granulargas.analysis.elastic import analyze_elastic
 from granulargas.analysis.rough import analyze_rough
 from granulargas.analysis.run import RunInfo, analyze_cooling
 from granulargas.analysis.shear import analyze_shear
+from granulargas.analysis.vibrated import analyze_vibrated
 from granulargas.errors import InputFileError
 from granulargas.io.scene import MODELS
 
@@ -30,6 +31,7 @@ ANALYSES = {
     "elastic": analyze_elastic,
     "driven": analyze_driven,
     "shear": analyze_shear,
+    "vibrated": analyze_vibrated,
     "rough": analyze_rough,
 }
 

@@ -102,13 +102,14 @@ import numpy as np
 from granulargas import theory
 from granulargas.contact import restitution_table
 from granulargas.contact.material import damping_from_prefactor, effective_modulus, rho_from_material
-from granulargas.errors import ConfigError
-from granulargas.io.config import TABLE_BETA_MAX
+from granulargas.errors import ConfigError, TableRangeError
+from granulargas.io.config import TABLE_BETA_MAX, RunConfig
 from granulargas.io.scene import Scene
 from granulargas.theory import rough as rough_theory
 from granulargas.theory.moments import speed_quadrature
 from granulargas.run.prepare import (mean_particle, mean_restitution, mixture_of_config, pair_weights, reduced_prefactor,
                                      species_fractions)
+from granulargas.run.vibrated import scene_lines
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -320,6 +321,9 @@ class RunValidity:
     T_stable: float = math.nan
     #: what holds the steady state of a sheared run (None: not sheared)
     steady: str | None = None
+    #: a vibrated scene's lines (gravity, thermal or vibrating walls: :mod:`granulargas.run.vibrated`),
+    #: in place of the homogeneous gas's temperature range
+    vibrated: list = field(default_factory=list)
 
     @property
     def driven(self) -> bool:
@@ -332,6 +336,11 @@ class RunValidity:
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
+        if self.vibrated:
+            out = [x for x in self.vibrated if not x.startswith("warning: ")]
+            out += [f"warning: {w}" for w in self.warnings]
+            out += [f"error: {e}" for e in self.errors]
+            return out
         theory_name = "two-temperature theory" if self.scene.rough else "Enskog theory"
         if self.steady is not None:
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady shear flow: {self.steady})"]
@@ -359,6 +368,12 @@ class RunValidity:
         return out
 
 
+def _damping_key(gas: RunGas) -> str:
+    """The config key that sets a viscoelastic gas's damping, with its value."""
+    return ("collision.material" if gas.material is not None
+            else f"collision.damping = {damping_from_prefactor(gas.prefactor):.6g}")
+
+
 def table_range_error(gas: RunGas) -> str | None:
     """One line when the fastest impacts the kinetic theory integrates over at T0 (its largest
     speed node, :func:`granulargas.theory.moments.speed_quadrature`) reach beta beyond the
@@ -369,9 +384,7 @@ def table_range_error(gas: RunGas) -> str | None:
     beta = float(gas.beta(math.sqrt(2.0 * gas.temperature / gas.mass) * u_max))
     if beta <= TABLE_BETA_MAX / 1.01:
         return None
-    key = ("collision.material" if gas.material is not None
-           else f"collision.damping = {damping_from_prefactor(gas.prefactor):.6g}")
-    return (f"{gas.source}: {key}: fast thermal impacts ({u_max:.3g} thermal speeds) reach beta = {beta:.3g}, "
+    return (f"{gas.source}: {_damping_key(gas)}: fast thermal impacts ({u_max:.3g} thermal speeds) reach beta = {beta:.3g}, "
             f"beyond the restitution table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well "
             "below 3)")
 
@@ -567,6 +580,16 @@ def check_run(config) -> RunValidity:
         return _check_sheared(config, gas, scene)
     if scene.kind == "driven":
         return _check_driven(config, gas, scene)
+    if scene.kind == "vibrated" and isinstance(config, RunConfig):
+        # the walls put energy in (or, under gravity alone, the gas comes to rest on the floor): no
+        # cooling curve to predict; the scene's numbers instead
+        lines = scene_lines(config)
+        rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, math.nan, scene=scene,
+                         vibrated=lines)
+        rv.tc_ratio = contact_time_ratio(gas)
+        _warn_contact(rv, gas, None)
+        rv.warnings += [x[len("warning: "):] for x in lines if x.startswith("warning: ")]
+        return rv
     src = gas.source
     spread = curve = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
@@ -574,7 +597,14 @@ def check_run(config) -> RunValidity:
     t_end, ln_T_end = predicted_end(gas, curve)
     rough = rough_gas_from_config(config)
     if rough is not None:  # two temperatures: the rough theory's T_tr
-        t_end, ln_T_end = rough_end(rough, gas.end_time, gas.collisions_per_particle)
+        try:
+            t_end, ln_T_end = rough_end(rough, gas.end_time, gas.collisions_per_particle)
+        except TableRangeError:  # the rotational energy fed back makes impacts faster than at T0
+            rv = RunValidity(gas, math.nan, gas.temperature, math.nan, scene=scene)
+            rv.errors.append(f"{src}: {_damping_key(gas)}: the fastest impacts of the two-temperature theory "
+                             f"reach beyond the restitution table's beta = {TABLE_BETA_MAX:g} (the "
+                             "viscoelastic model holds for beta well below 3)")
+            return rv
     elif not isinstance(config, RunGas) and config.species and gas.model != "elastic":
         t_end, ln_T_end = _mixture_end(config, gas)
     T_end = math.exp(ln_T_end)

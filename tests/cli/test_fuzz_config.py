@@ -113,6 +113,28 @@ ISSUE_CASES = {
 }
 
 
+# a vibrated scene's bad input: one line naming the key, exit 2, nothing written
+SCENE_CASES = {
+    "walls meet": (case("vibrated-2d", ("walls.y_low.amplitude", 9.0), ("walls.y_high", {"kind": "vibrating",
+                                                                                       "amplitude": 9.0,
+                                                                                       "frequency": 1.0})),
+                   "walls.y_low.amplitude = 9"),
+    "no room": (case("vibrated-2d", ("walls.y_low.amplitude", 17.5)), "walls.y_low.amplitude = 17.5"),
+    "frequency 0": (case("vibrated-2d", ("walls.y_low.frequency", 0.0)), "walls.y_low.frequency = 0"),
+    "frequency < 0": (case("vibrated-2d", ("walls.y_low.frequency!", -2.0)), "walls.y_low.frequency = -2"),
+    "vibrating on a periodic axis": (case("vibrated-2d", ("system.boundary", ["wall", "periodic"])), "walls.y_low"),
+    "gravity axes": (case("vibrated-2d", ("gravity.acceleration", [0.0, -1.0, 0.0])), "gravity.acceleration"),
+    "dsmc": (case("vibrated-2d", ("run.method", "dsmc")), "[gravity]"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SCENE_CASES))
+def test_scene_bad_input_gives_one_line_and_writes_nothing(name):
+    mc, key = SCENE_CASES[name]
+    o, d, after = _run_command(mc, ["run", "c.toml", "--quiet"], output_made=False)
+    assert o.code == 2 and key in o.stderr and o.stderr.count("\n") == 1, o.stderr
+
+
 @pytest.mark.parametrize("name", sorted(ISSUE_CASES))
 def test_issue_cases_give_one_line_or_run_to_the_end(name):
     mc, codes = ISSUE_CASES[name]

@@ -54,6 +54,14 @@ BAD = {
     "driving": (SHEARED + "\n[driving]\nheating_rate = 0.1\n", "[driving] is not available with [shear]"),
     "rough grains": (_with("[shear]", '[collision.tangential]\nmodel = "constant"\nrestitution = 0.0\n\n[shear]'),
                      "rough particles are not available with [shear]"),
+    "gravity": (SHEARED + "\n[gravity]\nacceleration = [0.0, 0.0, -1.0]\n",
+                "gravity.acceleration = [0, 0, -1]: [gravity] is not available with [shear]"),
+    "vibrating wall": (_with('"periodic", "lees-edwards", "periodic"', '"periodic", "lees-edwards", "wall"')
+                       + '\n[walls.z_low]\nkind = "vibrating"\namplitude = 0.1\nfrequency = 1.0\n',
+                       'walls.z_low = {...}: kind = "vibrating" is not available with [shear]'),
+    "thermal wall": (_with('"periodic", "lees-edwards", "periodic"', '"periodic", "lees-edwards", "wall"')
+                     + '\n[walls.z_high]\nkind = "thermal"\ntemperature = 1.0\n',
+                     'walls.z_high = {...}: kind = "thermal" is not available with [shear]'),
     "species": (SHEARED + '\n[[species]]\nname = "a"\ncount = 100\ndiameter = 1.0\nmass = 1.0\n'
                 '\n[[species]]\nname = "b"\ncount = 100\ndiameter = 1.0\nmass = 2.0\n',
                 "[shear] is not available with [[species]]"),

@@ -285,3 +285,23 @@ def test_shear_refuses_rough_particles():
     st = random_state(60, 0.1, 3, seed=1, boundary=LE3, shear=0.5)
     with pytest.raises(ConfigError, match="rough particles"):
         Simulation(st, CollisionRule.elastic(), shear=Shear(0.5), tangential=TangentialRule.constant(0.0))
+
+
+def test_shear_refuses_gravity_and_moving_walls():
+    from granulargas.engine.walls import Wall, Walls
+
+    st = random_state(60, 0.1, 3, seed=1, boundary=LE3, shear=0.5)
+    with pytest.raises(ConfigError, match="shear: gravity and thermal or vibrating walls"):
+        Simulation(st, CollisionRule.elastic(), shear=Shear(0.5), gravity=(0.0, 0.0, -1.0))
+    walled = ("periodic", "lees-edwards", "wall")
+    st = random_state(60, 0.1, 3, seed=1, boundary=walled, shear=0.5)
+    with pytest.raises(ConfigError, match="shear: gravity and thermal or vibrating walls"):
+        Simulation(st, CollisionRule.elastic(), shear=Shear(0.5), walls=Walls(z_high=Wall.thermal(1.0)))
+    # hard walls at rest on z stay available with shear
+    Simulation(st, CollisionRule.elastic(), shear=Shear(0.5), walls=Walls(z_low=Wall.hard()))
+
+
+def test_stress_refused_under_gravity():
+    st = random_state(60, 0.1, 3, seed=1)
+    with pytest.raises(ConfigError, match="stress: the pressure tensor under gravity"):
+        Simulation(st, CollisionRule.elastic(), stress=True, gravity=(0.0, 0.0, -1.0))
