@@ -6,8 +6,8 @@ RSS of the process and the collision rate of a second, timed batch.
 
 Usage::
 
-    python scripts/bench_large.py
-    python scripts/bench_large.py --particles 1e6 --collisions 2e6
+    python scripts/benchmarks/run.py
+    python scripts/benchmarks/run.py --particles 1e6 --collisions 2e6
 """
 
 import argparse

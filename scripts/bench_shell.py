@@ -10,9 +10,9 @@ loaded machine slows all of them alike.
 
 Usage::
 
-    python scripts/bench_shell.py --n 1e4 --packings 0.05 0.1 --shells 1.2 2 3 4
-    python scripts/bench_shell.py --rule viscoelastic     # damping 0.1, cooling
-    python scripts/bench_shell.py --dimension 2 --packings 0.1 0.25 0.4 --shells 0 0.5 1 1.5
+    python scripts/benchmarks/neighbours.py --n 1e4 --packings 0.05 0.1 --shells 1.2 2 3 4
+    python scripts/benchmarks/neighbours.py --rule viscoelastic     # damping 0.1, cooling
+    python scripts/benchmarks/neighbours.py --dimension 2 --packings 0.1 0.25 0.4 --shells 0 0.5 1 1.5
 """
 
 import argparse

@@ -1,6 +1,6 @@
 """What walls and driving cost: the same gas periodic, between walls, and driven, alternated.
 
-Each round runs, for each size, the three scenes of ``scripts/bench_engine.py --case``
+Each round runs, for each size, the three scenes of ``scripts/benchmarks/run.py --case``
 in fresh processes of this source tree (pinned to one core when ``taskset`` exists): the
 periodic gas, the same particles with flat walls on the last axis (``--scene
 walls``), and the periodic gas with white-noise driving (``--scene driven:H``,
@@ -10,8 +10,8 @@ collision, and wall collisions per pair collision.
 
 Usage::
 
-    python scripts/bench_sources.py --sizes 1e4 1e5 --rounds 3
-    python scripts/bench_sources.py --sizes 1e5 --rule 0.9 --heating-rate 0.1
+    python scripts/benchmarks/run.py --sizes 1e4 1e5 --rounds 3
+    python scripts/benchmarks/run.py --sizes 1e5 --rule 0.9 --heating-rate 0.1
 """
 
 from __future__ import annotations
@@ -28,14 +28,14 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 def case(n, packing, dim, rule, scene):
-    cmd = [sys.executable, os.path.join(HERE, "bench_engine.py"), "--case", str(n), str(packing), str(dim),
+    cmd = [sys.executable, os.path.join(HERE, "scripts/benchmarks/run.py"), "--case", str(n), str(packing), str(dim),
            rule, "--scene", scene]
     if shutil.which("taskset"):
         cmd = ["taskset", "-c", str(os.cpu_count() - 1)] + cmd
     env = dict(os.environ, PYTHONPATH=os.path.dirname(HERE))  # this source tree
     out = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if out.returncode != 0:
-        sys.exit(f"bench_sources.py: {scene} N = {n}: {out.stderr.strip().splitlines()[-1:]}")
+        sys.exit(f"scripts/benchmarks/run.py: {scene} N = {n}: {out.stderr.strip().splitlines()[-1:]}")
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 

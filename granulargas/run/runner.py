@@ -102,7 +102,7 @@ class RunSummary:
         if self.three_body_contacts is not None:
             share = self.three_body_contacts / self.collisions if self.collisions else 0.0
             note = (f"; more than the {100 * RESOLVED_THREE_BODY_CHECKED:.2g} % met at the longest contacts for which "
-                    "the resolved scheme was checked against LAMMPS (scripts/resolved_lammps.py): use DEM"
+                    "the resolved scheme was checked against LAMMPS (scripts/lammps/resolved_collisions.py): use DEM"
                     if share > RESOLVED_THREE_BODY_CHECKED else "")
             extra.append(f"three-body   {self.three_body_contacts} collisions with a pair still in contact "
                          f"({100.0 * share:.3g} % of the collisions{note})")
