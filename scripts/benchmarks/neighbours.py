@@ -1,4 +1,5 @@
-"""Dilute gases: cell crossings against neighbour lists (and, optionally, Smallenburg's C code).
+"""The neighbour search: cell crossings against neighbour lists, cell widths and list shells,
+and the side by side with Smallenburg's C code.
 
 For each N and packing fraction the same random state (3D, or 2D with
 ``--dimension 2``) runs with each
@@ -25,6 +26,13 @@ Usage::
     taskset -c 1 python scripts/benchmarks/neighbours.py --n 10976 --packings 0.05 0.1
     taskset -c 1 python scripts/benchmarks/neighbours.py --rule viscoelastic --modes lists cells cells:0.5
     taskset -c 1 python scripts/benchmarks/neighbours.py --c-cell /path/Cell/md --c-single /path/Single/md
+    python scripts/benchmarks/neighbours.py --dimension 2 --n 1e4 --packings 0.05 0.25 --modes lists lists:2 lists:4
+
+``--record`` writes the figures into ``docs/performance/results.json``
+(``scripts/benchmarks/results.py``) and rewrites the performance page: the engine's rate per
+case for the default ``lists`` and ``cells`` modes, the ratio to the C code where it ran,
+and, when several modes ran on an elastic 3D gas, every mode's rate and events per collision
+(the page's chart of speed against events per collision).
 
 ``--plot FILE`` draws the rate against the events per collision, one panel per
 N and packing, one point per mode (the C codes' rates as horizontal lines):
@@ -34,10 +42,12 @@ more, cheaper ones.
 
 import argparse
 import math
+import os
 import re
 import resource
 import statistics
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -113,7 +123,10 @@ def main(argv=None):
     p.add_argument("--c-collisions", type=float, default=2e6)
     p.add_argument("--core", type=int, default=1)
     p.add_argument("--plot", help="PNG file: rate against events per collision")
+    p.add_argument("--record", action="store_true",
+                   help="write the figures into docs/performance/results.json and rewrite the performance page")
     args = p.parse_args(argv)
+    load = os.getloadavg()[0]
     results = []
     rule = make_rule(args.rule)
     for mode, s in compile_seconds(rule, args.modes).items():
@@ -146,12 +159,14 @@ def main(argv=None):
                 per = {k: (now[k] - start[k]) / col for k in ("events", "expiries", "crossings", "stale")}
                 bound = (f"crossings {per['crossings']:.3f}" if sim.neighbours == "cells"
                          else f"expiries {per['expiries']:.3f}")
+                if sim.neighbours == "lists":
+                    bound += f", mean list length {float(np.mean(sim._engine.lists.nbn)):.1f}"
                 print(f"{args.dimension}D N={n} packing {eta} {args.rule} {mode} (shell {sim.shell:.3f}): events/collision "
                       f"{per['events']:.3f} ({bound}, stale {per['stale']:.3f}), "
                       f"{statistics.median(cpu) / 1e6:.4f} M collisions/s CPU "
                       f"({statistics.median(wall) / 1e6:.4f} wall; rounds "
                       f"{' '.join(f'{x / 1e6:.4f}' for x in cpu)})", flush=True)
-                results.append(dict(n=n, packing=eta, mode=mode, shell=sim.shell,
+                results.append(dict(n=n, packing=eta, mode=mode, shell=sim.shell, neighbours=sim.neighbours,
                                     events=per["events"], rate=statistics.median(cpu) / 1e6))
             for name, rates in c_rates.items():
                 if rates:
@@ -160,6 +175,44 @@ def main(argv=None):
                     results.append(dict(n=n, packing=eta, mode=name, rate=statistics.median(rates)))
     if args.plot:
         plot(results, args.plot, f"{args.dimension}D, {args.rule}")
+    if args.record:
+        record(results, args, argv if argv is not None else sys.argv[1:], max(load, os.getloadavg()[0]))
+
+
+def record(results, args, argv, load):
+    """Write the engine's, the C code's and the chart's records into the results file; rewrite the page."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import performance_page
+    import results as results_file
+
+    words, skip = [], False
+    for w in argv:  # the command as recorded: the C code's binaries are not part of the repository
+        words.append("BINARY" if skip else w)
+        skip = w in ("--c-cell", "--c-single")
+    command = "python scripts/benchmarks/neighbours.py " + " ".join(words)
+    ours = [r for r in results if not r["mode"].startswith("C ")]
+    records = []
+    for r in ours:
+        if r["mode"] in ("lists", "cells"):
+            mag = f"1e{len(str(r['n'])) - 1}"
+            records.append(dict(table="engine", id=f"{args.dimension}D periodic {args.rule} {r['mode']} packing "
+                                f"{r['packing']:g} N~{mag}", n=r["n"], dim=args.dimension, packing=r["packing"],
+                                rule=args.rule, neighbours=r["mode"], scene="periodic", rate_cpu=round(r["rate"], 4),
+                                events_per_collision=round(r["events"], 2), rounds=args.rounds))
+            variant = "C Cell" if r["mode"] == "cells" else "C Single"
+            c = [x for x in results if x["mode"] == variant and (x["n"], x["packing"]) == (r["n"], r["packing"])]
+            if c:
+                records.append(dict(table="c_code", id=f"{r['mode']} packing {r['packing']:g} N={r['n']}", n=r["n"],
+                                    packing=r["packing"], neighbours=r["mode"], rate_cpu=round(r["rate"], 4),
+                                    c_variant=variant[2:], c_rate_cpu=round(c[0]["rate"], 4), rounds=args.rounds))
+    if args.rule == "elastic" and args.dimension == 3 and len(args.modes) > 1:
+        for r in ours:
+            width = 1.0 + r["shell"] if r["neighbours"] == "cells" else r["shell"]
+            records.append(dict(table="dilute", id=f"{r['mode']} packing {r['packing']:g} N={r['n']}", n=r["n"],
+                                packing=r["packing"], mode=r["mode"], width=round(width, 1),
+                                rate_cpu=round(r["rate"], 4), events_per_collision=round(r["events"], 2)))
+    results_file.record(records, command, load_average=load)
+    performance_page.main([])
 
 
 def plot(results, path, title):

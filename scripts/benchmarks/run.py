@@ -1,22 +1,40 @@
-"""Benchmark of the event-driven engine: collisions per second, JIT time, memory.
+"""The benchmark runner: every speed figure of the performance page, by named sets of cases.
 
-Each case runs in its own process (clean peak memory): random initial state,
-warm-up to a steady state (5 collisions per particle), then ``--repeats`` timed runs of about
-``max(2e5, N)`` collisions each; the median rate is printed, with the wall-clock
-rate and the CPU-time rate of the process (the CPU rate is less sensitive to a
-loaded machine). Memory: bytes per particle of the engine's internal state
-(``sum of array sizes / N``) and the growth of the process's peak RSS during
-the case divided by N (includes the initial-state construction).
+Each case runs in its own process (clean peak memory): initial state, warm-up to a steady
+state (5 collisions per particle: aged neighbour lists, memory order drifted from the initial
+sort), then ``--repeats`` timed runs of ``max(2e5, N)`` collisions; printed are the median
+rates in collisions per second of CPU time of the process (less sensitive to a loaded machine)
+and of the wall clock, the events per collision, the engine state in bytes per particle
+(``sum of array sizes / N``) and the growth of the process's peak RSS per particle (including
+the initial state).
 
-JIT: the first compile is measured in a fresh process with the numba cache
-disabled (``GRANULARGAS_NO_CACHE=1``); the cached load in a fresh process with
-the cache on (import plus a first tiny run).
+Sets of cases (``--list`` prints them):
+
+* ``table``: the engine at N ~ 1e4, 1e5, 1e6: 3D elastic at packing 0.3 and 0.5 (neighbour
+  lists) and at 0.05 and 0.1 (cell crossings), 2D at 0.5, 3D viscoelastic at 0.3;
+* ``quick``: 3D elastic at packing 0.3 (N ~ 1e4, 1e5) and 0.05 (N ~ 1e4);
+* ``scenes``: one gas (3D, packing 0.3, constant eps = 0.9) periodic, between walls on the
+  last axis, and driven by white noise (H = 0.1, kicks every 0.02 / zeta);
+* ``large``: 1e7 spheres at packing 0.3 (about 5 GB and 10 minutes on one core);
+* ``dsmc``: the DSMC against the engine on the same gas (``scripts/benchmarks/dsmc.py``);
+* ``compile``: the first JIT compile of each neighbour mode (CPU time of a fresh process with
+  an empty numba cache) and the cached load;
+* ``initial``: the initial placement (``random_state``) of large dense states;
+* ``all``: every set above.
+
+``--record`` writes the figures into ``docs/performance/results.json`` (replacing the
+records of the same cases) and rewrites the performance page from it
+(``scripts/benchmarks/performance_page.py``). The side by side with Smallenburg's C code
+has its own harness (``scripts/benchmarks/neighbours.py --c-single/--c-cell``), as do the
+first-run start-up (``scripts/benchmarks/startup.py``) and the comparisons with LAMMPS
+(``scripts/lammps/``).
 
 Usage::
 
-    python scripts/benchmarks/run.py            # full table (N = 1e4, 1e5, 1e6; 3D eta 0.1/0.3/0.5, 2D, viscoelastic)
-    python scripts/benchmarks/run.py --quick    # N = 1e4, 1e5 at eta = 0.3 only, fewer repeats
-    python scripts/benchmarks/run.py --sizes 1e5 --packings 0.3 --dims 3 --rules elastic
+    python scripts/benchmarks/run.py quick                    # a few minutes
+    python scripts/benchmarks/run.py all --record             # hours: every record of the page
+    python scripts/benchmarks/run.py table scenes --only "N~1e4" --record
+    python scripts/benchmarks/run.py --case 10976 0.3 3 elastic [--neighbours cells] [--scene walls]
 """
 
 from __future__ import annotations
@@ -31,18 +49,65 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+SIZES_3D = (10976, 108000, 1000188)  # 4 n^3: the sizes the C code runs (FCC start)
+SIZES_2D = (10000, 100000, 1000000)
+THREADS = int(os.environ.get("NUMBA_NUM_THREADS", os.cpu_count()))  # the initial placement's threads
+
+
+def magnitude(n):
+    """``"1e4"`` for N of about 10^4 (the order of magnitude that names a case)."""
+    return f"1e{len(str(int(n))) - 1}"
+
+
+def engine_case(n, packing, dim, rule="elastic", neighbours="lists", scene="periodic", repeats=5, warmup=None):
+    """A case of the engine: its id in the results file and its parameters."""
+    cid = f"{dim}D {scene} {rule} {neighbours} packing {packing:g} N~{magnitude(n)}"
+    return dict(kind="engine", id=cid, n=int(n), packing=packing, dim=dim, rule=rule, neighbours=neighbours,
+                scene=scene, repeats=repeats, warmup=warmup)
+
+
+def case_sets():
+    """Named sets of cases: a list of case dicts per set name."""
+    table = []
+    for k in range(3):
+        n3, n2 = SIZES_3D[k], SIZES_2D[k]
+        table += [engine_case(n3, 0.3, 3), engine_case(n3, 0.5, 3), engine_case(n3, 0.05, 3, neighbours="cells"),
+                  engine_case(n3, 0.1, 3, neighbours="cells"), engine_case(n2, 0.5, 2),
+                  engine_case(n3, 0.3, 3, rule="viscoelastic")]
+    scenes = []
+    for n in SIZES_3D[:2]:
+        scenes += [engine_case(n, 0.3, 3, rule="0.9", scene=s) for s in ("periodic", "walls", "driven:0.1")]
+    dsmc = [dict(kind="dsmc", id=f"{d}D N~{magnitude(n)}", n=n, dim=d, packings=(0.02, 0.3))
+            for d in (3,) for n in (10**4, 10**5, 10**6)]
+    sets = {
+        "table": table,
+        "quick": [engine_case(SIZES_3D[0], 0.3, 3, repeats=3), engine_case(SIZES_3D[1], 0.3, 3, repeats=3),
+                  engine_case(SIZES_3D[0], 0.05, 3, neighbours="cells", repeats=3)],
+        "scenes": scenes,
+        "large": [engine_case(10**7, 0.3, 3, repeats=1, warmup=5 * 10**6)],
+        "dsmc": dsmc,
+        "compile": [dict(kind="compile", id=f"3D {mode}", neighbours=mode) for mode in ("lists", "cells")],
+        "initial": [dict(kind="initial", id=f"{d}D packing {eta:g} N~{magnitude(n)} threads {THREADS}", n=n, packing=eta,
+                         dim=d)
+                    for n, eta, d in ((10**6, 0.5, 3), (10**7, 0.3, 3), (10**6, 0.7, 2))],
+    }
+    sets["all"] = [c for name in ("table", "scenes", "large", "dsmc", "compile", "initial") for c in sets[name]]
+    return sets
 
 
 def _peak_rss_bytes():
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 
 
-def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
+def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic", neighbours="lists",
+             warmup=None):
     """One benchmark case in this process; returns a dict.
 
     ``scene``: "periodic" (the standard), "walls" (flat walls on the last axis, the
     same particles), or "driven:H" (white-noise driving at heating rate H, kicks every
-    0.02 / zeta of the steady state: :func:`granulargas.theory.driving_interval`)."""
+    0.02 / zeta of the steady state: :func:`granulargas.theory.driving_interval`).
+    ``neighbours``: the engine's neighbour search ("lists", "cells"). ``warmup``: collisions
+    before the timed runs (default: 5 per particle, at least 2e5)."""
     import numpy as np
 
     from granulargas.engine import CollisionRule, Simulation
@@ -50,7 +115,7 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
 
     # compile (from cache) before measuring memory
     warm = random_state(64, 0.2, dim, seed=0)
-    Simulation(warm, CollisionRule.elastic()).run(0.1)
+    Simulation(warm, CollisionRule.elastic(), neighbours=neighbours).run(0.1)
     rss0 = _peak_rss_bytes()
     t0 = time.perf_counter()
     walls = {"boundary": ("periodic",) * (dim - 1) + ("wall",)} if scene == "walls" else {}
@@ -82,11 +147,12 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
         t_ss = float(theory.driven_temperature(h, eps, nd, dim))
         zeta = float(theory.enskog_cooling_rate(eps, nd, t_ss, dim, a2=theory.driven_sonine_a2(eps, dim)))
         driving = WhiteNoise(h, theory.driving_interval(zeta), seed=seed)
-    sim = Simulation(st, rule, **({"driving": driving} if driving else {}))
+    sim = Simulation(st, rule, neighbours=neighbours, **({"driving": driving} if driving else {}))
+    del st
     t0 = time.perf_counter()
     # build + warm-up to a steady state: 5 collisions per particle, so that the timed runs
     # see aged neighbour lists and a memory order that has drifted from the initial sort
-    sim.run(np.inf, max_collisions=max(200_000, 5 * n // 2))
+    sim.run(np.inf, max_collisions=max(200_000, 5 * n // 2) if warmup is None else warmup)
     t_build = time.perf_counter() - t0
     per_run = max(200_000, n)
     wall, cpu = [], []
@@ -107,7 +173,7 @@ def run_case(n, packing, dim, rule_name, repeats, seed=1, scene="periodic"):
         events_per_collision=sim.events / max(1, sim.collisions),
         expiries_per_collision=expiries / max(1, sim.collisions),
         stale_per_collision=stale / max(1, sim.collisions),
-        init_seconds=t_init, build_seconds=t_build, list_width=sim._nb_width, scene=scene,
+        init_seconds=t_init, build_seconds=t_build, scene=scene, neighbours=sim.neighbours,
         wall_collisions_per_collision=getattr(sim, "wall_collisions", 0) / max(1, sim.collisions),
     )
 
@@ -130,21 +196,28 @@ def _internals(sim):
             float(s["iscal"][5]))
 
 
-def jit_times():
-    """(first compile s, cached load s), each in a fresh process."""
-    code = ("import time; t=time.perf_counter(); "
-            "from granulargas.engine import Simulation, CollisionRule; "
-            "from granulargas.initial import random_state; "
-            "st=random_state(64, 0.2, 3, seed=0); "
-            "Simulation(st, CollisionRule.elastic()).run(0.5); "
-            "print(time.perf_counter()-t)")
-    env = dict(os.environ, GRANULARGAS_NO_CACHE="1")
-    first = float(subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                                 text=True, check=True).stdout.strip())
-    subprocess.run([sys.executable, "-c", code], capture_output=True, check=True)  # fill cache
-    cached = [float(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                                   check=True).stdout.strip()) for _ in range(3)]
+def compile_seconds(neighbours="lists"):
+    """(first compile, cached load) in CPU seconds of a 64-sphere run, each in a fresh process
+    (``scripts/benchmarks/startup.py``'s measurement: an empty numba cache, then the filled one)."""
+    import tempfile
+
+    import startup
+
+    root = os.path.dirname(os.path.dirname(HERE))
+    with tempfile.TemporaryDirectory() as cache:
+        first, _ = startup.engine_compile(root, neighbours, cache)
+        cached = [startup.engine_compile(root, neighbours, cache)[0] for _ in range(3)]
     return first, statistics.median(cached)
+
+
+def initial_seconds(n, packing, dim, seed=1):
+    """Wall and CPU seconds of one ``random_state`` placement (kernels compiled beforehand)."""
+    from granulargas.initial import random_state
+
+    random_state(500, packing, dim, seed=0)
+    w0, p0 = time.perf_counter(), time.process_time()
+    random_state(n, packing, dim, seed=seed)
+    return time.perf_counter() - w0, time.process_time() - p0
 
 
 def _rule_valid(name):
@@ -159,77 +232,117 @@ def _rule_valid(name):
     return value > 0 if head == "viscoelastic" else 0 < value <= 1
 
 
+def _child(args):
+    """Run ``args`` (a list) as a fresh Python process; the last line of its output as JSON."""
+    out = subprocess.run([sys.executable, *args], capture_output=True, text=True)
+    if out.returncode != 0:
+        raise RuntimeError((out.stderr.strip().splitlines() or ["no output"])[-1])
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def measure(case):
+    """Run one case (in fresh processes); the record of the results file (without its stamp)."""
+    kind = case["kind"]
+    if kind == "engine":
+        args = [os.path.abspath(__file__), "--case", str(case["n"]), str(case["packing"]), str(case["dim"]),
+                case["rule"], "--neighbours", case["neighbours"], "--scene", case["scene"],
+                "--repeats", str(case["repeats"])]
+        if case["warmup"] is not None:
+            args += ["--warmup", str(case["warmup"])]
+        r = _child(args)
+        return dict(table="engine", id=case["id"], n=r["n"], dim=r["dim"], packing=r["packing"], rule=r["rule"],
+                    neighbours=r["neighbours"], scene=r["scene"], rate_cpu=round(r["rate_cpu"] / 1e6, 4),
+                    rate_wall=round(r["rate_wall"] / 1e6, 4), events_per_collision=round(r["events_per_collision"], 2),
+                    bytes_per_particle=round(r["bytes_per_particle"]),
+                    peak_rss_per_particle=round(r["peak_rss_per_particle"]), repeats=case["repeats"])
+    if kind == "dsmc":
+        script = os.path.join(HERE, "dsmc.py")
+        d = _child([script, "--case", "dsmc", str(case["n"]), str(case["dim"]), str(case["packings"][0])])
+        rec = dict(table="dsmc", id=case["id"], n=case["n"], dim=case["dim"], rate_cpu=round(d["rate_cpu"] / 1e6, 3),
+                   acceptance=round(d["acceptance"], 3), bytes_per_particle=round(d["bytes_per_particle"]))
+        for eta in case["packings"]:
+            e = _child([script, "--case", "engine", str(case["n"]), str(case["dim"]), str(eta)])
+            rec[f"engine_rate_cpu_{eta:g}"] = round(e["rate_cpu"] / 1e6, 4)
+        return rec
+    if kind == "compile":
+        first, cached = compile_seconds(case["neighbours"])
+        return dict(table="compile", id=case["id"], first_seconds=round(first, 1), cached_seconds=round(cached, 2))
+    if kind == "initial":
+        w, c = _child([os.path.abspath(__file__), "--initial", str(case["n"]), str(case["packing"]), str(case["dim"])])
+        return dict(table="initial", id=case["id"], n=case["n"], packing=case["packing"], dim=case["dim"],
+                    wall_seconds=round(w, 1), cpu_seconds=round(c, 1),
+                    threads=THREADS)
+    raise ValueError(kind)
+
+
+def _show(rec):
+    skip = {"table", "id"}
+    return f"{rec['table']:>8} | {rec['id']:<44} | " + ", ".join(f"{k} {v}" for k, v in rec.items() if k not in skip
+                                                               and k not in ("n", "dim", "packing", "rule",
+                                                                             "neighbours", "scene"))
+
+
 def main(argv=None):
+    sets = case_sets()
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--quick", action="store_true", help="N = 1e4, 1e5 at packing 0.3 (3D elastic, "
-                   "2D, viscoelastic), 3 repeats")
-    p.add_argument("--sizes", type=float, nargs="+", default=None)
-    p.add_argument("--packings", type=float, nargs="+", default=None)
-    p.add_argument("--dims", type=int, nargs="+", default=None)
-    p.add_argument("--rules", nargs="+", default=None,
-                   help="elastic, viscoelastic (damping 0.1), viscoelastic:DAMPING or a constant eps")
-    p.add_argument("--repeats", type=int, default=None)
-    p.add_argument("--no-jit", action="store_true", help="skip the JIT timing")
-    p.add_argument("--json", default=None, help="also write the results to this JSON file")
+    p.add_argument("sets", nargs="*", help=f"sets of cases: {', '.join(sets)}")
+    p.add_argument("--only", default=None, help="only the cases whose id contains this text")
+    p.add_argument("--list", action="store_true", help="print the cases of the sets and exit")
+    p.add_argument("--record", action="store_true",
+                   help="write the figures into docs/performance/results.json and rewrite the performance page")
     p.add_argument("--case", nargs=4, default=None, help=argparse.SUPPRESS)
+    p.add_argument("--initial", nargs=3, default=None, help=argparse.SUPPRESS)
     p.add_argument("--scene", default="periodic", help=argparse.SUPPRESS)
+    p.add_argument("--neighbours", default="lists", choices=["lists", "cells"], help=argparse.SUPPRESS)
+    p.add_argument("--repeats", type=int, default=5, help=argparse.SUPPRESS)
+    p.add_argument("--warmup", type=int, default=None, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
-    for rule in args.rules or []:
-        if not _rule_valid(rule):
-            p.error(f"--rules {rule}: allowed are elastic, viscoelastic, viscoelastic:DAMPING "
-                    f"(DAMPING > 0) and a constant eps in (0, 1]")
 
-    if args.case:
+    if args.case:  # one engine case in this process (the runner's child; scripts/ab/alternated.py)
         n, eta, dim, rule = args.case
-        print(json.dumps(run_case(int(float(n)), float(eta), int(dim), rule, args.repeats or 5,
-                                  scene=args.scene)))
+        if not _rule_valid(rule):
+            p.error(f"rule {rule}: allowed are elastic, viscoelastic, viscoelastic:DAMPING (DAMPING > 0) "
+                    f"and a constant eps in (0, 1]")
+        print(json.dumps(run_case(int(float(n)), float(eta), int(dim), rule, args.repeats, scene=args.scene,
+                                  neighbours=args.neighbours, warmup=args.warmup)))
         return 0
-
-    if args.quick:
-        sizes, packings = [1e4, 1e5], [0.3]
-        repeats = args.repeats or 3
-    else:
-        sizes, packings = [1e4, 1e5, 1e6], [0.1, 0.3, 0.5]
-        repeats = args.repeats or 5
-    sizes = args.sizes or sizes
-    packings = args.packings or packings
-    cases = []
-    for n in sizes:
-        for dim in (args.dims or [3]):
-            for eta in packings:
-                for rule in (args.rules or ["elastic"]):
-                    cases.append((n, eta if dim == 3 else min(0.7, eta * 5 / 3), dim, rule))
-    if args.dims is None and args.rules is None:  # the standard extras: 2D and viscoelastic
-        for n in sizes:
-            cases.append((n, 0.5, 2, "elastic"))
-            cases.append((n, 0.3, 3, "viscoelastic"))
-
-    print(f"# granulargas engine benchmark, {time.strftime('%Y-%m-%d %H:%M')}, "
-          f"{os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f} at start")
-    if not args.no_jit:
-        first, cached = jit_times()
-        print(f"# JIT: first compile + tiny run {first:.1f} s (no cache); cached load + tiny run {cached:.2f} s")
-    print("# rate = median pair collisions per second over repeats (wall clock; CPU time of the process)")
-    header = (f"{'N':>9} {'d':>2} {'eta':>5} {'rule':>12} {'Mcoll/s wall':>13} {'Mcoll/s cpu':>12} "
-              f"{'B/particle':>10} {'peakRSS B/p':>11} {'ev/coll':>8} {'init s':>7}")
-    print(header)
-    results = []
-    for n, eta, dim, rule in cases:
-        out = subprocess.run([sys.executable, os.path.abspath(__file__), "--case", str(int(n)), str(eta),
-                              str(dim), rule, "--repeats", str(repeats)],
-                             capture_output=True, text=True)
-        if out.returncode != 0:
-            print(f"{int(n):>9} {dim:>2} {eta:>5} {rule:>12}  FAILED: {out.stderr.strip().splitlines()[-1]}")
+    if args.initial:
+        n, eta, dim = args.initial
+        print(json.dumps(initial_seconds(int(float(n)), float(eta), int(dim))))
+        return 0
+    unknown = [s for s in args.sets if s not in sets]
+    if not args.sets or unknown:
+        p.error(f"sets: {' '.join(unknown) or '(none given)'}: allowed are {', '.join(sets)}")
+    cases, seen = [], set()
+    for name in args.sets:
+        for c in sets[name]:
+            if (c["kind"], c["id"]) not in seen and (args.only is None or args.only in c["id"]):
+                seen.add((c["kind"], c["id"]))
+                cases.append(c)
+    if args.list:
+        for c in cases:
+            print(f"{c['kind']:>8} | {c['id']}")
+        return 0
+    load = os.getloadavg()[0]
+    print(f"# granulargas benchmark, {time.strftime('%Y-%m-%d %H:%M')}, {os.cpu_count()} CPUs, "
+          f"load average {load:.2f} at start; rates in million collisions per second (CPU time)", flush=True)
+    records = []
+    for c in cases:
+        try:
+            rec = measure(c)
+        except RuntimeError as err:
+            print(f"{c['kind']:>8} | {c['id']:<44} | FAILED: {err}", flush=True)
             continue
-        r = json.loads(out.stdout.strip().splitlines()[-1])
-        results.append(r)
-        print(f"{r['n']:>9} {r['dim']:>2} {r['packing']:>5} {r['rule']:>12} {r['rate_wall'] / 1e6:>13.3f} "
-              f"{r['rate_cpu'] / 1e6:>12.3f} {r['bytes_per_particle']:>10.0f} "
-              f"{r['peak_rss_per_particle']:>11.0f} {r['events_per_collision']:>8.2f} "
-              f"{r['init_seconds']:>7.1f}", flush=True)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(results, f, indent=1)
+        records.append(rec)
+        print(_show(rec), flush=True)
+    if args.record and records:
+        import performance_page
+        import results
+
+        command = "python scripts/benchmarks/run.py " + " ".join(args.sets) + (
+            f" --only {args.only!r}" if args.only else "")
+        results.record(records, command, load_average=max(load, os.getloadavg()[0]))
+        performance_page.main([])
     return 0
 
 

@@ -52,6 +52,17 @@ VARIANT_RUNS = [
     ("constant eps", "haff_3d.toml", SHORT),
     ("lists 3D", "elastic_3d.toml", SHORT),
 ]
+#: the rows of the performance page's start-up table: (id in the results file, text) per row name
+PAGE_ROWS = {
+    "quickstart (fresh install)": ("0", "quickstart on a fresh install (empty numba and table caches)"),
+    "after the quickstart: 2D": ("1", "then a 2D run (neighbour lists)"),
+    "after the quickstart: driven": ("2", "then a driven run (the driving step)"),
+    "after the quickstart: walls": ("3", "then a run with walls"),
+    "after the quickstart: DSMC": ("4", "then a DSMC run"),
+    "after the quickstart: constant eps": ("5", "then a constant-ε run"),
+    "after the quickstart: lists 3D": ("6", "then dense 3D (neighbour lists, placement with pushes)"),
+    "warm small 2D run (400 disks)": ("7", "a warm run (everything cached), 400 disks"),
+}
 WARM = ("haff_2d.toml", ["--set", "system.particles=400", "--set", "run.collisions_per_particle=5"])
 
 _STARTUP = re.compile(r"\+ ([0-9.e+-]+) s start-up \((?:([0-9.e+-]+) s of it compiling)?")
@@ -155,7 +166,12 @@ def main(argv=None):
     p.add_argument("--modes", nargs="+", default=["lists", "cells"], choices=["lists", "cells"])
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--core", type=int, default=None, help="pin the runs to this core (taskset)")
+    p.add_argument("--record", action="store_true", help="write the medians into docs/performance/results.json "
+                   "and rewrite the performance page (one tree only)")
     args = p.parse_args(argv)
+    if args.record and len(args.trees) > 1:
+        p.error("--record: measures one source tree; give one --trees entry")
+    load = os.getloadavg()[0]
     for tree in args.trees:
         if not os.path.isdir(os.path.join(tree, "granulargas")):
             p.error(f"--trees {tree}: no granulargas package there")
@@ -192,7 +208,29 @@ def main(argv=None):
             print(f"engine {mode:5s} {tree}: first compile CPU {statistics.median(x[0] for x in f):.1f} s, "
                   f"wall {statistics.median(x[1] for x in f):.1f} s; cached load CPU "
                   f"{statistics.median(x[0] for x in c):.2f} s, wall {statistics.median(x[1] for x in c):.2f} s")
+    if args.record:
+        record(args, rows, first, cached, argv if argv is not None else sys.argv[1:], max(load, os.getloadavg()[0]))
     return 0
+
+
+def record(args, rows, first, cached, argv, load):
+    """The medians as records of the results file (tables ``startup`` and ``compile``); rewrite the page."""
+    sys.path.insert(0, HERE)
+    import performance_page
+    import results
+
+    records = []
+    for name, rs in rows.items():
+        key, what = PAGE_ROWS[name]
+        records.append(dict(table="startup", id=f"{key} {what}", what=what,
+                            cpu_seconds=round(statistics.median(x[0] for x in rs), 1),
+                            compile_seconds=round(statistics.median(x[3] for x in rs), 1), rounds=len(rs)))
+    for (tree, mode), f in first.items():
+        records.append(dict(table="compile", id=f"3D {mode}", neighbours=mode,
+                            first_seconds=round(statistics.median(x[0] for x in f), 1),
+                            cached_seconds=round(statistics.median(x[0] for x in cached[(tree, mode)]), 2)))
+    results.record(records, "python scripts/benchmarks/startup.py " + " ".join(argv), load_average=load)
+    performance_page.main([])
 
 
 if __name__ == "__main__":
