@@ -127,6 +127,7 @@ def main(argv=None):
                    help="write the figures into docs/performance/results.json and rewrite the performance page")
     args = p.parse_args(argv)
     load = os.getloadavg()[0]
+    commit = _commit()
     results = []
     rule = make_rule(args.rule)
     for mode, s in compile_seconds(rule, args.modes).items():
@@ -176,10 +177,10 @@ def main(argv=None):
     if args.plot:
         plot(results, args.plot, f"{args.dimension}D, {args.rule}")
     if args.record:
-        record(results, args, argv if argv is not None else sys.argv[1:], max(load, os.getloadavg()[0]))
+        record(results, args, argv if argv is not None else sys.argv[1:], max(load, os.getloadavg()[0]), commit)
 
 
-def record(results, args, argv, load):
+def record(results, args, argv, load, commit):
     """Write the engine's, the C code's and the chart's records into the results file; rewrite the page."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     import performance_page
@@ -211,7 +212,7 @@ def record(results, args, argv, load):
             records.append(dict(table="dilute", id=f"{r['mode']} packing {r['packing']:g} N={r['n']}", n=r["n"],
                                 packing=r["packing"], mode=r["mode"], width=round(width, 1),
                                 rate_cpu=round(r["rate"], 4), events_per_collision=round(r["events"], 2)))
-    results_file.record(records, command, load_average=load)
+    results_file.record(records, command, load_average=load, commit=commit)
     performance_page.main([])
 
 
@@ -257,6 +258,14 @@ def plot(results, path, title):
 def _counts(sim):
     c = sim._engine.counters[0]
     return {k: float(c[k]) for k in ("events", "collisions", "expiries", "crossings", "stale")}
+
+
+def _commit():
+    """The source tree's commit when the measurement starts (``scripts/benchmarks/results.py``)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import results
+
+    return results.this_commit()
 
 
 if __name__ == "__main__":

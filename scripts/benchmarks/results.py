@@ -69,14 +69,15 @@ def this_commit(tree=ROOT):
     return head + ("+changes" if dirty else "")
 
 
-def record(new, command, path=RESULTS, load_average=None):
+def record(new, command, path=RESULTS, load_average=None, commit=None):
     """Add measured records (dicts with ``table``, ``id`` and the figures) to the results file,
     stamped with this machine, today's date, the commit and ``command``; a record of the same
-    table and id is replaced."""
+    table and id is replaced. ``commit``: the source tree measured (default: this tree's HEAD now;
+    a long run passes the commit it started from)."""
     data = load(path)
     key, desc = this_machine()
     data["machines"].setdefault(key, desc)
-    stamp = {"machine": key, "date": datetime.date.today().isoformat(), "commit": this_commit(),
+    stamp = {"machine": key, "date": datetime.date.today().isoformat(), "commit": commit or this_commit(),
              "command": command}
     if load_average is not None:
         stamp["load"] = round(load_average, 1)

@@ -324,6 +324,7 @@ def main(argv=None):
             print(f"{c['kind']:>8} | {c['id']}")
         return 0
     load = os.getloadavg()[0]
+    commit = _commit()
     print(f"# granulargas benchmark, {time.strftime('%Y-%m-%d %H:%M')}, {os.cpu_count()} CPUs, "
           f"load average {load:.2f} at start; rates in million collisions per second (CPU time)", flush=True)
     records = []
@@ -341,9 +342,17 @@ def main(argv=None):
 
         command = "python scripts/benchmarks/run.py " + " ".join(args.sets) + (
             f" --only {args.only!r}" if args.only else "")
-        results.record(records, command, load_average=max(load, os.getloadavg()[0]))
+        results.record(records, command, load_average=max(load, os.getloadavg()[0]), commit=commit)
         performance_page.main([])
     return 0
+
+
+def _commit():
+    """The source tree's commit when the measurement starts (``scripts/benchmarks/results.py``)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import results
+
+    return results.this_commit()
 
 
 if __name__ == "__main__":

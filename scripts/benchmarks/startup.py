@@ -172,6 +172,7 @@ def main(argv=None):
     if args.record and len(args.trees) > 1:
         p.error("--record: measures one source tree; give one --trees entry")
     load = os.getloadavg()[0]
+    commit = _commit()
     for tree in args.trees:
         if not os.path.isdir(os.path.join(tree, "granulargas")):
             p.error(f"--trees {tree}: no granulargas package there")
@@ -209,11 +210,12 @@ def main(argv=None):
                   f"wall {statistics.median(x[1] for x in f):.1f} s; cached load CPU "
                   f"{statistics.median(x[0] for x in c):.2f} s, wall {statistics.median(x[1] for x in c):.2f} s")
     if args.record:
-        record(args, rows, first, cached, argv if argv is not None else sys.argv[1:], max(load, os.getloadavg()[0]))
+        record(args, rows, first, cached, argv if argv is not None else sys.argv[1:], max(load, os.getloadavg()[0]),
+               commit)
     return 0
 
 
-def record(args, rows, first, cached, argv, load):
+def record(args, rows, first, cached, argv, load, commit):
     """The medians as records of the results file (tables ``startup`` and ``compile``); rewrite the page."""
     sys.path.insert(0, HERE)
     import performance_page
@@ -229,8 +231,17 @@ def record(args, rows, first, cached, argv, load):
         records.append(dict(table="compile", id=f"3D {mode}", neighbours=mode,
                             first_seconds=round(statistics.median(x[0] for x in f), 1),
                             cached_seconds=round(statistics.median(x[0] for x in cached[(tree, mode)]), 2)))
-    results.record(records, "python scripts/benchmarks/startup.py " + " ".join(argv), load_average=load)
+    results.record(records, "python scripts/benchmarks/startup.py " + " ".join(argv), load_average=load,
+                   commit=commit)
     performance_page.main([])
+
+
+def _commit():
+    """The source tree's commit when the measurement starts (``scripts/benchmarks/results.py``)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import results
+
+    return results.this_commit()
 
 
 if __name__ == "__main__":
