@@ -16,6 +16,8 @@ Usage::
 
     python scripts/benchmarks/performance_page.py            # rewrite the page and its figures
     python scripts/benchmarks/performance_page.py --check    # exit 1 if the page differs from the file
+
+The README's Performance section holds the page's summary in a ``readme`` block, written the same way.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ sys.path.insert(0, str(HERE))
 import results  # noqa: E402
 
 PAGE = results.ROOT / "docs" / "performance.md"
+README = results.ROOT / "README.md"  # its Performance section shows the page's summary
 FIGURES = results.ROOT / "docs" / "figures"
 BLOCK = re.compile(r"(<!-- results: ([\w-]+) -->\n)(.*?)(<!-- end results -->)", re.S)
 
@@ -238,13 +241,18 @@ def _find(data, table, **match):
     raise KeyError(f"{table}: no record with {match}")
 
 
-def block_headline(data):
+def headline(data, plain=False):
+    """The page's summary in one paragraph; ``plain``: for the README (no maths markup)."""
+    def m(tex, text):
+        return text if plain else f"\\({tex}\\)"
+
     dense = [_find(data, "c_code", neighbours="lists", packing=0.3, n=n) for n in (10976, 108000, 1000188)]
     dilute = [_find(data, "c_code", neighbours="cells", packing=eta, n=10976) for eta in (0.05, 0.1)]
     dilute5 = _find(data, "c_code", neighbours="cells", packing=0.05, n=108000)
     quick = _find(data, "startup", id=min(r["id"] for r in by_table(data, "startup")))
     lists = [r["bytes_per_particle"] for r in by_table(data, "memory") if r["what"].endswith("neighbour lists")]
     init = _find(data, "initial", dim=3, packing=0.5, n=10**6, threads=2)
+    dsmc = [r["rate_cpu"] for r in by_table(data, "dsmc")]
 
     def x(r):
         return f"×{r['rate_cpu'] / r['c_rate_cpu']:.2f}"
@@ -252,15 +260,25 @@ def block_headline(data):
     def rate(r):
         return fmt(r["rate_cpu"], 3)
 
+    n4, n5, n6 = m("N \\approx 10^4", "N ≈ 10⁴"), m("10^5", "10⁵"), m("10^6", "10⁶")
     return (f"Elastic hard spheres at packing 0.3, one core, side by side with a compiled C reference code: "
-            f"{x(dense[0])} at \\(N \\approx 10^4\\), {x(dense[1])} at \\(10^5\\) and {x(dense[2])} at \\(10^6\\) "
-            f"({rate(dense[0])}, {rate(dense[1])} and {rate(dense[2])} million "
+            f"{x(dense[0])} at {n4}, {x(dense[1])} at {n5} and "
+            f"{x(dense[2])} at {n6} ({rate(dense[0])}, {rate(dense[1])} and {rate(dense[2])} million "
             f"collisions per CPU second). Dilute gases (cell crossings): {x(dilute[0])} at packing 0.05 and "
-            f"{x(dilute[1])} at 0.1 for \\(N \\approx 10^4\\), {x(dilute5)} at 0.05 for \\(10^5\\). The "
-            f"quickstart's first run on a fresh install: {fmt(quick['cpu_seconds'])} s of CPU, "
-            f"{fmt(quick['compile_seconds'])} s of it compiling (once). Engine state {min(lists)}–{max(lists)} "
-            f"bytes per particle. The initial state of \\(10^6\\) spheres at packing 0.5 in "
-            f"{fmt(init['wall_seconds'])} s (two threads).\n")
+            f"{x(dilute[1])} at 0.1 for {n4}, {x(dilute5)} at 0.05 for "
+            f"{n5}. The quickstart's first run on a fresh install: {fmt(quick['cpu_seconds'])} s of "
+            f"CPU, {fmt(quick['compile_seconds'])} s of it compiling (once). Engine state {min(lists)}–{max(lists)} "
+            f"bytes per particle. The initial state of {n6} spheres at packing 0.5 in "
+            f"{fmt(init['wall_seconds'])} s (two threads). The DSMC: {fmt(min(dsmc))}–{fmt(max(dsmc))} million "
+            f"collisions per CPU second.\n")
+
+
+def block_headline(data):
+    return headline(data)
+
+
+def block_readme(data):
+    return headline(data, plain=True)
 
 
 BLOCKS = {name[len("block_"):].replace("_", "-"): fn for name, fn in globals().items() if name.startswith("block_")}
@@ -271,44 +289,38 @@ def render(page_text, data):
     def one(m):
         name = m.group(2)
         if name not in BLOCKS:
-            raise KeyError(f"{PAGE.name}: unknown results block {name!r}; known: {', '.join(sorted(BLOCKS))}")
+            raise KeyError(f"unknown results block {name!r}; known: {', '.join(sorted(BLOCKS))}")
         return m.group(1) + BLOCKS[name](data) + m.group(4)
 
     return BLOCK.sub(one, page_text)
 
 
 def figure_scaling(data, path):
-    """Collision rate against N: the engine's cases and the C code's, one line per (d, packing, mode)."""
+    """Collision rate against N for the cases that the C code ran too: granulargas solid, the C code
+    dashed, one colour per (packing, neighbour search)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    lines = {}
-    for r in by_table(data, "engine"):
-        if r["scene"] == "periodic" and r["rule"] == "elastic":
-            lines.setdefault((r["dim"], r["packing"], r["neighbours"]), []).append((r["n"], r["rate_cpu"]))
-    for k, ((d, eta, nb), pts) in enumerate(sorted(lines.items())):
-        if len(pts) < 2:
+    pairs = sorted({(r["packing"], r["neighbours"], r["c_variant"]) for r in by_table(data, "c_code")})
+    for k, (eta, nb, variant) in enumerate(pairs):
+        ours = sorted((r["n"], r["rate_cpu"]) for r in by_table(data, "engine")
+                      if (r["dim"], r["scene"], r["rule"], r["packing"], r["neighbours"]) == (3, "periodic", "elastic",
+                                                                                            eta, nb))
+        theirs = sorted((r["n"], r["c_rate_cpu"]) for r in by_table(data, "c_code")
+                        if (r["packing"], r["neighbours"]) == (eta, nb))
+        if len(theirs) < 2:
             continue
-        n, rate = zip(*sorted(pts))
-        ax.plot(n, rate, "o-", color=f"C{k}", label=f"granulargas, {d}D, packing {eta:g}, {nb}")
-    c = {}
-    for r in by_table(data, "c_code"):
-        c.setdefault((r["c_variant"], r["packing"]), []).append((r["n"], r["c_rate_cpu"]))
-    for (variant, eta), pts in sorted(c.items()):
-        if len(pts) < 2:
-            continue
-        n, rate = zip(*sorted(pts))
-        ax.plot(n, rate, "s--", color="0.35" if variant == "Single" else "0.65",
-                label=f"C code ({variant}), 3D, packing {eta:g}")
+        ax.plot(*zip(*ours), "o-", color=f"C{k}", label=f"granulargas, packing {eta:g}, {nb}")
+        ax.plot(*zip(*theirs), "s--", color=f"C{k}", alpha=0.6, label=f"C code ({variant}), packing {eta:g}")
     ax.set_xscale("log")
     ax.set_xlabel("particles N")
     ax.set_ylabel("million collisions per CPU second")
     ax.set_ylim(bottom=0)
-    ax.set_title("Elastic gases, one core: rate against system size")
-    ax.legend(fontsize=7)
+    ax.set_title("Elastic hard spheres (3D), one core: rate against N")
+    ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -345,7 +357,7 @@ def figure_dilute(data, path):
         ax.set_title(f"N = {rows[0]['n']}, packing {eta:g}")
         ax.set_ylim(0.0, 1.15 * max(r["rate_cpu"] for r in rows))
         ax.set_xlim(0.0, 1.12 * max(max(r["events_per_collision"] for r in rows), 2.0))
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=8, loc="upper left")
     fig.suptitle("Speed against events per collision (3D, elastic)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -358,15 +370,19 @@ def main(argv=None):
     p.add_argument("--results", type=Path, default=results.RESULTS)
     args = p.parse_args(argv)
     data = results.load(args.results)
-    text = PAGE.read_text()
-    new = render(text, data)
-    if args.check:
+    stale = []
+    for page in (PAGE, README):
+        text = page.read_text()
+        new = render(text, data)
         if new != text:
-            print(f"{PAGE}: tables differ from {args.results}; run python scripts/benchmarks/performance_page.py",
+            stale.append(page)
+            if not args.check:
+                page.write_text(new)
+    if args.check:
+        for page in stale:
+            print(f"{page}: figures differ from {args.results}; run python scripts/benchmarks/performance_page.py",
                   file=sys.stderr)
-            return 1
-        return 0
-    PAGE.write_text(new)
+        return 1 if stale else 0
     figure_scaling(data, FIGURES / "performance_scaling.png")
     figure_dilute(data, FIGURES / "performance_dilute_events.png")
     print(f"wrote {PAGE}, {FIGURES / 'performance_scaling.png'}, {FIGURES / 'performance_dilute_events.png'}")
