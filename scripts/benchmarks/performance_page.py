@@ -327,17 +327,17 @@ def figure_scaling(data, path):
 
 
 def figure_dilute(data, path):
-    """Rate against events per collision at packing 0.05 and 0.1 (cells of several widths, list shells)."""
+    """Rate against events per collision, one panel per N and packing (cells of several widths, list shells)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     recs = by_table(data, "dilute")
-    packings = sorted({r["packing"] for r in recs})
-    fig, axes = plt.subplots(1, len(packings), figsize=(4.8 * len(packings), 4.0), squeeze=False)
-    for ax, eta in zip(axes[0], packings):
-        rows = [r for r in recs if r["packing"] == eta]
+    cases = sorted({(r["n"], r["packing"]) for r in recs})  # one panel per N and packing
+    fig, axes = plt.subplots(1, len(cases), figsize=(4.8 * len(cases), 4.0), squeeze=False)
+    for ax, (n, eta) in zip(axes[0], cases):
+        rows = [r for r in recs if (r["n"], r["packing"]) == (n, eta)]
         for kind, marker, colour in (("lists", "s", "C0"), ("cells", "o", "C1")):
             pts = sorted((r["events_per_collision"], r["rate_cpu"], r["width"]) for r in rows
                          if r["mode"].split(":")[0] == kind)
@@ -348,13 +348,13 @@ def figure_dilute(data, path):
                     + ("cell width" if kind == "cells" else "shell") + ", diameters)")
             for xi, yi, wi in pts:
                 ax.annotate(f"{wi:g}", (xi, yi), textcoords="offset points", xytext=(4, 4), fontsize=8, color=colour)
-        for k, r in enumerate(r for r in by_table(data, "c_code") if r["packing"] == eta and r["n"] == rows[0]["n"]
+        for k, r in enumerate(r for r in by_table(data, "c_code") if (r["n"], r["packing"]) == (n, eta)
                               and r["neighbours"] == "cells"):
             ax.axhline(r["c_rate_cpu"], color=f"C{k + 2}", ls="--", label=f"C code ({r['c_variant']}, {r['date']})")
         ax.axvline(2.0, color="0.6", ls=":", lw=1, label="2 events per collision")
         ax.set_xlabel("events per collision")
         ax.set_ylabel("million collisions per CPU second")
-        ax.set_title(f"N = {rows[0]['n']}, packing {eta:g}")
+        ax.set_title(f"N = {n}, packing {eta:g}")
         ax.set_ylim(0.0, 1.15 * max(r["rate_cpu"] for r in rows))
         ax.set_xlim(0.0, 1.12 * max(max(r["events_per_collision"] for r in rows), 2.0))
         ax.legend(fontsize=8, loc="upper left")
