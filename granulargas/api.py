@@ -104,7 +104,9 @@ class Result:
             raise ModuleNotFoundError("Result.observables() returns a pandas DataFrame and pandas is not "
                                       "installed: pip install 'granulargas[pandas]' (or use "
                                       "Result.observables_dict(), numpy arrays)", name="pandas") from None
-        columns = observable_columns(self.observables_dict(), self.path)
+        params = h5md.read_parameters(self.path)
+        names = params["species"]["names"] if isinstance(params.get("species"), dict) else None
+        columns = observable_columns(self.observables_dict(), self.path, species=names)
         frame = pd.DataFrame(columns)
         return frame.set_index("time")
 
@@ -130,9 +132,11 @@ class Result:
         return analyze(self.path, **options)
 
 
-def observable_columns(observables: dict, source="observables") -> dict:
+def observable_columns(observables: dict, source="observables", species=None) -> dict:
     """Columns of the observables table from :func:`granulargas.io.h5md.read_observables`:
-    ``time``, ``step`` and one column per scalar observable (one per axis for a vector).
+    ``time``, ``step`` and one column per scalar observable (one per axis for a vector; a
+    mixture's per species, ``species_temperature_<name>``, and per pair of species,
+    ``species_collisions_<a>_<b>``, with the species' ``species`` names or their indices).
 
     All observables of a run share one clock; one that is shorter than the longest (a
     sample cut short) is NaN at the missing times.
@@ -146,8 +150,14 @@ def observable_columns(observables: dict, source="observables") -> dict:
         if not (np.array_equal(t, time[:n]) and np.array_equal(s, step[:n])):
             raise InputFileError(f"{source}: observables/{name} is not sampled on the clock of the others")
         value = np.asarray(value)
-        parts = {name: value} if value.ndim == 1 else {
-            f"{name}_{AXES[k] if value.shape[1] <= len(AXES) else k}": value[:, k] for k in range(value.shape[1])}
+        if name.startswith("species_") and value.ndim >= 2:  # per species, per pair of species
+            label = list(species) if species is not None else [str(k) for k in range(value.shape[1])]
+            parts = ({f"{name}_{label[k]}": value[:, k] for k in range(value.shape[1])} if value.ndim == 2 else
+                     {f"{name}_{label[a]}_{label[b]}": value[:, a, b] for a in range(value.shape[1])
+                      for b in range(a, value.shape[1])})
+        else:
+            parts = {name: value} if value.ndim == 1 else {
+                f"{name}_{AXES[k] if value.shape[1] <= len(AXES) else k}": value[:, k] for k in range(value.shape[1])}
         for column, v in parts.items():
             if n < time.size:
                 v = np.concatenate([v.astype(np.float64), np.full(time.size - n, np.nan)])

@@ -1,4 +1,5 @@
-"""Observables of a particle sample: kinetic energy, momentum, temperature, Sonine coefficients a2, a3.
+"""Observables of a particle sample: kinetic energy, momentum, temperature, Sonine coefficients a2, a3
+(and per species of a mixture, :func:`species_moments`).
 
 With c_i the peculiar velocity (velocity minus the mass-weighted mean) and
 e_i = m_i c_i^2, the temperature is T = <e>/d (k_B = 1) and
@@ -129,6 +130,36 @@ def sonine_a2(velocities, masses=None) -> float:
 def sonine_a3(velocities, masses=None) -> float:
     """Third Sonine coefficient a3 = 1 + 3 a2 - d^2/((d+2)(d+4)) <c^6>/<c^2>^3."""
     return sonine_coefficients(velocities, masses)[1]
+
+
+def species_moments(velocities, masses, species, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """(T_s, a2_s), arrays (S,), of each species of a mixture.
+
+    With c the peculiar velocity (velocity minus the mass-weighted mean of the whole gas, the
+    mixture's flow velocity) and e = m c^2: T_s = <e>_s / d over the n_s particles of species s
+    (Garzó & Dufty 1999: the partial temperatures, T = sum_s x_s T_s) and
+    a2_s = d/(d+2) <e^2>_s / <e>_s^2 - 1. ``species`` (N,) ints in [0, count); a species without
+    particles gives NaN. Sums over c divided by its largest component (no underflow).
+    """
+    v, m = _arrays(velocities, masses)
+    m = np.broadcast_to(m, (v.shape[0],))
+    s = np.asarray(species, dtype=np.int64)
+    if s.shape != (v.shape[0],) or (s.size and (s.min() < 0 or s.max() >= count)):
+        raise ValueError(f"species: one index in [0, {count}) per particle")
+    d = v.shape[1]
+    c = v - (m @ v) / m.sum()
+    scale = float(np.max(np.abs(c))) if c.size else 0.0
+    n = np.bincount(s, minlength=count).astype(np.float64)
+    if not scale > 0.0:
+        return np.where(n > 0, 0.0, np.nan), np.full(count, np.nan)
+    c = c / scale
+    e = m * np.einsum("ij,ij->i", c, c)
+    e1 = np.bincount(s, e, minlength=count)
+    e2 = np.bincount(s, e * e, minlength=count)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        temperature = np.where(n > 0, e1 / (d * n) * scale * scale, np.nan)
+        a2 = np.where(e1 > 0, d / (d + 2.0) * n * e2 / (e1 * e1) - 1.0, np.nan)
+    return temperature, a2
 
 
 def finite_sample_sonine(n: int, dim: int) -> tuple[float, float]:

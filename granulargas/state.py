@@ -165,6 +165,9 @@ class State:
         Kinetic energy dissipated in collisions and put in by the driving so far.
     kick_step : int or None
         Index k of the next driving step, at (k + 1/2) dt (None: the first after ``time``).
+    species_collisions : int64 array (S, S) or None
+        A mixture: pair collisions so far per pair of species, symmetric (entry (a, b)
+        counts the collisions between species a and b); None: not counted (0).
     dsmc : DSMCContinuation or None
         The DSMC's random state and pending collision (None: a fresh DSMC start).
     """
@@ -188,6 +191,7 @@ class State:
     injected_energy: float = 0.0
     kick_step: int | None = None
     three_body_contacts: int = 0
+    species_collisions: np.ndarray | None = None
     dsmc: DSMCContinuation | None = None
 
     def __post_init__(self):
@@ -223,6 +227,11 @@ class State:
             set_(self, name, int(getattr(self, name)))
         if self.kick_step is not None:
             set_(self, "kick_step", int(self.kick_step))
+        if self.species_collisions is not None:
+            counts = np.array(self.species_collisions, dtype=np.int64)
+            if counts.ndim != 2 or counts.shape[0] != counts.shape[1] or not np.array_equal(counts, counts.T):
+                raise ConfigError(f"species_collisions: a symmetric (S, S) table of counts, got shape {counts.shape}")
+            set_(self, "species_collisions", counts)
 
     @property
     def n(self) -> int:

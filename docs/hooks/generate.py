@@ -62,6 +62,9 @@ SECTION_TEXT = {
                           "(SI; all keys required), converted once to the reduced pair prefactor "
                           "k = (3/2) A (2Y / (3(1 − ν²)))^(2/5) (σ u / m²)^(1/5).",
     "driving": "Optional: white-noise driving (a heated granular gas in a steady state).",
+    "species": "Optional, in place of `[particles]`: an array of tables `[[species]]`, one per species of "
+               "a mixture ([Mixtures](mixtures.md)). Each key below is checked per species and named "
+               "`species.<name>.<key>` in messages and overrides.",
     "run": "When to stop (at least one key).",
     "output": "The output file and its schedule.",
 }
@@ -113,7 +116,8 @@ def config_reference_markdown() -> str:
     lines = []
     for section in dict.fromkeys(e.section for e in entries):
         anchor = section.replace(".", "-")
-        lines += [f"## `[{section}]` {{ #{anchor} }}", ""]
+        shown = f"[[{section}]]" if section == "species" else f"[{section}]"  # an array of tables
+        lines += [f"## `{shown}` {{ #{anchor} }}", ""]
         if section in SECTION_TEXT:
             lines += [SECTION_TEXT[section], ""]
         lines += ["| key | type | default | unit | allowed | meaning |", "|---|---|---|---|---|---|"]

@@ -7,7 +7,8 @@ cooling runs against the kinetic theory of :mod:`granulargas.theory.gas`, elasti
 against the equation of state and Enskog's collision frequency, driven runs' steady
 state against :mod:`granulargas.theory.driven`; a run with walls also gets the wall
 pressure and the density across the walls, :mod:`granulargas.analysis.walls`, and
-``--plot`` a second figure of the density profile) or a sweep's output
+``--plot`` a second figure of the density profile; a mixture also gets the temperature of each
+species against :mod:`granulargas.analysis.species` and a figure of T_i/T_j) or a sweep's output
 directory (its ``index.json``: one row per parameter set, mean +- standard error over
 the seeds). ``--json`` prints one JSON object instead of the text report.
 """
@@ -81,6 +82,10 @@ def _header(info) -> list[str]:
         lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
                      f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
                      f"same number density (packing {info.packing_fraction:.4g})")
+    if info.scene.shows("mixture_mean_particle"):
+        lines.append(f"  note: a mixture; the T(t) theory below is that of identical particles of the mean diameter "
+                     f"{info.diameter:.4g} and its mass {info.mass:.4g} with the mean law; the species section at the "
+                     "end compares each species and T = sum x_i T_i with the mixture's own theory")
     return lines
 
 
@@ -338,14 +343,23 @@ def run(args) -> int:
 
         t_from = getattr(a, "t_equilibrated", getattr(a, "t_relaxed", float(a.time[0])))
         walls = wall_summary(a.info, t_from)
+    from granulargas.analysis.species import analyze_species
+
+    try:
+        species = analyze_species(args.file, a.info.box, a.info.dimension)
+    except (ValueError, ArithmeticError, KeyError) as exc:
+        raise InputFileError(f"{args.file}: cannot analyse the species ({exc or type(exc).__name__})") from None
     if args.json:
         out = a.summary()
         out["method"] = a.info.method
         if walls is not None:
             out["walls"] = walls
+        if species is not None:
+            out["species"] = species.summary()
         print(json.dumps(out, indent=1, ensure_ascii=False, default=float))
     else:
-        print(report(a, rows=args.rows) + ("\n" + walls_report(walls) if walls is not None else ""))
+        print(report(a, rows=args.rows) + ("\n" + walls_report(walls) if walls is not None else "")
+              + ("\n" + "\n".join(species.lines()) if species is not None else ""))
     if args.plot:
         from granulargas.analysis.plots import plot_analysis, plot_density_profiles  # matplotlib only when asked
 
@@ -354,6 +368,11 @@ def run(args) -> int:
         if walls is not None:
             p = Path(args.plot)
             extra.append(plot_density_profiles(a.info, walls, p.with_name(p.stem + "_profile" + p.suffix)))
+        if species is not None:
+            from granulargas.analysis.species import plot_species
+
+            p = Path(args.plot)
+            extra.append(plot_species(species, p.with_name(p.stem + "_species" + p.suffix)))
         if not args.json:
             print("  wrote " + ", ".join(str(x) for x in [args.plot] + extra))
     if args.velocity:

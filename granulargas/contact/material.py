@@ -7,7 +7,9 @@ equation depends on the pair and the impact speed g only through
     k = (3/2) A (2 Y / (3 (1 - nu^2)))^{2/5}                       (ARCHITECTURE.md)
 
 so a run needs one material prefactor k and, per pair, b_ij = k (R_eff/m_eff^2)^{1/5}
-with beta = b_ij g^{1/5}. Physical durations are t_c = tau_c(beta) rho^{-2/5} g^{-1/5}.
+with beta = b_ij g^{1/5}. Two materials in contact (a mixture) have k_ij of the effective modulus
+1/Y* = (1 - nu_i^2)/Y_i + (1 - nu_j^2)/Y_j and the compliance-weighted dissipative constant
+(:func:`pair_prefactor_from_materials`). Physical durations are t_c = tau_c(beta) rho^{-2/5} g^{-1/5}.
 
 Validity (Brilliantov, Spahn, Hertzsch & Pöschel 1996): the viscoelastic force is a
 quasi-static theory. It needs the dissipative time A well below the collision
@@ -73,6 +75,48 @@ def prefactor_from_material(young_modulus: float, poisson_ratio: float, dissipat
     if not (dissipation_time >= 0.0 and math.isfinite(dissipation_time)):
         raise ValueError(f"dissipation_time must be >= 0, got {dissipation_time}")
     return 1.5 * dissipation_time * (2.0 * young_modulus / (3.0 * (1.0 - poisson_ratio ** 2))) ** 0.4
+
+
+def effective_modulus(young_i, poisson_i, young_j, poisson_j):
+    """Y* of two materials in contact, 1/Y* = (1 - nu_i^2)/Y_i + (1 - nu_j^2)/Y_j (Hertz; Johnson,
+    *Contact Mechanics* (1985), eq. (4.22); Brilliantov & Pöschel, *Kinetic Theory of Granular
+    Gases* (2004), ch. 2). One material: Y* = Y / (2 (1 - nu^2))."""
+    return 1.0 / ((1.0 - poisson_i**2) / young_i + (1.0 - poisson_j**2) / young_j)
+
+
+def pair_dissipation_time(young_i, poisson_i, dissipation_i, young_j, poisson_j, dissipation_j):
+    """The dissipative constant A_ij of a contact of two materials: the compliance-weighted mean
+
+        A_ij = (c_i A_i + c_j A_j) / (c_i + c_j),   c = (1 - nu^2) / Y.
+
+    Derivation. The viscoelastic force of one material, F = rho xi^(3/2) + (3/2) A rho xi^(1/2) dxi/dt
+    (Brilliantov, Spahn, Hertzsch & Pöschel 1996), is F = F_el(xi) + A dF_el/dt: each body responds
+    to the contact force like a Kelvin-Voigt element of relaxation time A. In a Hertz contact of two
+    bodies the compression splits as xi_k = xi c_k / (c_i + c_j) (each body's displacement is its
+    compliance times the same pressure integral), so body k gives xi_k = g_k(F) - A_k dg_k/dt at first
+    order in A_k, with g_k(F) = c_k g(F) / (c_i + c_j). Summing the two and inverting at the same
+    order: F = F_el(xi) + A_ij dF_el/dt with A_ij above. The viscoelastic theory itself holds at
+    first order in A / t_c (quasi-static), so nothing is lost. One material: A_ij = A.
+    """
+    ci = (1.0 - poisson_i**2) / young_i
+    cj = (1.0 - poisson_j**2) / young_j
+    return (ci * dissipation_i + cj * dissipation_j) / (ci + cj)
+
+
+def pair_prefactor_from_materials(young_i: float, poisson_i: float, dissipation_i: float,
+                                  young_j: float, poisson_j: float, dissipation_j: float) -> float:
+    """Material prefactor k_ij of a contact of two materials (SI), k_ij = (3/2) A_ij (4 Y*/3)^(2/5),
+    with Y* of :func:`effective_modulus` and A_ij of :func:`pair_dissipation_time`: beta =
+    k_ij (R_eff g / m_eff^2)^(1/5), the rho of Schwager & Pöschel (1997), eq. (3), being
+    (4/3) Y* sqrt(R_eff) / m_eff. One material gives :func:`prefactor_from_material` exactly
+    (the same floating-point expression)."""
+    if (young_i, poisson_i, dissipation_i) == (young_j, poisson_j, dissipation_j):
+        return prefactor_from_material(young_i, poisson_i, dissipation_i)
+    for y, nu, a in ((young_i, poisson_i, dissipation_i), (young_j, poisson_j, dissipation_j)):
+        prefactor_from_material(y, nu, a)  # the same checks of each material
+    y_star = effective_modulus(young_i, poisson_i, young_j, poisson_j)
+    a_ij = pair_dissipation_time(young_i, poisson_i, dissipation_i, young_j, poisson_j, dissipation_j)
+    return 1.5 * a_ij * (4.0 * y_star / 3.0) ** 0.4
 
 
 def prefactor_from_damping(damping: float, radius: float = 0.5, mass: float = 1.0) -> float:

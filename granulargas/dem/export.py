@@ -7,6 +7,8 @@ LAMMPS data file and input script that start from the same initial state as
 (:mod:`granulargas.dem.lammps`: hertz/material + damping viscoelastic, a
 stiffness whose contact time is a stated fraction of the mean free time), and
 the same walls (``f`` boundaries and ``fix wall/gran`` of the same contact law).
+A mixture's species become atom types, each pair of species with its own contact
+(prefactor, and on the material route the pair's effective modulus).
 A driven run has no LAMMPS counterpart here and is refused.
 """
 
@@ -17,7 +19,9 @@ from pathlib import Path
 from granulargas.dem import lammps
 from granulargas.errors import ConfigError
 from granulargas.io.paths import existing_directory
-from granulargas.run.prepare import initial_state, reduced_prefactor, reduced_young_modulus
+from granulargas.contact.material import effective_modulus
+from granulargas.run.prepare import (initial_state, pair_prefactors, reduced_prefactor, reduced_young_modulus,
+                                     reference_mass_si, species_indices)
 from granulargas.run.schedule import DEFAULT_OBSERVABLE_SAMPLES
 
 
@@ -63,17 +67,20 @@ def export_lammps(config, directory, *, contact_fraction: float | None = 0.01, s
     if end_time is None:
         raise ConfigError(f"{config.source}: run.end_time is not set: LAMMPS runs for a fixed time (use --end-time)")
     young = None
+    mixture = bool(config.species)
+    if poisson_ratio is None:
+        poisson_ratio = (c.material.poisson_ratio if c.material is not None and c.material.poisson_ratio is not None
+                         and not mixture else lammps.DEFAULT_POISSON)
     if contact_fraction is None:
         if c.material is None:
             raise ConfigError(f"{config.source}: no [collision.material]: the material stiffness needs it "
                               "(give a contact fraction instead)")
-        young = reduced_young_modulus(config)
+        # a mixture: per pair of species Y with Y / (1 - nu^2) = 2 Y*_ij (the pair's effective modulus)
+        young = pair_young_moduli(config, poisson_ratio) if mixture else reduced_young_modulus(config)
     if c.model == "elastic":
         prefactor, end = 0.0, "overlap"
     else:
-        prefactor, end = reduced_prefactor(config), c.contact_end
-    if poisson_ratio is None:
-        poisson_ratio = c.material.poisson_ratio if c.material is not None else lammps.DEFAULT_POISSON
+        prefactor, end = (pair_prefactors(config) if mixture else reduced_prefactor(config)), c.contact_end
     if not Path(directory).is_dir():  # the export makes DIR itself, never its parents
         existing_directory(directory, f"--output {directory}")
     state = initial_state(config)
@@ -88,5 +95,21 @@ def export_lammps(config, directory, *, contact_fraction: float | None = 0.01, s
         end=end, end_time=end_time, thermo_interval=interval, contact_fraction=contact_fraction,
         steps_per_contact=steps_per_contact, poisson_ratio=poisson_ratio, name=name, source=config.source,
         time_origin=state.time, boundary=config.system.boundary, young_modulus=young, pressure=pressure,
-        contact_pairs=contact_pairs,
+        contact_pairs=contact_pairs, species=species_indices(config),
     )
+
+
+def pair_young_moduli(config, poisson_ratio: float):
+    """A mixture's LAMMPS E per pair of species (reduced units, (S, S)): E / (1 - nu^2) = 2 Y*_ij with
+    Y*_ij the effective modulus of the two species' materials
+    (:func:`granulargas.contact.material.effective_modulus`; constants of the species or of
+    ``[collision.material]``), so that LAMMPS's explicit pair coefficient of hertz/material has the
+    pair's stiffness."""
+    import numpy as np
+
+    m = config.collision.material
+    unit = m.diameter**3 / (reference_mass_si(m) * m.speed_unit**2)  # Pa -> reduced energy / length^3
+    consts = [(sp.young_modulus or m.young_modulus, sp.poisson_ratio if sp.poisson_ratio is not None
+               else m.poisson_ratio) for sp in config.species]
+    return np.array([[2.0 * (1.0 - poisson_ratio**2) * effective_modulus(*a, *b) * unit for b in consts]
+                     for a in consts])

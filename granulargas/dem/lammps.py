@@ -552,7 +552,8 @@ MAX_MASS_TYPES = 32
 def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefactor, *, end="overlap",
                      end_time, thermo_interval=None, contact_fraction=0.01, steps_per_contact=50,
                      poisson_ratio=DEFAULT_POISSON, name="granulargas", source="", time_origin=0.0,
-                     boundary=None, young_modulus=None, pressure=False, contact_pairs=False) -> LammpsExport:
+                     boundary=None, young_modulus=None, pressure=False, contact_pairs=False,
+                     species=None) -> LammpsExport:
     """Write a LAMMPS data file and input script equivalent to one of our runs.
 
     Parameters
@@ -565,8 +566,9 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     radii, masses : float arrays (N,)
     box : float array (d,)
         Box edges.
-    prefactor : float
-        Our pair prefactor k (beta = k (R_eff g / m_eff^2)^{1/5}).
+    prefactor : float or array (S, S)
+        Our pair prefactor k (beta = k (R_eff g / m_eff^2)^{1/5}); a mixture (``species``):
+        one per pair of species.
     end : {"overlap", "force"}
         End of contact; ``force`` adds LAMMPS's ``limit_damping``.
     end_time : float
@@ -598,13 +600,19 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         at every step to ``contacts.<name>`` (``compute property/local`` and
         ``compute pair/local ... cutoff radius``); :func:`read_contacts` turns it
         into the number of collisions and the elastic energy stored in the contacts.
+    species : int array (N,), optional
+        A mixture: atom type s + 1 for species s, each with its own mass, and one
+        ``pair_coeff`` per pair of species with that pair's prefactor and stiffness
+        (``young_modulus`` may then be an (S, S) table of the pairs' Y / (1 - nu^2) = 2 Y*,
+        Y* the effective modulus of the two materials; LAMMPS's explicit ``pair_coeff i j``
+        of ``hertz/material`` takes E / (2 (1 - nu^2)) as the pair's effective modulus).
 
     Notes
     -----
     Atom types are the distinct masses (eta_n0 depends on the pair's m_eff
     but not on the radii), so a continuously polydisperse gas of equal masses
     is exported exactly; more than :data:`MAX_MASS_TYPES` distinct masses
-    are refused. Per-atom diameters go to the data file.
+    are refused. Per-atom diameters go to the data file. A mixture's types are its species.
     """
     positions = np.asarray(positions, dtype=float)
     velocities = np.asarray(velocities, dtype=float)
@@ -612,22 +620,27 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     masses = np.asarray(masses, dtype=float)
     box = np.asarray(box, dtype=float)
     d = positions.shape[1]
-    type_masses, typeid = _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact, end_time)
-    young, t_contact, tau_free, contact_fraction, g_thermal = _stiffness(
-        velocities, radii, masses, box, contact_fraction, young_modulus, poisson_ratio)
-    contact = DemContact.from_prefactor(prefactor, young, poisson_ratio, end)
+    type_masses, typeid = _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact, end_time,
+                                        species, prefactor)
+    ntypes = len(type_masses)
+    k_pairs = np.broadcast_to(np.asarray(prefactor, dtype=float), (ntypes, ntypes))
+    young, y_pairs, t_contact, tau_free, contact_fraction, g_thermal = _stiffness(
+        velocities, radii, masses, box, contact_fraction, young_modulus, poisson_ratio, typeid, ntypes)
+    pair_contact = {(i, j): DemContact.from_prefactor(float(k_pairs[i, j]), float(y_pairs[i, j]), poisson_ratio, end)
+                    for i in range(ntypes) for j in range(ntypes)}
+    contact = pair_contact[(0, 0)] if species is not None else DemContact.from_prefactor(
+        float(k_pairs[0, 0]), young, poisson_ratio, end)
     steps, dt, thermo_every = _time_steps(end_time, steps_per_contact, t_contact, thermo_interval, source)
 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     data_file = directory / f"data.{name}"
     input_file = directory / f"in.{name}"
-    ntypes = len(type_masses)
     eta = {}
     for i in range(ntypes):
         for j in range(i, ntypes):
             mi, mj = type_masses[i], type_masses[j]
-            eta[(i + 1, j + 1)] = float(contact.eta_n0(mi * mj / (mi + mj)))
+            eta[(i + 1, j + 1)] = float(pair_contact[(i, j)].eta_n0(mi * mj / (mi + mj)))
 
     _write_data_file(data_file, positions, velocities, radii, masses, typeid + 1, ntypes, box, source)
     header = [
@@ -635,26 +648,32 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         "# Same contact law as granulargas (Schwager & Pöschel (1997), eq. (2)): hertz/material + damping viscoelastic,",
         "# E = Y, nu = nu, eta_n0 = A Y / ((1 - nu^2) m_eff) per pair of atom types;",
         f"# end of contact '{end}'" + (" -> limit_damping" if end == "force" else " (no limit_damping)") + ".",
-        f"# Dissipation time A = {contact.dissipation_time:.6g}, pair prefactor k = {prefactor:.6g}.",
+        (f"# Dissipation time A = {contact.dissipation_time:.6g}, pair prefactor k = {float(k_pairs[0, 0]):.6g}."
+         if species is None else f"# A mixture of {ntypes} species = atom types 1..{ntypes}: prefactor k, stiffness "
+                                 "and A per pair of types (pair_coeff lines)."),
         f"# Stiffness: elastic Hertz contact time {t_contact:.6g} at the thermal impact speed "
         f"{g_thermal:.6g} = {contact_fraction:g} x Enskog mean free time {tau_free:.6g}.",
         f"# Timestep {dt:.6g} <= contact time / {steps_per_contact}; {steps} steps to t = {end_time:.6g}.",
         "# Thermo: c_granT = m<c^2>/d (peculiar velocity c, d N degrees of freedom).",
         f"# LAMMPS time 0 is granulargas time {time_origin:.17g}.",
     ]
-    lines = header + _input_commands(contact, data_file.name, type_masses, eta, radii, box, boundary, dt, steps,
+    lines = header + _input_commands(pair_contact, data_file.name, type_masses, eta, radii, box, boundary, dt, steps,
                                      thermo_every, pressure, contact_pairs, name)
     input_file.write_text("\n".join(lines))
     export = LammpsExport(input_file, data_file, contact, dt, steps, thermo_every, t_contact, tau_free,
                           contact_fraction, steps_per_contact, g_thermal, eta, tuple(float(m) for m in type_masses))
     summary = {**export.summary(), "time_origin": float(time_origin)}
+    if species is not None:
+        summary["pairs"] = {f"{i + 1} {j + 1}": {"prefactor": float(k_pairs[i, j]), "young_modulus": c.young_modulus,
+                                                 "dissipation_time": c.dissipation_time}
+                            for (i, j), c in pair_contact.items() if i <= j}
     (directory / "granulargas_lammps.json").write_text(json.dumps(summary, indent=2) + "\n")
     return export
 
 
-def _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact, end_time):
+def _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact, end_time, species, prefactor):
     """The export's arguments checked (one :class:`UserError` each); (masses of the atom types,
-    each particle's type index)."""
+    each particle's type index): a mixture's types are its species, otherwise the distinct masses."""
     if d not in (2, 3):
         raise ValueError(f"dimension must be 2 or 3, not {d}")
     if young_modulus is None and not 0.0 < contact_fraction < 1.0:  # also rejects nan
@@ -663,7 +682,14 @@ def _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact,
         raise UserError(f"steps per contact = {steps_per_contact}: must be an integer >= 2")
     if not end_time > 0.0:
         raise UserError(f"end time = {end_time}: must be > 0 (LAMMPS runs for a fixed time)")
-    type_masses, typeid = np.unique(masses, return_inverse=True)
+    if species is not None:
+        typeid = np.asarray(species, dtype=np.int64)
+        ntypes = int(np.asarray(prefactor).shape[0]) if np.ndim(prefactor) == 2 else int(typeid.max()) + 1
+        type_masses = np.array([masses[typeid == s][0] if np.any(typeid == s) else 1.0 for s in range(ntypes)])
+        if np.any(masses != type_masses[typeid]):
+            raise UserError("species: every particle of a species needs its species' mass (one LAMMPS atom type each)")
+    else:
+        type_masses, typeid = np.unique(masses, return_inverse=True)
     if len(type_masses) > MAX_MASS_TYPES:
         raise UserError(
             f"{len(type_masses)} distinct particle masses: LAMMPS export supports at most {MAX_MASS_TYPES} "
@@ -672,11 +698,13 @@ def _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact,
     return type_masses, typeid
 
 
-def _stiffness(velocities, radii, masses, box, contact_fraction, young_modulus, poisson_ratio):
-    """The stiffness Y from the reference pair (mean diameter and mass) at the initial temperature:
-    (Y, elastic Hertz contact time at the thermal impact speed, Enskog mean free time, their
-    ratio, the thermal impact speed). Y is ``young_modulus`` when given, else the one whose
-    contact time is ``contact_fraction`` of the mean free time."""
+def _stiffness(velocities, radii, masses, box, contact_fraction, young_modulus, poisson_ratio, typeid, ntypes):
+    """The stiffness from the reference pair (mean diameter and mass) at the initial temperature:
+    (Y of the reference pair, Y per pair of types, elastic Hertz contact time at the thermal
+    impact speed, Enskog mean free time, their ratio, the thermal impact speed). Y is
+    ``young_modulus`` when given (a number, or a table per pair of types whose mean pair sets
+    the contact time), else the one whose contact time is ``contact_fraction`` of the mean
+    free time."""
     n, d = velocities.shape
     sigma = float(np.mean(2.0 * radii))
     mass = float(np.mean(masses))
@@ -692,13 +720,17 @@ def _stiffness(velocities, radii, masses, box, contact_fraction, young_modulus, 
     if young_modulus is None:
         t_contact = contact_fraction * tau_free
         young = stiffness_for_contact_time(t_contact, g_thermal, r_eff, m_eff, poisson_ratio)
+        y_pairs = np.full((ntypes, ntypes), young)
     else:
-        if not young_modulus > 0.0:
+        y_pairs = np.broadcast_to(np.asarray(young_modulus, dtype=float), (ntypes, ntypes))
+        if not np.all(y_pairs > 0.0):
             raise UserError(f"Young modulus = {young_modulus}: must be > 0")
-        young = float(young_modulus)
+        # the mean pair's stiffness for the reference contact time
+        x = np.bincount(typeid, minlength=ntypes) / n
+        young = float(x @ y_pairs @ x)
         t_contact = DemContact(young, poisson_ratio, 0.0).hertz_contact_time(g_thermal, r_eff, m_eff)
         contact_fraction = t_contact / tau_free
-    return young, t_contact, tau_free, contact_fraction, g_thermal
+    return young, y_pairs, t_contact, tau_free, contact_fraction, g_thermal
 
 
 def _time_steps(end_time, steps_per_contact, t_contact, thermo_interval, source):
@@ -715,11 +747,12 @@ def _time_steps(end_time, steps_per_contact, t_contact, thermo_interval, source)
     return steps, dt, max(1, int(round(thermo_interval / dt)))
 
 
-def _input_commands(contact, data_name, type_masses, eta, radii, box, boundary, dt, steps, thermo_every,
+def _input_commands(pair_contact, data_name, type_masses, eta, radii, box, boundary, dt, steps, thermo_every,
                     pressure, contact_pairs, name):
     """The LAMMPS commands of the input script (after its comment header): the box and its
-    boundaries, the atoms' masses, the pair and wall contact law, the integration, the thermo
-    output (with the pressure and the contact dump when asked for) and the run."""
+    boundaries, the atoms' masses, the contact law per pair of types and at the walls (each
+    type's wall of its own material), the integration, the thermo output (with the pressure
+    and the contact dump when asked for) and the run."""
     d = len(box)
     boundary = ("periodic",) * d if boundary is None else tuple(boundary)
     walls = [a for a in range(d) if boundary[a] == "wall"]
@@ -737,12 +770,13 @@ def _input_commands(contact, data_name, type_masses, eta, radii, box, boundary, 
     lines.append("pair_style granular")
     for (i, j), _ in eta.items():
         mi, mj = type_masses[i - 1], type_masses[j - 1]
-        lines.append(contact.pair_coeff(i, j, mi * mj / (mi + mj)))
+        lines.append(pair_contact[(i - 1, j - 1)].pair_coeff(i, j, mi * mj / (mi + mj)))
     for k, m in enumerate(type_masses):
         if walls:
             lines.append(f"group type{k + 1} type {k + 1}")
-        for a in walls:
-            lines.append(contact.wall_fix(f"wall{k + 1}{'xyz'[a]}", f"type{k + 1}", float(m), a, float(box[a])))
+        for a in walls:  # a wall of the type's own material
+            lines.append(pair_contact[(k, k)].wall_fix(f"wall{k + 1}{'xyz'[a]}", f"type{k + 1}", float(m), a,
+                                                       float(box[a])))
     skin = 0.3 * float(np.max(2.0 * radii))
     lines += [
         f"neighbor {skin:.6g} bin",
@@ -765,7 +799,7 @@ def _input_commands(contact, data_name, type_masses, eta, radii, box, boundary, 
         lines += ["compute granPairs all property/local patom1 patom2 cutoff radius",
                   "compute granDist all pair/local dist cutoff radius",
                   f"dump granPairs all local 1 contacts.{name} c_granPairs[1] c_granPairs[2] c_granDist",
-                  "dump_modify granPairs format float %.17g"]
+                  f"dump_modify granPairs format float %.17g"]
     lines += [
         f"thermo_style custom {columns} cpu",
         "thermo_modify norm no flush yes format float %.12g",

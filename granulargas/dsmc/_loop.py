@@ -17,6 +17,11 @@ candidates form a Poisson process of total rate
 
 each a uniformly drawn pair, accepted with probability
 sigma_ij^(d-1) |v_i - v_j| / (sigma_max^(d-1) G) (thinning; Lewis & Shedler 1979).
+A mixture has one chi_ij per pair of species: chi above is then the largest of them and
+the acceptance has the further factor chi_ij / chi_max, the pair's weight in the species
+record (:mod:`granulargas.engine._species`), which also gives the pair's collision law
+and counts the collisions per pair of species (None: one kind of particle, the loop
+compiled without any of it).
 This is the Kac process / Bird's no-time-counter scheme with one global bound
 and no time step: the waiting time between candidates is exponential with
 rate Lambda, and Lambda is updated after every collision because G may
@@ -44,6 +49,7 @@ from granulargas.dsmc._majorant import build_histogram, class_edge, speed_class,
 from granulargas.dsmc._random import pair_of, uniform
 from granulargas.engine._collide import VISCOELASTIC, restitution
 from granulargas.engine._prefetch import prefetch
+from granulargas.engine._species import count_pair, pair_law, pair_weight
 
 # status codes
 DONE = 0  # reached ``until``
@@ -126,7 +132,7 @@ def recentre(rec, mass, mono, dim, hist):
 
 @jit
 def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, target, budget,
-            recentre_every, ring, scal, iscal):
+            recentre_every, ring, scal, iscal, species):
     """Collide until ``until``, ``target`` collisions or about ``budget`` candidates.
 
     Parameters
@@ -153,6 +159,9 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
         :func:`recentre` runs after every collision whose count is a multiple of this.
     ring : int64 (2, RING)
         Work space for the pairs ahead (rebuilt on entry; not state).
+    species : None or Species
+        A mixture's law per pair of species, acceptance weights and pair counts
+        (:class:`granulargas.engine._state.Species`, particle order = id order).
 
     Returns
     -------
@@ -215,6 +224,9 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
                 if prod < 1e-280:
                     logs += math.log(prod)
                     prod = 1.0
+                # a mixture: accept g w < x with w = chi_ij / chi_max (1.0 without species: no operation)
+                w = pair_weight(species, i, j)
+                g2 *= w * w
                 if mono:
                     if x * x < g2:
                         break
@@ -259,7 +271,8 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
             pz = 0.0
         m_eff = mi * mj / (mi + mj)
         gn = math.sqrt(gn2) if kind == VISCOELASTIC else 0.0
-        eps = restitution(kind, eps_const, prefactor, inv_h, coeffs, gn, r_eff, m_eff)
+        eps_pair, k_pair = pair_law(eps_const, prefactor, species, i, j)
+        eps = restitution(kind, eps_pair, k_pair, inv_h, coeffs, gn, r_eff, m_eff)
         if eps < 0.0:
             iscal[I_ERR_I] = i
             iscal[I_ERR_J] = j
@@ -269,6 +282,7 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
         oj = _class_of(rec, j, dim)
         apply_pair_update(rec, i, j, dim, px, py, pz, eps, mi, mj)
         dissipated += 0.5 * (1.0 - eps * eps) * m_eff * gn2
+        count_pair(species, i, j)
         time = t_next
         pi = -1
         pj = -1

@@ -19,7 +19,9 @@ from granulargas.dsmc._majorant import build_histogram, class_edge, largest_comp
 from granulargas.dsmc._random import STATE_WORDS, seed_state
 from granulargas.engine._drive import kick_scale, kick_velocities
 from granulargas.engine.driving import WhiteNoise
+from granulargas.engine._state import species_record
 from granulargas.engine.rules import CollisionRule
+from granulargas.engine.pairs import pair_count_matrix, species_of_state
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
 from granulargas.observables import energy_moments, kinetic_energy_momentum
 from granulargas.state import PARTICLE_FIELDS, DSMCContinuation, State
@@ -68,10 +70,12 @@ class DSMC:
         At most one (none: the volume of ``state.box``): the density n = N / V, the
         packing fraction sum_i v_i / V (v_i the particle volume, or area in 2D), or V
         itself.
-    chi : float, optional
+    chi : float or array (S, S), optional
         Pair correlation at contact; default the Enskog value
         :func:`granulargas.theory.contact_value` of the packing fraction
-        (``chi=1`` gives the Boltzmann equation).
+        (``chi=1`` gives the Boltzmann equation). A mixture (a rule with a table per pair
+        of S species; the state's ``species`` index it) may give chi_ij per pair of species
+        (e.g. :func:`granulargas.theory.mixture.mixture_contact_values`).
     seed : int
         Seed of the random streams (not used when the state has a continuation).
     driving : WhiteNoise, optional
@@ -175,10 +179,28 @@ class DSMC:
                               f"must be < 1")
         if chi is None:
             chi = float(theory.contact_value(self.packing_fraction, d))
+        chi_pairs = None
+        if np.ndim(chi) == 2:
+            chi_pairs = np.array(chi, dtype=np.float64)
+            if rule.pairs is None or chi_pairs.shape != (rule.species,) * 2:
+                raise ConfigError(f"chi: shape {chi_pairs.shape}: a table of chi per pair of species needs a rule "
+                                  f"with a table per pair of as many species ({rule.species or 'none'})")
+            if not (np.all(chi_pairs > 0) and np.all(np.isfinite(chi_pairs))
+                    and np.array_equal(chi_pairs, chi_pairs.T)):
+                raise ConfigError("chi: every chi_ij must be finite and > 0, the table symmetric")
+            chi = float(chi_pairs.max())
         chi = float(chi)
         if not (chi > 0 and math.isfinite(chi)):
             raise ConfigError(f"chi = {chi}: must be finite and > 0")
         self.chi = chi
+        #: a mixture's chi_ij (S, S) (None: one chi for every pair)
+        self.chi_pairs = chi_pairs
+        # a mixture: the law per pair of species, the acceptance weights chi_ij / chi_max, the counts
+        self._species = None
+        if rule.pairs is not None:
+            of, counts = species_of_state(state, rule)
+            weight = None if chi_pairs is None else chi_pairs / chi
+            self._species = species_record(of, rule.pairs, counts, weight)
 
         kind, eps, _, pref, inv_h, coeffs = rule.kernel_arguments()
         self._kind, self._coeffs = kind, coeffs
@@ -332,7 +354,7 @@ class DSMC:
         while True:
             status = _loop.advance(self._rec, self._rad_k, self._mas_k, self._mono, d, self._hist,
                                    self._rng, self._kind, self._fpar, self._coeffs, until, target,
-                                   chunk, self._recentre_every, self._ring, s, self._iscal)
+                                   chunk, self._recentre_every, self._ring, s, self._iscal, self._species)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
@@ -404,7 +426,21 @@ class DSMC:
                      time=self.time, collisions=self.collisions, events=self.collisions,
                      dissipated_energy=self.dissipated_energy, injected_energy=self.injected_energy,
                      kick_step=None if self.driving is None else self.kick_step, dsmc=self.continuation,
+                     species_collisions=self.species_collisions,
                      **{name: value.copy() for name, value in self._carried.items()})
+
+    @property
+    def species(self) -> np.ndarray | None:
+        """Species index of each particle (N,), as given (None: all 0)."""
+        return self._carried["species"].copy() if "species" in self._carried else None
+
+    @property
+    def species_collisions(self) -> np.ndarray | None:
+        """Collisions so far per pair of species (S, S), symmetric (None without a pair table in
+        the rule; as :attr:`granulargas.engine.Simulation.species_collisions`)."""
+        if self._species is None:
+            return None
+        return pair_count_matrix(self._species.pairs, self.rule.species)
 
     # ------------------------------------------------------------- observables
     def _moments(self):

@@ -106,6 +106,7 @@ from granulargas.engine._drive import kick_velocities
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image, pair_delay, wall_delay
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._resolved import resolved_pair
+from granulargas.engine._species import count_pair, pair_law, wall_law
 from granulargas.engine._probe import (
     COLLIDE,
     PEEK,
@@ -406,12 +407,14 @@ def _collapse_watch(i, te, p, prm):
 
 
 @inlined_ir
-def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
+def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, species):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
     Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
     ``c.err_j`` set). With ``contacts`` (the resolved rule; None otherwise) the pair collides by
-    :func:`granulargas.engine._resolved.resolved_pair`.
+    :func:`granulargas.engine._resolved.resolved_pair`. With ``species`` (a mixture; None
+    otherwise) the pair's law comes from the species table and the collision is counted per
+    pair of species (:mod:`granulargas.engine._species`).
     """
     rec = p.rec
     period = prm.space.period
@@ -445,7 +448,8 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
             eps = 1.0
         else:
             r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
-            eps = restitution(rule.kind, rule.eps, rule.prefactor, rule.inv_h, rule.coeffs, -un,
+            eps_pair, k_pair = pair_law(rule.eps, rule.prefactor, species, i, j)
+            eps = restitution(rule.kind, eps_pair, k_pair, rule.inv_h, rule.coeffs, -un,
                               r_eff, mi * mj / (mi + mj))
             if eps < 0.0:
                 c.err_i = i
@@ -464,6 +468,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     p.count[i] += 1
     p.count[j] += 1
     c.collisions += 1
+    count_pair(species, i, j)
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
     if onlists is not None:
@@ -510,9 +515,9 @@ def execute_crossing(i, face, te, p, grid, c, prm):
 
 
 @kernel(python=False)
-def execute_wall(i, wall, te, p, c, walls, prm):
+def execute_wall(i, wall, te, p, c, walls, prm, species):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
-    m_eff = m_i. Returns DONE or TABLE_RANGE."""
+    m_eff = m_i (a mixture: the law of i's species). Returns DONE or TABLE_RANGE."""
     rec = p.rec
     rule = prm.rule
     stream(i, te, rec, p.img, prm.space.period)
@@ -524,7 +529,8 @@ def execute_wall(i, wall, te, p, c, walls, prm):
         if rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time:
             eps = 1.0
         else:
-            eps = restitution(rule.kind, rule.wall_eps, rule.prefactor, rule.inv_h, rule.coeffs,
+            eps_wall, k_wall = wall_law(rule.wall_eps, rule.prefactor, species, i)
+            eps = restitution(rule.kind, eps_wall, k_wall, rule.inv_h, rule.coeffs,
                               abs(vn), rec[i, 7], mi)
             if eps < 0.0:
                 c.err_i = i
@@ -691,6 +697,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
     c = engine.counters[0]
     walls = engine.walls
     contacts = engine.contacts
+    species = engine.species
     rec = p.rec
     time = c.time
     zero_advance = 0
@@ -738,7 +745,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if onlists is not None:  # j's list row is in cache: start the misses of predict(j)
                 for k in range(lists.nbn[j]):
                     prefetch(rec, lists.nbl[j, k])
-            status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts)
+            status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, species)
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
@@ -751,7 +758,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if status != DONE:
                 break
         elif j == WALL:
-            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm)
+            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, species)
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:

@@ -64,6 +64,12 @@ Record layout
   contact's partner (-1: none); work space ``work`` (3,) and ``out`` (5,) f8 of
   the table lookup. None for the other rules, whose loop then compiles without
   any of this (:func:`granulargas.engine._loop.in_contact`).
+* ``species`` :class:`Species` -- the collision law per pair of species
+  (:mod:`granulargas.engine._species`): ``of`` i4 the species of each slot, ``count``
+  the number S of species, ``eps`` and ``prefactor`` (S*S,) f8 the pair table,
+  ``wall_eps`` and ``wall_prefactor`` (S,) f8 per species, ``weight`` (S*S,) f8 the DSMC's
+  acceptance weights (ones in the engine), ``pairs`` (S*S,) i8 the pair collision counts. None for a rule without a pair table, whose loop then compiles
+  without any of this.
 """
 
 from __future__ import annotations
@@ -81,8 +87,10 @@ Grid = namedtuple("Grid", ["head", "cell", "width", "pair_t", "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
+Species = namedtuple("Species", ["of", "count", "eps", "prefactor", "wall_eps", "wall_prefactor", "weight",
+                                 "pairs"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
-                               "walls", "contacts"])
+                               "walls", "contacts", "species"])
 
 # Read-only parameters.
 #: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
@@ -151,6 +159,19 @@ def contacts(n: int, until=None, partner=None) -> Contacts:
     u = np.full(n, -np.inf) if until is None else np.ascontiguousarray(until, dtype=np.float64)
     q = np.full(n, -1, dtype=np.int32) if partner is None else np.ascontiguousarray(partner, dtype=np.int32)
     return Contacts(u, q, np.zeros(3), np.zeros(5))
+
+
+def species_record(of, table, pairs=None, weight=None) -> Species:
+    """A :class:`Species` record for the slots' species ``of`` and a
+    :class:`granulargas.engine.pairs.PairTable` (``pairs``: the counts to continue from;
+    ``weight`` (S, S): the DSMC's acceptance weights, default ones)."""
+    size = table.count
+    flat = lambda a: np.ascontiguousarray(np.asarray(a, dtype=np.float64).reshape(-1))  # noqa: E731
+    counts = np.zeros(size * size, dtype=np.int64) if pairs is None else \
+        np.ascontiguousarray(np.asarray(pairs, dtype=np.int64).reshape(-1))
+    return Species(np.ascontiguousarray(of, dtype=np.int32), int(size), flat(table.restitution),
+                   flat(table.prefactor), flat(table.wall_restitution), flat(table.wall_prefactor),
+                   flat(np.ones((size, size)) if weight is None else weight), counts)
 
 
 def space(box3, period3, ncell, wall_axes, dims) -> Space:

@@ -15,15 +15,24 @@ outgoing line (:mod:`granulargas.engine._resolved`). It needs the contact
 stiffness as well as the damping: the compression prefactor
 q = (2 Y / (3 (1 - nu^2)))^(-2/5) of
 :func:`granulargas.contact.oblique.compression_prefactor` in reduced units.
+
+A mixture has one law per pair of species (:class:`granulargas.engine.pairs.PairTable`):
+``CollisionRule.constant`` with a symmetric (S, S) table of restitutions (and walls one
+per species), ``CollisionRule.viscoelastic`` with an (S, S) table of prefactors,
+``CollisionRule.elastic(species=S)``. The simulation then needs the species of every
+particle; the collision counts per pair of species come with it.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
+
+import numpy as np
 
 from granulargas.engine._collide import CONSTANT, ELASTIC, VISCOELASTIC
 from granulargas.engine._state import RuleParams, rule_params
+from granulargas.engine.pairs import PairTable
 from granulargas.errors import ConfigError
 
 #: How long a collision takes: "instantaneous", or "resolved" (viscoelastic only).
@@ -61,6 +70,9 @@ class CollisionRule:
     oblique : object
         Resolved rule: the oblique-contact table
         (:class:`granulargas.contact.oblique_grid.ObliqueTable`) of the same contact end.
+    pairs : PairTable or None
+        One law per pair of species (a mixture); ``restitution``, ``wall_restitution`` and
+        ``prefactor`` then hold those of the first species' own pair, (0, 0).
     """
 
     kind: str
@@ -72,17 +84,32 @@ class CollisionRule:
     duration: str = "instantaneous"
     compression: float = 0.0
     oblique: Any = None
+    pairs: PairTable | None = None
 
     @classmethod
-    def elastic(cls) -> "CollisionRule":
-        """Elastic collisions, eps = 1."""
-        return cls("elastic")
+    def elastic(cls, species: int | None = None) -> "CollisionRule":
+        """Elastic collisions, eps = 1 (``species``: a mixture of that many species, whose
+        collisions are counted per pair of species)."""
+        if species is None:
+            return cls("elastic")
+        if not (isinstance(species, int) and species >= 1):
+            raise ConfigError(f"species = {species!r}: the number of species, an integer >= 1")
+        return cls("elastic", pairs=PairTable.elastic(species))
 
     @classmethod
-    def constant(cls, restitution: float, tc_time: float | None = None,
-                 wall_restitution: float | None = None) -> "CollisionRule":
+    def constant(cls, restitution, tc_time: float | None = None,
+                 wall_restitution=None) -> "CollisionRule":
         """Constant coefficient of restitution 0 < eps <= 1, optionally with the TC model
-        and a separate constant eps for sphere-wall collisions."""
+        and a separate constant eps for sphere-wall collisions.
+
+        A mixture: ``restitution`` a symmetric (S, S) table eps_ij, ``wall_restitution``
+        one number or one per species (default eps_ii)."""
+        if np.ndim(restitution) == 2:
+            table = PairTable.constant(restitution, wall_restitution)
+            rule = cls.constant(table.restitution[0][0], tc_time, table.wall_restitution[0])
+            return replace(rule, pairs=table)
+        if np.ndim(wall_restitution) == 1:
+            raise ConfigError("wall_restitution: one value per species needs a table of restitutions per pair")
         restitution = float(restitution)
         if not 0.0 < restitution <= 1.0:
             raise ConfigError(f"restitution = {restitution}: allowed range is 0 < eps <= 1")
@@ -106,7 +133,15 @@ class CollisionRule:
 
         ``duration="resolved"``: collisions take time (module docstring); needs
         ``compression`` (q > 0) and ``oblique`` (an ObliqueTable), and no TC model.
+        A mixture: ``prefactor`` a symmetric (S, S) table k_ij (instantaneous collisions).
         """
+        if np.ndim(prefactor) == 2:
+            pairs = PairTable.viscoelastic(prefactor)
+            if duration != "instantaneous":
+                raise ConfigError('duration = "resolved" takes one material: a table of prefactors per pair '
+                                  "of species needs instantaneous collisions")
+            rule = cls.viscoelastic(pairs.prefactor[0][0], table, tc_time)
+            return replace(rule, pairs=pairs)
         prefactor = float(prefactor)
         if not prefactor >= 0.0:
             raise ConfigError(f"viscoelastic prefactor = {prefactor}: must be >= 0")
@@ -133,6 +168,11 @@ class CollisionRule:
                               f"at {end!r}: give both for the same contact end")
         return cls("viscoelastic", prefactor=prefactor, table=table, duration="resolved",
                    compression=compression, oblique=oblique)
+
+    @property
+    def species(self) -> int:
+        """Number of species of the rule's pair table (0: one law for all pairs)."""
+        return 0 if self.pairs is None else self.pairs.count
 
     @property
     def resolved(self) -> bool:

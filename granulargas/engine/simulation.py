@@ -29,6 +29,7 @@ from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
 from granulargas.engine._crossing import FRESH_SIZE, MARGIN, build_grid, particle_rows
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
+from granulargas.engine.pairs import pair_count_matrix, species_of_state
 from granulargas.engine.rules import CollisionRule
 from granulargas.errors import (
     ConfigError,
@@ -280,6 +281,10 @@ class Simulation:
             raise ConfigError("contact_partner: particle ids in [0, N) or -1; contact_until: no NaN")
         self._contact_until, self._contact_partner = cu, cp
         self._three_body = state.three_body_contacts
+        # a mixture: the species of every particle index the rule's pair table
+        self._species_of = self._pair_counts = None
+        if rule.pairs is not None:
+            self._species_of, self._pair_counts = species_of_state(state, rule)
         # per-particle fields the engine does not use: kept as they are, returned by ``state``
         self._carried = {f.name: getattr(state, f.name).copy() for f in PARTICLE_FIELDS
                          if f.name not in OWN_FIELDS and getattr(state, f.name) is not None}
@@ -334,8 +339,9 @@ class Simulation:
             want = default_shell(self.packing_fraction, d) if shell is None else float(shell)
         if want <= 0 and self.neighbours == "lists":
             raise ConfigError(f"shell = {want}: must be > 0")
-        # at least 3 cells per side so that the 27 neighbour cells are distinct
-        fit = float(bx.min()) / 3.0 - dmax
+        # at least 3 cells per side so that the 27 neighbour cells are distinct (the margin keeps
+        # floor(L / cut) at 3 when the shell is cut to fit: L / (L / 3) can round to just below 3)
+        fit = float(bx.min()) / 3.0 * (1.0 - 1e-12) - dmax
         if float(bx.min()) < MIN_BOX_DIAMETERS * dmax:
             short = [f"{'xyz'[a]} ({self.boundary[a]})" for a in range(d)
                      if bx[a] < MIN_BOX_DIAMETERS * dmax]
@@ -467,7 +473,11 @@ class Simulation:
         c["three_body"] = self._three_body
         c["err_i"] = c["err_j"] = -1
         walls = _state.Walls(impulse=self._wall_impulse.copy())
-        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts)
+        # a rule without a pair table compiles the loop without the species (None)
+        species = None if self._species_of is None else _state.species_record(
+            self._species_of[order], self.rule.pairs, self._pair_counts)
+        self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts,
+                                     species)
         self._place_events(self._time)
         self._built = True
 
@@ -707,6 +717,8 @@ class Simulation:
             self._kick_step = int(c["kick_step"])
             self._three_body = int(c["three_body"])
             self._wall_impulse = e.walls.impulse.copy()
+            if e.species is not None:
+                self._pair_counts = e.species.pairs.copy()
             if e.contacts is not None:
                 self._contact_until = np.empty(n)
                 self._contact_until[inv] = e.contacts.until
@@ -831,6 +843,16 @@ class Simulation:
         return self._carried["species"].copy() if "species" in self._carried else None
 
     @property
+    def species_collisions(self) -> np.ndarray | None:
+        """Pair collisions so far per pair of species (S, S), symmetric: entry (a, b) counts the
+        collisions between a particle of species a and one of species b (None without a pair
+        table in the rule)."""
+        if self._species_of is None:
+            return None
+        raw = self._engine.species.pairs if self._built else self._pair_counts
+        return pair_count_matrix(raw, self.rule.pairs.count)
+
+    @property
     def state(self) -> State:
         """The public state as a record (:class:`granulargas.state.State`): a synchronised copy at
         ``time``, particles in id order, every counter; ``Simulation(sim.state, rule, ...)``
@@ -847,7 +869,7 @@ class Simulation:
             time=self.time, collisions=self.collisions, events=self.events,
             dissipated_energy=self.dissipated_energy, wall_collisions=self.wall_collisions,
             injected_energy=self.injected_energy, kick_step=None if self.driving is None else self.kick_step,
-            three_body_contacts=self.three_body_contacts,
+            three_body_contacts=self.three_body_contacts, species_collisions=self.species_collisions,
             **{name: value.copy() for name, value in self._carried.items()})
 
     # ------------------------------------------------------------ observables

@@ -2,7 +2,8 @@
 
 A config file has the sections ``[system]``, ``[particles]``, ``[initial]``,
 ``[collision]`` (with the optional sub-table ``[collision.material]``),
-``[driving]`` (optional), ``[run]`` and ``[output]``; :func:`load_config` reads it with :mod:`tomllib`, applies
+``[driving]`` (optional), ``[run]`` and ``[output]``, and for a mixture an array of tables
+``[[species]]`` in place of ``[particles]``; :func:`load_config` reads it with :mod:`tomllib`, applies
 optional dotted-key overrides, and returns a :class:`RunConfig`.
 
 The schema
@@ -55,7 +56,7 @@ from __future__ import annotations
 import difflib
 import math
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Callable
 
@@ -126,6 +127,34 @@ class ParticlesConfig:
 
 
 @dataclass(frozen=True)
+class SpeciesConfig:
+    """One ``[[species]]`` table of a mixture: its ``name``, its number of particles
+    ``count`` (given, or from ``fraction`` of ``system.particles``), ``diameter``, and
+    ``mass`` or ``density`` (reduced, as in ``[particles]``); for the material route
+    (``[collision.material]``) its Young modulus, Poisson ratio and dissipative constant
+    (SI; None: those of ``[collision.material]``), and instead of a mass its material density
+    ``material_density`` (SI; the mass is then set from it when the config is read)."""
+
+    name: str
+    count: int
+    fraction: float | None = field(default=None, compare=False)  # as given; ``count`` is what a run uses
+    diameter: float = 1.0
+    mass: float | None = None
+    density: float | None = None
+    material_density: float | None = None
+    young_modulus: float | None = None
+    poisson_ratio: float | None = None
+    dissipation_time: float | None = None
+
+    def particle_mass(self, dimension: int) -> float:
+        """The mass of one particle: ``mass``, or ``density`` times its volume."""
+        if self.density is None:
+            return 1.0 if self.mass is None else self.mass
+        unit = math.pi / 6.0 if dimension == 3 else math.pi / 4.0
+        return self.density * unit * self.diameter**dimension
+
+
+@dataclass(frozen=True)
 class InitialConfig:
     """``[initial]``: Maxwell-Boltzmann temperature, or a file to continue from."""
 
@@ -140,11 +169,13 @@ class MaterialConfig:
 
     young_modulus (Pa), poisson_ratio, dissipation_time A (s), diameter (m) and
     density (kg/m^3) of the reference particle, speed_unit (m/s): the reduced
-    velocity unit sqrt(T0/m)."""
+    velocity unit sqrt(T0/m). A mixture may give the first three per species
+    (``[[species]]``); here they are then the values of the species that give none
+    (None: every species gives its own)."""
 
-    young_modulus: float
-    poisson_ratio: float
-    dissipation_time: float
+    young_modulus: float | None
+    poisson_ratio: float | None
+    dissipation_time: float | None
     diameter: float
     density: float
     speed_unit: float
@@ -164,16 +195,48 @@ class CollisionConfig:
     sphere-wall collisions (default: ``restitution``); elastic runs have elastic
     walls, viscoelastic runs the sphere-plane contact of the same material.
     ``duration``: "instantaneous" collisions, or "resolved" (viscoelastic with
-    ``[collision.material]``): collisions that take time."""
+    ``[collision.material]``): collisions that take time.
+    A mixture (``[[species]]``): ``restitution`` and ``damping`` may be tables
+    ``{"a-b": value}`` with one entry per pair of species (keys in the species' order,
+    "a-b" with a at or before b; :meth:`pair_table`), ``wall_restitution`` a table
+    ``{"a": value}`` per species."""
 
     model: str = "viscoelastic"
-    restitution: float | None = None
-    damping: float | None = None
+    restitution: float | dict | None = None
+    damping: float | dict | None = None
     material: MaterialConfig | None = None
     contact_end: str = "overlap"
     tc_time: float | None = None
-    wall_restitution: float | None = None
+    wall_restitution: float | dict | None = None
     duration: str = "instantaneous"
+
+    @staticmethod
+    def pair_table(value, names) -> list:
+        """A per-pair value (a number for every pair, or a ``{"a-b": x}`` table) as an (S, S)
+        list of lists for the species ``names``."""
+        size = len(names)
+        if not isinstance(value, dict):
+            return [[float(value)] * size for _ in range(size)]
+        out = [[0.0] * size for _ in range(size)]
+        for i, a in enumerate(names):
+            for j, b in enumerate(names[i:], i):
+                out[i][j] = out[j][i] = float(value[pair_key(a, b)])
+        return out
+
+    @staticmethod
+    def species_values(value, names, default) -> list:
+        """A per-species value (a number, a ``{"a": x}`` table, or None) as a list, the entries
+        not given from ``default`` (a list)."""
+        if value is None:
+            return list(default)
+        if not isinstance(value, dict):
+            return [float(value)] * len(names)
+        return [float(value.get(a, default[i])) for i, a in enumerate(names)]
+
+
+def pair_key(a: str, b: str) -> str:
+    """The key of the pair of species a, b in a per-pair table: ``"a-b"``."""
+    return f"{a}-{b}"
 
 
 @dataclass(frozen=True)
@@ -234,6 +297,16 @@ class RunConfig:
     source: str = "<config>"
     text: str = ""
     driving: DrivingConfig | None = None
+    species: tuple = ()
+
+    @property
+    def mixture(self) -> bool:
+        """Whether the config has ``[[species]]``."""
+        return bool(self.species)
+
+    @property
+    def species_names(self) -> tuple:
+        return tuple(sp.name for sp in self.species)
 
     def to_toml(self) -> str:
         """The resolved configuration (defaults filled in) as TOML text."""
@@ -282,6 +355,9 @@ class Key:
         The dataclass field (default: ``key``).
     required_in_table : bool
         A key of a sub-table that must be given whenever the table is.
+    per_species : bool
+        A key of each ``[[species]]`` table (section ``"species"``), checked once for each
+        species under its name (``species.glass.diameter``).
     """
 
     section: str
@@ -301,6 +377,7 @@ class Key:
     run_check: str = ""
     field: str | None = None
     required_in_table: bool = False
+    per_species: bool = False
 
     @property
     def dotted(self) -> str:
@@ -426,12 +503,15 @@ SCHEMA: tuple[Key, ...] = (
     Key("collision", "model", "string",
         "The coefficient of restitution: elastic, constant, or the viscoelastic ε(g) of the contact law.",
         default="viscoelastic", choices=MODELS),
-    Key("collision", "restitution", "number", '`model = "constant"` only: the constant ε.',
-        low=0.0, low_open=True, high=1.0),
-    Key("collision", "damping", "number",
+    Key("collision", "restitution", "number or table of pairs",
+        '`model = "constant"` only: the constant ε; a mixture may give one per pair of species, '
+        '`{ "glass-glass" = 0.9, "glass-steel" = 0.8, "steel-steel" = 0.85 }` (every pair once, in '
+        "either order).", low=0.0, low_open=True, high=1.0),
+    Key("collision", "damping", "number or table of pairs",
         '`model = "viscoelastic"` only: the [damping](contact.md#damping), β of an impact at normal '
         "speed 1 between two reference particles (diameter 1, mass 1); an impact at speed g between "
-        "particles i, j has β = damping (R_eff g / m_eff²)^(1/5). Give `damping` or `[collision.material]`.",
+        "particles i, j has β = damping (R_eff g / m_eff²)^(1/5). Give `damping` or `[collision.material]`. "
+        'A mixture may give one per pair of species, `{ "a-a" = 0.1, "a-b" = 0.2, "b-b" = 0.15 }`.',
         low=0.0, high=TABLE_BETA_MAX, reason="the restitution table covers beta <= 40; the model holds "
                                              "for beta well below 3",
         run_check="beta of the fastest impact the run's energy allows must stay <= 40"),
@@ -452,22 +532,25 @@ SCHEMA: tuple[Key, ...] = (
         "of either particle's previous one is elastic, which guards against inelastic collapse. "
         "Leave the key out for no TC model.",
         unit="reduced time", low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
-    Key("collision", "wall_restitution", "number",
+    Key("collision", "wall_restitution", "number or table of species",
         '`model = "constant"` with walls only: the constant ε of particle–wall collisions (default: '
         "`restitution`). Elastic runs have elastic walls; viscoelastic runs the sphere–plane contact "
-        "of the same material.", low=0.0, low_open=True, high=1.0),
+        "of the same material. A mixture may give one per species, `{ glass = 0.9, steel = 0.7 }` "
+        "(a species left out: its own pair's ε).", low=0.0, low_open=True, high=1.0),
     Key("collision", "material", "table",
         "Instead of `damping`: the viscoelastic contact from material constants "
         "(`[collision.material]`, below)."),
     # [collision.material]
-    Key("collision.material", "young_modulus", "number", "Young's modulus Y.", unit="Pa",
+    Key("collision.material", "young_modulus", "number",
+        "Young's modulus Y (a mixture: of the species that give none).", unit="Pa",
         low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite",
         required_in_table=True, run_check="beta of the fastest impact must stay <= 40"),
-    Key("collision.material", "poisson_ratio", "number", "Poisson ratio ν.",
+    Key("collision.material", "poisson_ratio", "number", "Poisson ratio ν (a mixture: of the species that give none).",
         low=-1.0, high=0.5, low_open=True, high_open=True, reason="elastic stability",
         required_in_table=True),
     Key("collision.material", "dissipation_time", "number",
-        "The dissipative constant A of Schwager & Pöschel (1997), eq. (2).", unit="s",
+        "The dissipative constant A of Schwager & Pöschel (1997), eq. (2) (a mixture: of the species "
+        "that give none).", unit="s",
         low=0.0, high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
     Key("collision.material", "diameter", "number", "Diameter of the reference particle.", unit="m",
         low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
@@ -477,6 +560,44 @@ SCHEMA: tuple[Key, ...] = (
     Key("collision.material", "speed_unit", "number",
         "The reduced velocity unit √(T0/m); time is then in diameter / speed_unit.", unit="m/s",
         low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
+    # [[species]]
+    Key("species", "name", "string",
+        "The species' name (letters, digits and `_`): it names the species in the per-pair tables "
+        "(`\"glass-steel\"`), the output and the analysis.", default_text="required", per_species=True),
+    Key("species", "count", "integer",
+        "Number of particles of this species (give `count` for every species or `fraction` for every "
+        "species); their sum is `system.particles`.", low=1, high=MAX_PARTICLES,
+        reason="a species has particles; the engine indexes particles with int32", per_species=True),
+    Key("species", "fraction", "number",
+        "Instead of `count`: the species' share of `system.particles` (the fractions add up to 1; counts "
+        "rounded by largest remainder).", low=0.0, high=1.0, low_open=True, reason="a share of the particles",
+        per_species=True),
+    Key("species", "diameter", "number", "Diameter of the species' particles.", default=1.0,
+        unit="reference diameter", low=LENGTH_RANGE[0], high=LENGTH_RANGE[1], reason=_LENGTH, per_species=True),
+    Key("species", "mass", "number", "Mass of one particle (give `mass` or `density`, not both).",
+        default_text="1.0 when `density` is not given", unit="reference mass", low=SCALE_RANGE[0],
+        high=SCALE_RANGE[1], reason=_SPEED, per_species=True),
+    Key("species", "density", "number",
+        "Instead of `mass`: mass = density × π d³/6 (3D) or π d²/4 (2D), as `particles.density`.",
+        unit="reference mass per reference volume", low=0.0, low_open=True, high=1e250,
+        reason="finite; the mass it gives is checked like `mass`", per_species=True),
+    Key("species", "material_density", "number",
+        "The material route, instead of `mass` or `density`: the species' material density; a particle "
+        "of diameter d (reduced) has mass (material_density / `collision.material.density`) d³ (spheres, "
+        "also in 2D, as the reference mass).", unit="kg/m³", low=SI_RANGE[0], high=SI_RANGE[1],
+        reason="the reduced mass stays finite", per_species=True),
+    Key("species", "young_modulus", "number",
+        "The material route: the species' Young modulus (default: that of `[collision.material]`).",
+        unit="Pa", low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite",
+        per_species=True),
+    Key("species", "poisson_ratio", "number",
+        "The material route: the species' Poisson ratio (default: that of `[collision.material]`).",
+        low=-1.0, high=0.5, low_open=True, high_open=True, reason="elastic stability", per_species=True),
+    Key("species", "dissipation_time", "number",
+        "The material route: the species' dissipative constant A (default: that of "
+        "`[collision.material]`); a pair of species gets the effective modulus and the "
+        "compliance-weighted A of the [mixtures page](mixtures.md#viscoelastic-pairs).",
+        unit="s", low=0.0, high=SI_RANGE[1], reason="the reduced prefactor stays finite", per_species=True),
     # [driving]
     Key("driving", "model", "string",
         "White-noise driving: every particle receives independent Gaussian velocity kicks "
@@ -541,9 +662,15 @@ SCHEMA: tuple[Key, ...] = (
 SECTION_CLASSES = {
     "system": SystemConfig, "particles": ParticlesConfig, "initial": InitialConfig,
     "collision": CollisionConfig, "collision.material": MaterialConfig, "driving": DrivingConfig,
-    "run": RunSection, "output": OutputConfig,
+    "run": RunSection, "output": OutputConfig, "species": SpeciesConfig,
 }
-SECTIONS = ("system", "particles", "initial", "collision", "driving", "run", "output")
+SECTIONS = ("system", "particles", "initial", "collision", "driving", "run", "output", "species")
+#: the array of tables of a mixture, one table per species
+ARRAY_SECTIONS = ("species",)
+#: the material constants a species may give (``[[species]]``) or take from ``[collision.material]``
+MATERIAL_CONSTANTS = ("young_modulus", "poisson_ratio", "dissipation_time")
+#: characters of a species name
+_NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 #: sections that may be left out as a whole (absent: None in RunConfig)
 OPTIONAL_SECTIONS = ("driving",)
 #: keys whose value is a sub-table with its own section in SCHEMA
@@ -608,6 +735,8 @@ class Values:
         self.given: set[str] = set()
         self.raw: dict[str, Any] = {}
         self.sections: set[str] = set()
+        #: the names of the ``[[species]]`` tables, in order (empty: one kind of particle)
+        self.species: list[str] = []
 
     def origin(self, dotted: str) -> str:
         return "override" if dotted in self.overridden else self.source
@@ -640,9 +769,12 @@ def _check_type(key: Key, v: Any, values: Values, dimension: int):
         if isinstance(v, bool) or not isinstance(v, int):
             values.fail(d, f"must be {key.range_text(dimension) if key.choices is None else 'an integer: ' + key.range_text()}")
         return v
-    if key.type in ("number", "number or table"):
+    if key.type in TABLE_TYPES and isinstance(v, dict):
+        return dict(v)  # checked entry by entry against the species (_check_species_tables)
+    if key.type in ("number", "number or table") + tuple(TABLE_TYPES):
         if isinstance(v, bool) or not isinstance(v, (int, float)):
-            extra = " or { min = ..., max = ... }" if key.type == "number or table" else ""
+            extra = " or { min = ..., max = ... }" if key.type == "number or table" else \
+                f" or {TABLE_TYPES[key.type]}" if key.type in TABLE_TYPES else ""
             values.fail(d, f"must be {key.range_text(dimension)}{extra}")
         return float(v)
     if key.type == "string":
@@ -677,7 +809,9 @@ def _check_range(key: Key, v: Any, values: Values, dimension: int):
         ok = v in key.choices
     elif key.type == "string":
         ok = bool(v.strip())
-    elif key.type in ("number", "integer", "number or table"):
+    elif key.type in TABLE_TYPES and isinstance(v, dict):
+        return
+    elif key.type in ("number", "integer", "number or table") + tuple(TABLE_TYPES):
         x = float(v)
         high = key.high_by_dimension[dimension] if key.high_by_dimension is not None else key.high
         ok = math.isfinite(x)
@@ -695,6 +829,11 @@ def _check_range(key: Key, v: Any, values: Values, dimension: int):
         if key.type == "number or table":
             text += " or { min = ..., max = ... }"
         values.fail(d, f"must be {text}{reason}")
+
+
+#: key types that take a number or, in a mixture, a table (what the table is keyed by)
+TABLE_TYPES = {"number or table of pairs": 'a table { "a-b" = ..., ... } with one entry per pair of species',
+               "number or table of species": 'a table { a = ..., ... } with one entry per species'}
 
 
 # --------------------------------------------------------------------------- rules across keys
@@ -841,7 +980,221 @@ def _check_dsmc_supported(v: Values):
                                     'method = "dsmc" (a homogeneous DSMC gas shows no inelastic collapse)')
 
 
+# ------------------------------------------------------------------ [[species]]
+
+
+def _species_label(table: dict, index: int) -> str:
+    name = table.get("name") if isinstance(table, dict) else None
+    ok = isinstance(name, str) and name and set(name) <= _NAME_CHARACTERS
+    return f"species.{name}" if ok else f"species[{index}]"
+
+
+def _check_species_structure(tables: Any, values: Values):
+    """``[[species]]`` is a non-empty array of tables of known keys."""
+    if not isinstance(tables, list) or not tables or not all(isinstance(t, dict) for t in tables):
+        raise ConfigError(f"{values.source}: species: must be an array of tables, one [[species]] table per "
+                          "species (name, count or fraction, diameter, mass or density)")
+    known = _section_keys("species")
+    for k, table in enumerate(tables):
+        label = _species_label(table, k)
+        for key, value in table.items():
+            if key not in known:
+                values.fail(f"{label}.{key}", f"unknown key{_suggest(key, known)} (a species has "
+                                             f"{', '.join(known)})", value)
+
+
+def _check_species_keys(tables: Any, values: Values, dimension: int):
+    """Each species' keys by the ``per_species`` keys of :data:`SCHEMA` (as
+    ``species.<name>.<key>``), unique names, and the counts: given, or from the fractions."""
+    from dataclasses import replace
+
+    values.species = []
+    if tables is None:
+        return
+    for k, table in enumerate(tables):
+        name = table.get("name")
+        if name is None:
+            raise ConfigError(f"{values.source}: species[{k}].name: missing; every [[species]] needs a name")
+        if not (isinstance(name, str) and name and set(name) <= _NAME_CHARACTERS):
+            values.fail(f"species[{k}].name", 'must be a name of letters, digits and _ (a pair of species is '
+                                              'named "a-b")', name)
+        if name in values.species:
+            values.fail(f"species.{name}.name", f"two species are named {name}: names must be unique", name)
+        values.species.append(name)
+        for template in (key for key in SCHEMA if key.per_species and key.key != "name"):
+            key = replace(template, key=f"{name}.{template.key}", per_species=False)
+            dotted = key.dotted
+            if template.key not in table:
+                values.value[dotted] = key.default
+                continue
+            values.raw[dotted] = table[template.key]
+            values.given.add(dotted)
+            v = _check_type(key, table[template.key], values, dimension)
+            _check_range(key, v, values, dimension)
+            values.value[dotted] = v
+
+
+def _resolve_species_counts(values: Values):
+    """``species.<name>.count`` for every species: given, or the fractions of ``system.particles``
+    rounded by largest remainder; ``system.particles`` their sum."""
+    names = values.species
+    if not names:
+        return
+    counted = [n for n in names if values.has(f"species.{n}.count")]
+    shared = [n for n in names if values.has(f"species.{n}.fraction")]
+    for n in names:
+        if values.has(f"species.{n}.count") and values.has(f"species.{n}.fraction"):
+            values.fail(f"species.{n}.fraction", "give either count or fraction, not both")
+        if not (values.has(f"species.{n}.count") or values.has(f"species.{n}.fraction")):
+            values.fail(f"species.{n}.count", "missing; every species needs count (an integer >= 1) or fraction")
+    if counted and shared:
+        values.fail(f"species.{shared[0]}.fraction", f"give count for every species or fraction for every species "
+                                                     f"(species.{counted[0]} gives count)")
+    if counted:
+        total = sum(values.get(f"species.{n}.count") for n in names)
+        if values.has("system.particles") and values.get("system.particles") != total:
+            listed = ", ".join(f"{n} {values.get('species.' + n + '.count')}" for n in names)
+            values.fail("system.particles", f"the species' counts add up to {total} ({listed})")
+        if total > MAX_PARTICLES:
+            values.fail(f"species.{names[-1]}.count", f"the counts add up to {total}, beyond {MAX_PARTICLES} "
+                                                      "(the engine indexes particles with int32)")
+        values.value["system.particles"] = total
+        return
+    fractions = [values.get(f"species.{n}.fraction") for n in names]
+    total = math.fsum(fractions)
+    if abs(total - 1.0) > 1e-9:
+        listed = ", ".join(f"{n} {f:g}" for n, f in zip(names, fractions))
+        values.fail(f"species.{names[-1]}.fraction", f"the fractions add up to {total:.12g} ({listed}), not 1")
+    n_total = values.get("system.particles")
+    exact = [f / total * n_total for f in fractions]
+    counts = [math.floor(x) for x in exact]
+    for k in sorted(range(len(names)), key=lambda k: (counts[k] - exact[k], k))[:n_total - sum(counts)]:
+        counts[k] += 1
+    for name, count, f in zip(names, counts, fractions):
+        if count == 0:
+            values.fail(f"species.{name}.fraction", f"gives no particle of system.particles = {n_total}: a species "
+                                                    "needs particles (a larger fraction or more particles)")
+        values.value[f"species.{name}.count"] = count
+
+
+def _pair_entries(v: Values, dotted: str):
+    """The entries of a per-pair table keyed by the species' names (checked: known names, each
+    pair once, every pair given, values in the key's range); {(i, j): value} with i <= j."""
+    key = _BY_DOTTED[dotted]
+    table = v.get(dotted)
+    names = v.species
+    out = {}
+    for pair, value in table.items():
+        parts = str(pair).split("-")
+        shown = f"{dotted}.{quote(str(pair))}"
+        if f"{dotted}.{pair}" in v.overridden:
+            v.overridden.add(shown)
+        if len(parts) != 2 or not all(parts):
+            v.fail(shown, f'a pair of species is "a-b" with a, b among {", ".join(names)}', value)
+        for part in parts:
+            if part not in names:
+                v.fail(shown, f"no species named {part} (species: {', '.join(names)}){_suggest(part, names)}", value)
+        i, j = sorted(names.index(p) for p in parts)
+        if (i, j) in out:
+            v.fail(shown, f"the pair {names[i]}-{names[j]} is given twice (a-b and b-a are the same pair)", value)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(float(value)) or not (
+                (float(value) > key.low if key.low_open else float(value) >= key.low) and float(value) <= key.high):
+            v.fail(shown, f"must be {key.range_text()}" + (f" ({key.reason})" if key.reason else ""), value)
+        out[(i, j)] = float(value)
+    for i, a in enumerate(names):
+        for j, b in enumerate(names[i:], i):
+            if (i, j) not in out:
+                v.fail(dotted, f'no law for the pair {a}-{b}: give every pair of species, e.g. "{a}-{b}" = ...',
+                       _Shown("{...}"))
+    return out
+
+
+def _check_species_tables(v: Values):
+    """Per-pair and per-species tables: only with [[species]], keyed by its names, complete."""
+    for dotted in ("collision.restitution", "collision.damping", "collision.wall_restitution"):
+        if not isinstance(v.get(dotted), dict):
+            continue
+        if not v.species:
+            v.fail(dotted, "a table per pair or per species needs [[species]] (with one kind of particle give a "
+                           "number)", _Shown("{...}"))
+        if dotted != "collision.wall_restitution":
+            normal = _pair_entries(v, dotted)
+            names = v.species
+            v.value[dotted] = {pair_key(names[i], names[j]): x for (i, j), x in sorted(normal.items())}
+            continue
+        key = _BY_DOTTED[dotted]
+        for name, value in v.get(dotted).items():
+            shown = f"{dotted}.{name}"
+            if name not in v.species:
+                v.fail(shown, f"no species named {name} (species: {', '.join(v.species)})"
+                              f"{_suggest(str(name), v.species)}", value)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not (0.0 < float(value) <= 1.0):
+                v.fail(shown, f"must be {key.range_text()}", value)
+
+
+def _check_species_particles(v: Values):
+    """[[species]] replaces [particles]; each species has mass or density, not both, in range."""
+    if not v.species:
+        return
+    for key in ("particles.diameter", "particles.mass", "particles.density"):
+        if v.has(key):
+            v.fail(key, "is not used with [[species]] (each species gives its own diameter and mass or density)")
+    dim = v.get("system.dimension")
+    unit = math.pi / 6.0 if dim == 3 else math.pi / 4.0
+    for name in v.species:
+        if v.has(f"species.{name}.mass") and v.has(f"species.{name}.density"):
+            v.fail(f"species.{name}.density", "give either mass or density, not both")
+        rho = v.get(f"species.{name}.density")
+        if rho is not None:
+            mass = rho * unit * v.get(f"species.{name}.diameter") ** dim
+            if not SCALE_RANGE[0] <= mass <= SCALE_RANGE[1]:
+                v.fail(f"species.{name}.density", f"gives the mass {mass:.3g}, outside [1e-100, 1e100] ({_SPEED})")
+        if v.has(f"species.{name}.material_density"):
+            for other in ("mass", "density"):
+                if v.has(f"species.{name}.{other}"):
+                    v.fail(f"species.{name}.material_density", f"give one of mass, density, material_density "
+                                                               f"(the species gives {other})")
+            if not v.has("collision.material"):
+                v.fail(f"species.{name}.material_density", "is used with the material route: give "
+                                                           "[collision.material] (its density is the reference)")
+            mass = (v.get(f"species.{name}.material_density") / v.get("collision.material.density")
+                    * v.get(f"species.{name}.diameter") ** 3)
+            if not SCALE_RANGE[0] <= mass <= SCALE_RANGE[1]:
+                v.fail(f"species.{name}.material_density", f"gives the mass {mass:.3g}, outside [1e-100, 1e100] "
+                                                           f"({_SPEED})")
+
+
+def _check_species_material(v: Values):
+    """The material route of a mixture: every species has Y, nu and A (its own or those of
+    [collision.material]); material constants of a species need [collision.material] (the units)."""
+    if not v.species:
+        return
+    material = v.has("collision.material")
+    for name in v.species:
+        for const in MATERIAL_CONSTANTS:
+            own = v.has(f"species.{name}.{const}")
+            if own and not material:
+                v.fail(f"species.{name}.{const}", "is used with the material route: give [collision.material] "
+                                                  '(diameter, density, speed_unit) and model = "viscoelastic"')
+            if material and not own and v.get(f"collision.material.{const}") is None:
+                v.fail(f"species.{name}.{const}", f"missing; give it in this species or in [collision.material] "
+                                                  f"(the value of the species that give none)")
+    if v.get("collision.duration") == "resolved":
+        v.fail("collision.duration", '"resolved" takes one material: a mixture ([[species]]) needs instantaneous '
+                                     "collisions")
+
+
 RULES: tuple[Rule, ...] = (
+    Rule("`[[species]]`: every species has a unique `name` and `count` (an integer >= 1) or `fraction`, the "
+         "same form for all; the fractions add up to 1 and give every species a particle; counts add up to "
+         "`system.particles` when it is given.", _resolve_species_counts),
+    Rule("Tables per pair of species (`restitution`, `damping`) need `[[species]]` and give every pair once "
+         '(`"a-b"` or `"b-a"`); `wall_restitution` per species names known species.', _check_species_tables),
+    Rule("`[[species]]` replaces `[particles]`; each species gives `mass` or `density`, not both.",
+         _check_species_particles),
+    Rule("The material route of a mixture: every species has `young_modulus`, `poisson_ratio` and "
+         "`dissipation_time`, its own or those of `[collision.material]`; a mixture's collisions are "
+         "instantaneous.", _check_species_material),
     Rule('`model = "constant"` needs `restitution`.', _check_constant_needs_restitution),
     _only_with("collision.restitution", ("constant",)),
     _only_with("collision.tc_time", ("constant",)),
@@ -948,26 +1301,50 @@ def apply_overrides(data: dict, overrides: dict[str, Any], source: str = "<confi
                 f"{', '.join(SECTIONS)}{hint}"
             )
         node = data
+        if parts[0] in ARRAY_SECTIONS:
+            node = _species_override(data, parts, dotted, value)
+            parts = parts[2:]
         for part in parts[:-1]:
             nxt = node.setdefault(part, {})
             if not isinstance(nxt, dict):
                 raise ConfigError(f"override {dotted}: {part} is not a table")
             node = nxt
+        if len(parts) == 3 and parts[0] == "collision" and parts[1] in ("restitution", "damping"):
+            a, _, b = parts[2].partition("-")
+            node.pop(f"{b}-{a}", None)  # a pair's override replaces it in either order
         node[parts[-1]] = value
-        done.add(".".join(parts))
+        done.add(str(dotted))
     return done
+
+
+def _species_override(data: dict, parts: list, dotted: str, value) -> dict:
+    """The ``[[species]]`` table an override ``species.<name>.<key>`` addresses."""
+    tables = data.get("species")
+    names = [t.get("name") for t in tables] if isinstance(tables, list) and all(
+        isinstance(t, dict) for t in tables) else []
+    if len(parts) != 3:
+        raise ConfigError(f"override {dotted} = {_show(value)}: a species key is species.<name>.<key>, e.g. "
+                          f"species.{names[0] if names else 'glass'}.diameter")
+    if parts[1] not in names:
+        hint = _suggest(parts[1], [n for n in names if isinstance(n, str)])
+        listed = ", ".join(str(n) for n in names) or "none"
+        raise ConfigError(f"override {dotted} = {_show(value)}: no species named {parts[1]} (species: {listed}){hint}")
+    return tables[names.index(parts[1])]
 
 
 def _check_structure(data: dict, values: Values):
     """Unknown sections and keys (with the nearest valid name), non-table sections."""
     all_keys = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA}
     for name, table in data.items():
+        if name in ARRAY_SECTIONS and name in SECTIONS:
+            _check_species_structure(table, values)
+            continue
         if name not in SECTIONS:
             origin = "override" if any(o.startswith(name + ".") for o in values.overridden) else values.source
             close = difflib.get_close_matches(name, SECTIONS, n=1, cutoff=0.6)
             hint = f"; did you mean [{close[0]}]?" if close else ""
             raise ConfigError(f"{origin}: [{name}]: unknown section (allowed: "
-                              f"{', '.join(f'[{s}]' for s in SECTIONS)}){hint}")
+                              f"{', '.join(f'[[{s}]]' if s in ARRAY_SECTIONS else f'[{s}]' for s in SECTIONS)}){hint}")
         _check_table(name, table, values, all_keys)
 
 
@@ -1012,6 +1389,8 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
     values.sections = set(data)
     dimension = 3
     for key in SCHEMA:
+        if key.per_species:
+            continue
         dotted = key.dotted
         present, raw = _lookup(data, key)
         if dotted in INLINE_TABLES and present and isinstance(raw, dict):
@@ -1030,8 +1409,10 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
             continue
         if not present:
             parent = key.section if key.section in SUBTABLES else None
-            if key.required_in_table and parent and parent in values.given:
-                required = [k.key for k in SCHEMA if k.section == key.section and k.required_in_table]
+            optional = MATERIAL_CONSTANTS if "species" in data else ()  # a mixture's species may give them
+            if key.required_in_table and parent and parent in values.given and key.key not in optional:
+                required = [k.key for k in SCHEMA if k.section == key.section and k.required_in_table
+                            and k.key not in optional]
                 missing = [k for k in required if k not in values.raw[parent]]
                 raise ConfigError(f"{values.where(parent)}: missing key(s) {', '.join(missing)} "
                                   f"(all of {', '.join(required)} are needed)")
@@ -1044,6 +1425,7 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
         if dotted == "system.dimension":
             dimension = v
         values.value[dotted] = v
+    _check_species_keys(data.get("species"), values, dimension)
     for rule in RULES:
         rule.check(values)
     return _assemble(values, source, text)
@@ -1074,8 +1456,18 @@ def _assemble(values: Values, source: str, text: str) -> RunConfig:
             kwargs["material"] = material
         return SECTION_CLASSES[name](**kwargs)
 
-    parts = {s: section(s) if s not in OPTIONAL_SECTIONS or s in values.sections else None for s in SECTIONS}
-    return RunConfig(**parts, source=source, text=text)
+    parts = {s: section(s) if s not in OPTIONAL_SECTIONS or s in values.sections else None
+             for s in SECTIONS if s not in ARRAY_SECTIONS}
+    for name in values.species:
+        if v[f"species.{name}.material_density"] is not None:  # the reduced mass of the material route
+            v[f"species.{name}.mass"] = (v[f"species.{name}.material_density"] / v["collision.material.density"]
+                                         * v[f"species.{name}.diameter"] ** 3)
+        elif v[f"species.{name}.mass"] is None and v[f"species.{name}.density"] is None:
+            v[f"species.{name}.mass"] = 1.0
+    species = tuple(SpeciesConfig(name=name, **{k.attribute: v[f"species.{name}.{k.key}"] for k in SCHEMA
+                                                if k.per_species and k.key != "name"})
+                    for name in values.species)
+    return RunConfig(**parts, source=source, text=text, species=species)
 
 
 def default_output(source: str) -> str:
@@ -1101,9 +1493,11 @@ def _toml_value(v: Any) -> str:
 def dump_toml(config: RunConfig) -> str:
     """Resolved config as TOML (round-trips through :func:`parse_config`), key order of :data:`SCHEMA`."""
     lines = [f"# resolved from {config.source}"]
-    objects = {s: getattr(config, s) for s in SECTIONS}
+    objects = {s: getattr(config, s) for s in SECTIONS if s not in ARRAY_SECTIONS}
     objects["collision.material"] = config.collision.material
-    for name in SECTIONS + tuple(SUBTABLES):
+    if config.species:
+        objects["particles"] = None  # [[species]] in its place
+    for name in tuple(objects):
         obj = objects[name]
         if obj is None:
             continue
@@ -1118,6 +1512,20 @@ def dump_toml(config: RunConfig) -> str:
             value = getattr(obj, key.attribute)
             if isinstance(value, tuple):
                 lines.append(f"{key.key} = [{', '.join(_toml_value(x) for x in value)}]")
+            elif isinstance(value, dict):
+                entries = ", ".join(f"{quote(k)} = {_toml_value(x)}" for k, x in value.items())
+                lines.append(f"{key.key} = {{ {entries} }}")
             elif value is not None:
                 lines.append(f"{key.key} = {_toml_value(value)}")
+    for sp in config.species:
+        lines.append("\n[[species]]")
+        lines.append(f"name = {_toml_value(sp.name)}")
+        lines.append(f"count = {sp.count}")  # resolved: the counts the run uses
+        for key in SCHEMA:
+            if key.per_species and key.key not in ("name", "count", "fraction"):
+                if key.key == "mass" and sp.material_density is not None:
+                    continue  # set from material_density
+                value = getattr(sp, key.attribute)
+                if value is not None:
+                    lines.append(f"{key.key} = {_toml_value(value)}")
     return "\n".join(lines) + "\n"

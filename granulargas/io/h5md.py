@@ -113,13 +113,23 @@ DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_p
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
 RESOLVED_OBSERVABLES = ("three_body_contacts",)
+#: observables of a mixture of S species: one value per species, the collisions (S, S) per pair
+SPECIES_OBSERVABLES = ("species_temperature", "species_sonine_a2", "species_collisions")
+_SPECIES_DESCRIPTIONS = {
+    "species_temperature": "temperature T_s = <m c^2>_s / d of each species (index = particles/all/species; "
+                           "c the peculiar velocity of the whole gas)",
+    "species_sonine_a2": "second Sonine coefficient d/(d+2) <e^2>_s/<e>_s^2 - 1, e = m c^2, of each species",
+    "species_collisions": "pair collisions so far per pair of species (S, S), symmetric: (a, b) counts the "
+                          "collisions between species a and b",
+}
 #: per-frame fields every frame of an EDMD / a DSMC file holds; the other per-frame fields of
 #: granulargas.state.PARTICLE_FIELDS are stored when a run asks for them (``fields``)
 CORE_FIELDS = ("positions", "velocities", "images")
 CORE_FIELDS_DSMC = ("velocities",)
 #: per-frame fields a run may store besides the core ones (restart state of its model)
 OPTIONAL_FIELDS = tuple(x for x in PARTICLE_FIELDS if x.per_frame and x.name not in CORE_FIELDS)
-_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts")
+_INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts",
+                    "species_collisions")
 #: H5MD box boundary of each axis kind
 _H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
 
@@ -194,10 +204,12 @@ class H5MDWriter:
     overwrite : bool
     driven : bool
         Also the driving's observables (``injected_energy``, ``kick_step``).
+    species : int
+        A mixture of that many species: also :data:`SPECIES_OBSERVABLES` (0: none).
     """
 
     def __init__(self, path, state: State, *, fields=(), parameters=None, overwrite=False, author=None,
-                 driven=False):
+                 driven=False, species: int = 0):
         self.path = Path(path)
         self.d, self.n = state.dimension, state.n
         self.positions = state.positions is not None
@@ -211,7 +223,9 @@ class H5MDWriter:
         self.file = f
         self.boundary = state.boundary
         extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
-                 + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ()))
+                 + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ())
+                 + (SPECIES_OBSERVABLES if species else ()))
+        self.species = int(species)
         names = SCALAR_OBSERVABLES + ("momentum",) + extra
         if not self.positions:  # DSMC: no pair virial, no pressure
             names = tuple(x for x in names if x != "pressure")
@@ -352,6 +366,8 @@ class H5MDWriter:
         step = time = None
         for name in names:
             shape = (d,) if name == "momentum" else ()
+            if name in SPECIES_OBSERVABLES:
+                shape = (self.species,) * (2 if name == "species_collisions" else 1)
             dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
             g = obs.create_group(name)
             if step is None:
@@ -373,6 +389,9 @@ class H5MDWriter:
             "(mass-weighted; granulargas.observables)")
         obs["sonine_a3"].attrs["description"] = (
             "third Sonine coefficient of the peculiar velocities (granulargas.observables)")
+        for name, text in _SPECIES_DESCRIPTIONS.items():
+            if name in obs:
+                obs[name].attrs["description"] = text
         if "wall_pressure" in obs:
             obs["wall_pressure"].attrs["description"] = (
                 "normal momentum delivered to the walls per unit wall area per unit time over the sampling "
@@ -523,6 +542,8 @@ def _write_parameters(group, params: dict):
             write_text(group, key, value)
         elif isinstance(value, np.ndarray):
             group.attrs[key] = value.item()
+        elif isinstance(value, (list, tuple)) and value and all(isinstance(x, str) for x in value):
+            group.attrs.create(key, [str(x) for x in value], dtype=h5py.string_dtype())
         elif isinstance(value, (list, tuple)):
             group.attrs[key] = np.asarray(value)
         else:
@@ -847,6 +868,11 @@ def _counters_at(f, path, step: int, time: float, k: int) -> dict:
             if sample >= value.shape[0]:
                 raise InputFileError(f"{path}: damaged H5MD file: observables/{name} ends before snapshot {k}")
             out[name] = dtype(_read(value, sample)).item()
+    if "species_collisions" in obs:
+        value = obs["species_collisions"]["value"]
+        if sample >= value.shape[0]:
+            raise InputFileError(f"{path}: damaged H5MD file: observables/species_collisions ends before snapshot {k}")
+        out["species_collisions"] = np.asarray(_read(value, sample), dtype=np.int64)
     return out
 
 

@@ -18,7 +18,8 @@ A scene is a handful of orthogonal fields:
   (white-noise driving), ``"elastic"`` (conserved) or ``"unknown"``;
 * ``walls``, ``resolved`` (collisions that take time), ``polydisperse``, ``tc_model``
   (the TC model's elastic collisions), ``material`` (the material route: the contact
-  stiffness and so the contact time is known).
+  stiffness and so the contact time is known), ``mixture`` (species, ``[[species]]``:
+  the temperature of each species; the one-component theory is that of the mean particle).
 
 A new scene (another boundary, a force field, a tangential law, species) adds a field
 here, sets it in both constructors, and adjusts the predicates of the statements it
@@ -55,6 +56,7 @@ class Scene:
     polydisperse: bool = False
     tc_model: bool = False
     material: bool = False
+    mixture: bool = False
 
     @property
     def space(self) -> bool:
@@ -70,14 +72,18 @@ class Scene:
         """The scene of a :class:`granulargas.io.config.RunConfig`."""
         s, c, p = config.system, config.collision, config.particles
         driving = config.driving
+        # a mixture's tables per pair: it cools if any pair does
+        eps = min(c.restitution.values()) if isinstance(c.restitution, dict) else c.restitution
+        damping = max(c.damping.values()) if isinstance(c.damping, dict) else c.damping
+        mixture = bool(getattr(config, "species", ()))
         return cls(
             method=config.run.method, dimension=s.dimension, model=c.model,
-            kind=_kind(c.model, c.restitution, c.damping if c.material is None else 1.0,
+            kind=_kind(c.model, eps, damping if c.material is None else 1.0,
                        driving is not None and driving.heating_rate > 0.0),
             walls="wall" in s.boundary, resolved=c.duration == "resolved",
-            polydisperse=bool(p.polydisperse and p.diameter_max > p.diameter_min),
+            polydisperse=bool(not mixture and p.polydisperse and p.diameter_max > p.diameter_min),
             tc_model=c.tc_time is not None,
-            material=c.material is not None,
+            material=c.material is not None, mixture=mixture,
         )
 
     @classmethod
@@ -93,15 +99,17 @@ class Scene:
         drv = parameters.get("driving")
         driven = isinstance(drv, dict) and _float(drv.get("heating_rate"), 0.0) > 0.0
         material = isinstance(parameters.get("units_si"), dict)
+        mixture = isinstance(parameters.get("species"), dict)
         poly = False
         for values in (radii, masses):
-            if values is not None and np.size(values) and np.ptp(np.asarray(values)) > 0:
+            if not mixture and values is not None and np.size(values) and np.ptp(np.asarray(values)) > 0:
                 poly = True
         return cls(
             method=str(parameters.get("method", "edmd")), dimension=int(dimension), model=model,
             kind=_kind(model, _float(coll.get("restitution"), None), _float(coll.get("prefactor"), None), driven),
             walls="wall" in tuple(boundary), resolved=bool(contacts) or coll.get("duration") == "resolved",
             polydisperse=poly, tc_model=_float(coll.get("tc_time"), None) is not None, material=material,
+            mixture=mixture,
         )
 
     @classmethod
@@ -121,7 +129,7 @@ class Scene:
         parts.append(law)
         parts += [name for name, on in (("walls", self.walls), ("collisions that take time", self.resolved),
                                         ("polydisperse", self.polydisperse), ("TC model", self.tc_model),
-                                        ("material route", self.material)) if on]
+                                        ("material route", self.material), ("mixture", self.mixture)) if on]
         return ", ".join(parts)
 
     def as_dict(self) -> dict:
@@ -174,7 +182,8 @@ STATEMENTS = {
         lambda s: s.model == "viscoelastic" and s.kind in ("cooling", "driven")),
     "constant_or_viscoelastic": Statement(
         "best constant eps against the viscoelastic T(t), or the damping of the same initial cooling rate "
-        "(compares cooling curves)", lambda s: _cools(s) and s.model in ("constant", "viscoelastic")),
+        "(compares cooling curves of one kind of particle)",
+        lambda s: _cools(s) and s.model in ("constant", "viscoelastic") and not s.mixture),
     "instability": Statement(
         "box length against the shear-instability length L_c: clusters and shear modes in space",
         lambda s: s.space and _cools(s)),
@@ -201,6 +210,11 @@ STATEMENTS = {
         "collisions that met a pair still in contact", lambda s: s.resolved),
     "polydisperse_theory": Statement(
         "the theory is that of identical particles of the mean diameter", lambda s: s.polydisperse),
+    "species_temperatures": Statement(
+        "the temperature of each species of a mixture (Garzó & Dufty 1999), which equipartition does not fix",
+        lambda s: s.mixture and s.model != "unknown"),
+    "mixture_mean_particle": Statement(
+        "a mixture's one-component predictions are those of its mean particle and mean law", lambda s: s.mixture),
     "theory_comparison": Statement(
         "any comparison with kinetic theory (needs the collision model)", lambda s: s.model != "unknown"),
 }

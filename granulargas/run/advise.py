@@ -58,6 +58,16 @@ g = 1 for two reference particles) whose viscoelastic gas cools at the same
 initial rate and how far its T(t) would drift from Haff's law
 over the run, plus the inelastic-collapse risk.
 
+8. A mixture (``[[species]]``, :func:`species_advice`): the temperature of each species,
+   which equipartition does not fix -- in the homogeneous cooling state (constant eps) or
+   at the run's end (viscoelastic: the species' balance equations integrated over the run)
+   or in the driven steady state, from the Maxwellian theory of Garzó & Dufty (1999) with
+   the Enskog chi_ij (:mod:`granulargas.theory.mixture`). The run's temperature range, the
+   clustering and the method are those of the one-component gas of the mixture's mean
+   particle and mean law (:func:`granulargas.run.validity.gas_from_config`); the
+   constant-versus-viscoelastic comparison of items 2-4 is one of one kind of particle and
+   is not made for a mixture.
+
 The prediction is the kinetic theory of :mod:`granulargas.theory.gas`: a homogeneous
 gas whose temperature and second Sonine coefficient a2 evolve together (moment
 equations with the exact eps(g)); it is checked against real runs in
@@ -79,8 +89,8 @@ from granulargas.contact.material import damping_from_prefactor
 from granulargas.errors import ConfigError
 from granulargas.io.scene import Scene
 from granulargas.run import validity as V
-from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, oblique_bounds, reduced_compression,
-                                     reduced_prefactor)
+from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, mean_restitution, mixture_of_config,
+                                     oblique_bounds, reduced_compression, reduced_prefactor)
 from granulargas.theory.driven import RELAXATION_TIMES
 from granulargas.theory.gas import cooling_curve
 
@@ -303,6 +313,8 @@ class Advice:
         None off the material route.
     validity : list of str
         The run summary's checks that the lines above do not state (t_c/t_free, warnings).
+    species : list of str
+        A mixture: the lines of :func:`species_advice`.
     notes : list of str
     """
 
@@ -329,6 +341,7 @@ class Advice:
     duration: str | None = None
     duration_reason: str = ""
     validity: tuple = ()
+    species: tuple = ()
     notes: tuple = ()
 
     def _run_line(self) -> str:
@@ -345,7 +358,7 @@ class Advice:
 
     def lines(self) -> list[str]:
         sc = self.scene
-        out = [self._run_line()]
+        out = [self._run_line()] + list(self.species)
         if self.model == "elastic":
             out.append("advice       elastic collisions: nothing to choose")
         if sc.kind == "driven" and math.isfinite(self.relaxation_time):
@@ -482,6 +495,41 @@ def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.Cooling
     return cooling_curve(gas, t_end=t_end, t_min_ratio=None)
 
 
+def species_advice(config, t_end: float) -> list[str]:
+    """The temperature of each species of a mixture (module docstring, item 8), as lines: the
+    homogeneous cooling state's T_i / T (constant eps), T_i / T at the predicted end ``t_end``
+    of a viscoelastic run from equal temperatures at the start, or the driven steady state's
+    (granulargas's driving: the same heating rate dT_i/dt for every species)."""
+    mix = mixture_of_config(config)
+    c = config.collision
+    names = mix.names
+    driving = config.driving
+    t0 = config.initial.temperature
+
+    def listed(ratios):
+        return ", ".join(f"{n} {r:.4g}" for n, r in zip(names, ratios))
+
+    out = []
+    if c.model == "elastic":
+        return ["species      elastic collisions: every species keeps the temperature T (equipartition)"]
+    if driving is not None and driving.heating_rate > 0.0:
+        t_ss = float(theory.driven_temperature(driving.heating_rate, mean_restitution(config), mix.number_density,
+                                               mix.dimension, *mean_particle(config))) if c.model == "constant" else t0
+        ratios = mix.driven_ratios("equal_heating", t_ss)
+        return [f"species      driven steady state T_i / T: {listed(ratios)} (Garzó & Dufty 1999 Maxwellian, Enskog "
+                "chi_ij; the driving heats every species at the same dT_i/dt)"]
+    if c.model == "constant":
+        ratios = mix.hcs_ratios()
+        out.append(f"species      homogeneous cooling state T_i / T: {listed(ratios)} (Garzó & Dufty 1999 Maxwellian, "
+                   "Enskog chi_ij), reached from equal temperatures within a few collisions per particle")
+        return out
+    temps = mix.temperature_history(np.array([0.0, t_end]), np.full(len(names), t0))[-1]
+    ratios = temps / float(np.sum(mix.fractions * temps))
+    out.append(f"species      T_i / T at t = {t_end:.4g}: {listed(ratios)} (from equal temperatures; Maxwellian "
+               "balance of each species with eps_ij(g) per pair, Garzó & Dufty 1999)")
+    return out
+
+
 def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     """Advice on the collision rule for a config (module doc); every line applies to the
     config's scene (:class:`granulargas.io.scene.Scene`)."""
@@ -545,6 +593,12 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         notes.append(f"eps = {gas.restitution:g} without tc_time: dense or strongly inelastic regions can collapse "
                      "(InelasticCollapseError); set [collision] tc_time (TC model) or use the viscoelastic "
                      "rule (scripts/validation/collapse_demo.py)")
+    if scene.shows("species_temperatures"):
+        adv.species = tuple(species_advice(config, t_end))
+    if scene.shows("mixture_mean_particle"):
+        notes.append(f"a mixture: T(t), the clustering and the method above are those of its mean particle (diameter "
+                     f"{gas.sigma:.4g}, mass {gas.mass:.4g}) and mean law; the constant-versus-viscoelastic comparison "
+                     "is one of one kind of particle and is not made")
     if scene.shows("polydisperse_theory"):
         notes.append(f"polydisperse: the predictions are those of identical particles of the mean diameter "
                      f"{gas.sigma:.4g} (mass {gas.mass:.4g}) at the config's number density (packing "
@@ -582,6 +636,8 @@ def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
     Returns None where the scene has no such comparison (elastic and driven runs: the advice
     compares cooling curves).
     """
+    if Scene.from_config(config).shows("species_temperatures"):  # a mixture: the temperatures of its species
+        return "advice       " + advise(config, tolerance).species[0].split(None, 1)[1]
     if not Scene.from_config(config).shows("constant_or_viscoelastic"):
         return None
     adv = advise(config, tolerance)

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from granulargas.dsmc import DSMC
-from granulargas.observables import kinetic_energy_momentum
+from granulargas.observables import kinetic_energy_momentum, species_moments
 
 
 class DSMCRun(DSMC):
@@ -48,7 +48,7 @@ class DSMCRun(DSMC):
         ke, *p = kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)
         driven = {} if self.driving is None else {"injected_energy": float(self.injected_energy),
                                                    "kick_step": int(self.kick_step)}
-        return {**driven,
+        return {**driven, **self.species_observables(),
             "temperature": float(t),
             "kinetic_energy": float(ke),
             "collisions": int(self.collisions),
@@ -60,8 +60,20 @@ class DSMCRun(DSMC):
         }
 
 
+    def species_observables(self) -> dict:
+        """A mixture's observables: temperature and a2 of each species, collisions per pair of
+        species (none without a pair table in the rule)."""
+        if self._species is None:
+            return {}
+        temperature, a2 = species_moments(self.velocities, self.masses, self._species.of, self.rule.species)
+        return {"species_temperature": temperature, "species_sonine_a2": a2,
+                "species_collisions": self.species_collisions}
+
+
 def make_dsmc(config, setup) -> DSMCRun:
     """The DSMC of a prepared config (module docstring): the volume of the state's box, the
-    restart file's continuation if the state has one."""
-    return DSMCRun(setup.state, setup.rule, chi=setup.parameters["dsmc"]["chi"], seed=config.system.seed,
-                   driving=setup.driving)
+    restart file's continuation if the state has one; a mixture's chi per pair of species
+    (:func:`granulargas.run.prepare.mixture_contact_values`)."""
+    dsmc = setup.parameters["dsmc"]
+    chi = dsmc.get("chi_pairs", dsmc["chi"])
+    return DSMCRun(setup.state, setup.rule, chi=chi, seed=config.system.seed, driving=setup.driving)

@@ -80,17 +80,35 @@ class Setup:
 def mean_particle(config: RunConfig) -> tuple[float, float]:
     """(sigma, m): the config's mean diameter and the mass of a particle of that diameter
     (``particles.mass``, or ``particles.density`` times its volume); what kinetic theory
-    of identical particles uses for the config."""
+    of identical particles uses for the config. A mixture: the number-weighted mean diameter
+    and mean mass of its species."""
     s, p = config.system, config.particles
+    if config.species:
+        x = species_fractions(config)
+        sigma = float(np.dot(x, [sp.diameter for sp in config.species]))
+        return sigma, float(np.dot(x, [sp.particle_mass(s.dimension) for sp in config.species]))
     sigma = p.diameter
     mass = p.mass if p.mass is not None else p.density * float(particle_volume(sigma, s.dimension))
     return sigma, mass
 
 
+def species_fractions(config: RunConfig) -> np.ndarray:
+    """Number fractions x_i of a mixture's species (S,), from their counts."""
+    counts = np.array([sp.count for sp in config.species], dtype=float)
+    return counts / counts.sum()
+
+
 def make_particles(config: RunConfig, rng: np.random.Generator):
-    """Radii and masses of the config's particles (polydisperse radii drawn from ``rng``)."""
+    """Radii and masses of the config's particles (polydisperse radii drawn from ``rng``); a
+    mixture: the particles of each species in the order of ``[[species]]``, ids 0 .. n_1 - 1 the
+    first (positions are random: the order places nothing), nothing drawn from ``rng``."""
     s, p = config.system, config.particles
     n = s.particles
+    if config.species:
+        of = species_indices(config)
+        diam = np.array([sp.diameter for sp in config.species])[of]
+        masses = np.array([sp.particle_mass(s.dimension) for sp in config.species])[of]
+        return np.ascontiguousarray(0.5 * diam), np.ascontiguousarray(masses, dtype=np.float64)
     if p.polydisperse:
         diam = rng.uniform(p.diameter_min, p.diameter_max, n)
     else:
@@ -98,6 +116,14 @@ def make_particles(config: RunConfig, rng: np.random.Generator):
     radii = np.ascontiguousarray(0.5 * diam)
     masses = np.full(n, p.mass) if p.mass is not None else p.density * particle_volume(diam, s.dimension)
     return radii, np.ascontiguousarray(masses, dtype=np.float64)
+
+
+def species_indices(config: RunConfig) -> np.ndarray | None:
+    """The species index of every particle (int32 (N,), in the order of ``[[species]]``; None
+    without species)."""
+    if not config.species:
+        return None
+    return np.repeat(np.arange(len(config.species), dtype=np.int32), [sp.count for sp in config.species])
 
 
 def fresh_state(config: RunConfig) -> State:
@@ -126,8 +152,9 @@ def fresh_state(config: RunConfig) -> State:
                 "use more particles or a higher packing_fraction"
             )
     try:
-        return random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
-                            radii=radii, masses=masses, rng=rng, boundary=s.boundary)
+        state = random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
+                             radii=radii, masses=masses, rng=rng, boundary=s.boundary)
+        return state if not config.species else state.replace(species=species_indices(config))
     except ConfigError as exc:
         limit = RANDOM_PLACEMENT_MAX[s.dimension]
         raise ConfigError(f"{config.source}: system.packing_fraction = {s.packing_fraction:g}: {exc}; random "
@@ -146,7 +173,7 @@ def fresh_velocities(config: RunConfig) -> State:
     radii, masses = make_particles(config, rng)
     box = box_for_packing(radii, s.packing_fraction, s.dimension)
     velocities = maxwell_velocities(masses, s.dimension, config.initial.temperature, rng=rng)
-    return State(None, velocities, radii, masses, box, boundary=tuple(s.boundary))
+    return State(None, velocities, radii, masses, box, boundary=tuple(s.boundary), species=species_indices(config))
 
 
 def restart_state(config: RunConfig) -> State:
@@ -187,6 +214,18 @@ def restart_state(config: RunConfig) -> State:
             f"{config.source}: system.boundary = [{', '.join(repr(b) for b in config.system.boundary)}]: "
             f"restart file {path} has [{', '.join(repr(b) for b in state.boundary)}]"
         )
+    want, have = species_indices(config), state.species
+    if want is None and have is not None and np.any(have != 0):
+        raise ConfigError(f"{config.source}: [[species]]: restart file {path} is a mixture of "
+                          f"{int(have.max()) + 1} species; continue it with the [[species]] tables of its run")
+    if want is not None:
+        counts = [sp.count for sp in config.species]
+        found = np.bincount(np.zeros(n, dtype=np.int64) if have is None else np.maximum(have, 0),
+                            minlength=len(counts))
+        if have is None or np.any(have < 0) or len(found) != len(counts) or np.any(found != counts):
+            listed = ", ".join(f"{sp.name} {sp.count}" for sp in config.species)
+            raise ConfigError(f"{config.source}: [[species]]: restart file {path} has species counts "
+                              f"{found.tolist()}, the config {listed}")
     return state
 
 
@@ -194,13 +233,56 @@ def restart_state(config: RunConfig) -> State:
 
 
 def reduced_prefactor(config: RunConfig) -> float:
-    """The viscoelastic pair prefactor k in reduced units (see module docstring)."""
+    """The viscoelastic pair prefactor k in reduced units (see module docstring). A mixture: the
+    mean of its pair prefactors (:func:`pair_prefactors`) weighted by how often the pairs
+    collide (:func:`pair_weights`), what the kinetic theory of one kind of particle uses for it."""
     c = config.collision
+    if config.species:
+        return float(np.sum(pair_weights(config) * pair_prefactors(config)))
     if c.material is None:
         return float(material.prefactor_from_damping(c.damping, radius=0.5, mass=1.0))
     m = c.material
     k_si = float(material.prefactor_from_material(m.young_modulus, m.poisson_ratio, m.dissipation_time))
     return k_si * (m.diameter * m.speed_unit / reference_mass_si(m) ** 2) ** 0.2
+
+
+def pair_prefactors(config: RunConfig) -> np.ndarray:
+    """The viscoelastic prefactors k_ij (S, S) of a mixture in reduced units: from ``damping``
+    (a number or one per pair) as :func:`granulargas.contact.material.prefactor_from_damping`, or
+    from each pair's materials (:func:`granulargas.contact.material.pair_prefactor_from_materials`,
+    the species' constants or those of ``[collision.material]``) converted like one material's."""
+    c, names = config.collision, config.species_names
+    if c.material is None:
+        table = c.pair_table(c.damping, names)
+        return np.array([[material.prefactor_from_damping(x, radius=0.5, mass=1.0) for x in row] for row in table])
+    m = c.material
+    consts = [tuple(getattr(sp, k) if getattr(sp, k) is not None else getattr(m, k)
+                    for k in ("young_modulus", "poisson_ratio", "dissipation_time")) for sp in config.species]
+    unit = (m.diameter * m.speed_unit / reference_mass_si(m) ** 2) ** 0.2
+    return np.array([[float(material.pair_prefactor_from_materials(*a, *b)) * unit for b in consts] for a in consts])
+
+
+def pair_weights(config: RunConfig) -> np.ndarray:
+    """How often each pair of species collides, relative: x_i x_j sigma_ij^(d-1) (S, S), summing to 1
+    (the dilute collision rates at one temperature and one mass; for the averages of one-component
+    kinetic theory)."""
+    x = species_fractions(config)
+    sig = np.array([sp.diameter for sp in config.species])
+    w = np.outer(x, x) * (0.5 * (sig[:, None] + sig[None, :])) ** (config.system.dimension - 1)
+    return w / w.sum()
+
+
+def pair_restitutions(config: RunConfig) -> np.ndarray:
+    """The constant eps_ij (S, S) of a mixture (``restitution`` a number or one per pair)."""
+    return np.array(config.collision.pair_table(config.collision.restitution, config.species_names))
+
+
+def mean_restitution(config: RunConfig) -> float:
+    """The constant eps of a config; a mixture: the mean of eps_ij weighted by :func:`pair_weights`
+    (what the kinetic theory of one kind of particle uses for it)."""
+    if not config.species:
+        return config.collision.restitution
+    return float(np.sum(pair_weights(config) * pair_restitutions(config)))
 
 
 def reduced_young_modulus(config: RunConfig) -> float:
@@ -278,7 +360,12 @@ def validity_warnings(config: RunConfig, prefactor: float, state: State) -> list
         m, d = state.masses, state.velocities.shape[1]
         temp = float((m[:, None] * state.velocities**2).sum()) / (d * len(m))
         speed = 3.0 * math.sqrt(2.0 * temp / float(m.min())) * mat.speed_unit  # m/s
-        sound = material.sound_speed(mat.young_modulus, mat.density)
+        if config.species:  # the slowest sound of the species: density_s = density m_s / sigma_s^3
+            sound = min(material.sound_speed(sp.young_modulus or mat.young_modulus,
+                                             mat.density * sp.particle_mass(d) / sp.diameter**3)
+                        for sp in config.species)
+        else:
+            sound = material.sound_speed(mat.young_modulus, mat.density)
     return [f"warning: {config.source}: {p}" for p in material.validity_problems(beta=high, impact_speed=speed,
                                                                           speed_of_sound=sound)]
 
@@ -303,26 +390,40 @@ def make_rule(config: RunConfig, state: State):
     """(rule, name, prefactor, table, warnings, parameters) for the config."""
     c = config.collision
     params = {"model": c.model}
+    mixture = bool(config.species)
     if c.model == "elastic":
-        return CollisionRule.elastic(), "elastic", None, None, [], params
+        return CollisionRule.elastic(len(config.species) if mixture else None), "elastic", None, None, [], params
     if c.model == "constant":
         params.update(restitution=c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution)
-        rule = CollisionRule.constant(c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution)
+        if mixture:
+            eps = pair_restitutions(config)
+            walls = c.species_values(c.wall_restitution, config.species_names, np.diagonal(eps))
+            params.update(restitution=mean_restitution(config), restitution_pairs=eps,
+                          wall_restitution=np.array(walls))
+            rule = CollisionRule.constant(eps, tc_time=c.tc_time, wall_restitution=walls)
+        else:
+            rule = CollisionRule.constant(c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution)
         return rule, "constant", None, None, [], params
     k = reduced_prefactor(config)
+    pairs = pair_prefactors(config) if mixture else None
+    # the bounds of a mixture with its largest pair prefactor (rigorous: beta grows with k)
+    k_bound = float(pairs.max()) if mixture else k
     driven = config.driving is not None and config.driving.heating_rate > 0.0
-    bmax = beta_bound(k, state, driven_energy_bound(config, k, state) if driven else None)
+    bmax = beta_bound(k_bound, state, driven_energy_bound(config, k_bound, state) if driven else None)
     if not bmax <= TABLE_BETA_MAX:
-        key = (f"collision.damping = {c.damping:g}" if c.material is None else "collision.material")
+        key = ("collision.material" if c.material is not None else "collision.damping" if isinstance(c.damping, dict)
+               else f"collision.damping = {c.damping:g}")
         energy = "the driving's energy bound" if driven else "the run's kinetic energy"
         raise ConfigError(
             f"{config.source}: {key}: the fastest impact {energy} allows reaches beta = {bmax:.3g}, "
             f"beyond the restitution table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well below 3); "
             "lower the damping")
     table = restitution_table(max(bmax, 1e-6), end=c.contact_end)
-    warns = validity_warnings(config, k, state)
+    warns = validity_warnings(config, k_bound, state)
     params.update(prefactor=k, contact_end=c.contact_end, damping=c.damping,
-                  beta_expected=list(expected_beta(k, state)), beta_bound=bmax)
+                  beta_expected=list(expected_beta(k_bound, state)), beta_bound=bmax)
+    if mixture:
+        params["prefactor_pairs"] = pairs
     params["restitution_table"] = {
         "inv_h": table.inv_h, "coeffs": np.asarray(table.coeffs), "duration_coeffs": np.asarray(table.duration_coeffs),
         "beta_max": table.beta_max, "end": table.end, **{k2: v for k2, v in table.parameters.items()},
@@ -344,7 +445,8 @@ def make_rule(config: RunConfig, state: State):
         rule = CollisionRule.viscoelastic(prefactor=k, table=table, duration="resolved", compression=q,
                                           oblique=oblique)
         return rule, "viscoelastic", k, table, warns, params
-    return CollisionRule.viscoelastic(prefactor=k, table=table), "viscoelastic", k, table, warns, params
+    return (CollisionRule.viscoelastic(prefactor=pairs if mixture else k, table=table), "viscoelastic", k, table,
+            warns, params)
 
 
 def make_driving(config: RunConfig, prefactor: float | None, state: State):
@@ -374,7 +476,8 @@ def make_driving(config: RunConfig, prefactor: float | None, state: State):
         rates = [h / t0]
     else:
         if c.model == "constant":
-            eps_ss = eps0 = c.restitution
+            # a mixture: its most inelastic pair (the fastest cooling, the shortest interval)
+            eps_ss = eps0 = float(pair_restitutions(config).min()) if config.species else c.restitution
             t_ss = float(theory.driven_temperature(h, eps_ss, n, d, sigma, m))
         else:
             t_ss, _, eps_ss = theory.viscoelastic_driven_state(h, prefactor, n, d, sigma, m, end=c.contact_end)
@@ -390,6 +493,65 @@ def make_driving(config: RunConfig, prefactor: float | None, state: State):
             interval = obs_dt / math.ceil(obs_dt / interval * (1.0 - 1e-12))
     params = {"model": drv.model, "heating_rate": h, "interval": interval, "seed": s.seed}
     return WhiteNoise(h, interval, seed=s.seed), params
+
+
+def species_parameters(config: RunConfig) -> dict:
+    """The species of a mixture for the H5MD ``parameters/species`` group: names (in index order),
+    counts, diameters, masses, number fractions, and the material constants each species uses."""
+    d = config.system.dimension
+    sp = config.species
+    out = {"names": [x.name for x in sp], "counts": np.array([x.count for x in sp], dtype=np.int64),
+           "diameters": np.array([x.diameter for x in sp]), "masses": np.array([x.particle_mass(d) for x in sp]),
+           "fractions": species_fractions(config),
+           "description": "species i is particles/all/species == i; pair tables (S, S) in the same order"}
+    mat = config.collision.material
+    if mat is not None and config.collision.model == "viscoelastic":
+        for key in ("young_modulus", "poisson_ratio", "dissipation_time"):
+            out[key] = np.array([getattr(x, key) if getattr(x, key) is not None else getattr(mat, key) for x in sp])
+    return out
+
+
+def mixture_of_config(config: RunConfig) -> "theory.mixture.Mixture":
+    """The kinetic theory's view of a mixture config (:class:`granulargas.theory.mixture.Mixture`):
+    species, total number density of ``system.packing_fraction``, the law per pair (constant
+    eps_ij or viscoelastic k_ij), and the Enskog chi_ij at that packing fraction
+    (:func:`contact_values_at`)."""
+    d = config.system.dimension
+    sp = config.species
+    x = species_fractions(config)
+    diam = np.array([s.diameter for s in sp])
+    n = config.system.packing_fraction / float(np.sum(x * particle_volume(diam, d)))
+    c = config.collision
+    eps = pair_restitutions(config) if c.model == "constant" else None
+    k = pair_prefactors(config) if c.model == "viscoelastic" else None
+    as_tuple = lambda a: None if a is None else tuple(tuple(float(v) for v in row) for row in a)  # noqa: E731
+    return theory.mixture.Mixture(
+        names=config.species_names, masses=tuple(s.particle_mass(d) for s in sp), diameters=tuple(diam.tolist()),
+        counts=tuple(s.count for s in sp), dimension=d, number_density=float(n), restitution=as_tuple(eps),
+        prefactor=as_tuple(k), end=c.contact_end,
+        chi=as_tuple(contact_values_at(diam, x * n, config.system.packing_fraction, d)))
+
+
+def contact_values_at(diameters, densities, packing: float, dimension: int) -> np.ndarray:
+    """chi_ij (S, S) of species of ``diameters`` at number ``densities``: the one-component contact
+    value (:func:`granulargas.theory.contact_value`) for every pair when the species have one
+    diameter (so that a mixture of identical species is the one-component gas), else the
+    mixture's (:func:`granulargas.theory.mixture.mixture_contact_values`)."""
+    diam = np.asarray(diameters, dtype=float)
+    size = diam.size
+    if np.all(diam == diam[0]):
+        return np.full((size, size), float(theory.contact_value(packing, dimension)))
+    return theory.mixture.mixture_contact_values(diam, np.asarray(densities, dtype=float), dimension)
+
+
+def mixture_contact_values(config: RunConfig, state: State) -> np.ndarray:
+    """chi_ij (S, S) of a mixture's DSMC at the state's packing fraction (:func:`contact_values_at`)."""
+    d = config.system.dimension
+    diam = np.array([sp.diameter for sp in config.species])
+    volume = float(np.prod(state.box))
+    packing = float(particle_volume(2.0 * state.radii, d).sum() / volume)
+    counts = np.array([sp.count for sp in config.species], dtype=float)
+    return contact_values_at(diam, counts / volume, packing, d)
 
 
 def initial_state(config: RunConfig) -> State:
@@ -433,6 +595,15 @@ def prepare(config: RunConfig) -> Setup:
             "description": "DSMC of the homogeneous Enskog-Boltzmann equation (granulargas.dsmc): no positions; "
                            "chi = theory.contact_value(packing_fraction)",
         }
+    if config.species:
+        parameters["species"] = species_parameters(config)
+        if config.run.method == "dsmc":
+            chi = mixture_contact_values(config, state)
+            parameters["dsmc"]["chi_pairs"] = chi
+            parameters["dsmc"]["description"] = (
+                "DSMC of the homogeneous Enskog-Boltzmann equation of a mixture (granulargas.dsmc): no positions; "
+                "chi_pairs = theory.mixture.mixture_contact_values (BGHLM in 3D, Jenkins-Mancini in 2D; one size: "
+                "theory.contact_value)")
     if config.collision.material is not None:
         m = config.collision.material
         parameters["units_si"] = {"length_m": m.diameter, "mass_kg": reference_mass_si(m),

@@ -36,7 +36,7 @@ import numpy as np
 from granulargas import __version__, theory
 from granulargas.dsmc import DSMC
 from granulargas.io.h5md import H5MDWriter
-from granulargas.observables import sonine_coefficients
+from granulargas.observables import sonine_coefficients, species_moments
 from granulargas.state import State
 
 __all__ = ["RunWriter", "run_parameters", "rule_parameters", "observables"]
@@ -50,6 +50,12 @@ def rule_parameters(rule) -> dict:
     """``parameters/collision`` of a :class:`granulargas.engine.CollisionRule`: what the analysis
     needs to compare the run with kinetic theory (as ``granulargas run`` records it)."""
     out = {"model": rule.kind}
+    if rule.pairs is not None:  # a mixture: the law per pair of species
+        tables = rule.pairs.arrays()
+        if rule.kind == "constant":
+            out.update(restitution_pairs=tables["restitution"], wall_restitution=tables["wall_restitution"])
+        elif rule.kind == "viscoelastic":
+            out["prefactor_pairs"] = tables["prefactor"]
     if rule.kind == "constant":
         out.update(restitution=float(rule.restitution), tc_time=rule.tc_time,
                    wall_restitution=rule.wall_restitution)
@@ -121,7 +127,25 @@ def run_parameters(sim) -> dict:
                           "interval": float(drv.interval), "seed": int(drv.seed)}
     if _is_dsmc(sim):
         out["dsmc"] = {"chi": float(sim.chi), "number_density": float(radii.shape[0] / float(sim.volume))}
+        if sim.chi_pairs is not None:
+            out["dsmc"]["chi_pairs"] = np.asarray(sim.chi_pairs)
+    if sim.rule.species:
+        out["species"] = species_parameters(sim, d)
     return out
+
+
+def species_parameters(sim, dimension: int) -> dict:
+    """``parameters/species`` of a mixture built in Python: the species are named by their index
+    ("0", "1", ...); counts, and diameter and mass of each (those of its first particle)."""
+    size = sim.rule.species
+    of = sim.species
+    of = np.zeros(sim.n, dtype=np.int64) if of is None else np.asarray(of)
+    counts = np.bincount(of, minlength=size)
+    first = [int(np.flatnonzero(of == s)[0]) if counts[s] else 0 for s in range(size)]
+    radii, masses = np.asarray(sim.radii), np.asarray(sim.masses)
+    return {"names": [str(s) for s in range(size)], "counts": counts.astype(np.int64),
+            "diameters": 2.0 * radii[first], "masses": masses[first], "fractions": counts / counts.sum(),
+            "description": "species i is particles/all/species == i (a run built in Python)"}
 
 
 def observables(sim, pressure: bool) -> dict:
@@ -135,7 +159,8 @@ def observables(sim, pressure: bool) -> dict:
         a2, a3 = sim.sonine_a2, sim.sonine_a3
         driven = {} if sim.driving is None else {"injected_energy": float(sim.injected_energy),
                                                   "kick_step": int(sim.kick_step)}
-        return {**driven, "temperature": float(sim.temperature), "kinetic_energy": float(sim.kinetic_energy),
+        return {**driven, **species_observables(sim),
+                "temperature": float(sim.temperature), "kinetic_energy": float(sim.kinetic_energy),
                 "collisions": int(sim.collisions), "events": int(sim.candidates),
                 "dissipated_energy": float(sim.dissipated_energy),
                 "momentum": np.asarray(sim.momentum, dtype=np.float64), "sonine_a2": float(a2),
@@ -160,7 +185,22 @@ def observables(sim, pressure: bool) -> dict:
         out["kick_step"] = int(sim.kick_step)
     if sim.rule.resolved:
         out["three_body_contacts"] = int(sim.three_body_contacts)
+    out.update(species_observables(sim))
     return out
+
+
+def species_observables(sim) -> dict:
+    """The observables of a mixture (its rule has a pair table; else none): the temperature
+    and a2 of each species (:func:`granulargas.observables.species_moments`) and the collisions
+    per pair of species so far."""
+    size = sim.rule.species
+    if not size:
+        return {}
+    of = sim.species
+    of = np.zeros(sim.n, dtype=np.int32) if of is None else of
+    temperature, a2 = species_moments(sim.velocities, sim.masses, of, size)
+    return {"species_temperature": temperature, "species_sonine_a2": a2,
+            "species_collisions": np.asarray(sim.species_collisions, dtype=np.int64)}
 
 
 class RunWriter:
@@ -182,7 +222,7 @@ class RunWriter:
         self.dsmc = _is_dsmc(sim)
         params = {**run_parameters(sim), **(parameters or {})}
         self.writer = H5MDWriter(path, _state(sim), fields=_fields(sim), parameters=params, overwrite=overwrite,
-                                 driven=sim.driving is not None)
+                                 driven=sim.driving is not None, species=sim.rule.species)
         self.path = self.writer.path
         self._last_sample = None
         try:

@@ -527,7 +527,7 @@ def _open_writer(config: RunConfig, setup, st, sim, path, append: bool, overwrit
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None)
+                            driven=sim.driving is not None, species=setup.rule.species)
     try:
         if stop is not None:
             stop.arm()

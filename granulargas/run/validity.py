@@ -75,18 +75,19 @@ Runner API (one line each, for the run summary)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from granulargas import theory
 from granulargas.contact import restitution_table
-from granulargas.contact.material import damping_from_prefactor, rho_from_material
+from granulargas.contact.material import damping_from_prefactor, effective_modulus, rho_from_material
 from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX
 from granulargas.io.scene import Scene
 from granulargas.theory.moments import speed_quadrature
-from granulargas.run.prepare import mean_particle, reduced_prefactor
+from granulargas.run.prepare import (mean_particle, mean_restitution, mixture_of_config, pair_weights, reduced_prefactor,
+                                     species_fractions)
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -146,9 +147,12 @@ class RunGas(Gas):
 def mean_particle_volume(config) -> float:
     """Mean volume of the config's particles: that of the diameter for identical ones; for
     diameters uniform in [a, b], ``<sigma^d> = (b^(d+1) - a^(d+1)) / ((d + 1)(b - a))`` times
-    the volume prefactor."""
+    the volume prefactor; a mixture's: the mean over its species."""
     s, p = config.system, config.particles
     d = s.dimension
+    if config.species:  # a mixture: the number-weighted mean of its species' volumes
+        x = species_fractions(config)
+        return float(np.dot(x, theory.particle_volume(np.array([sp.diameter for sp in config.species]), d)))
     if not p.polydisperse or p.diameter_max <= p.diameter_min:
         return float(theory.particle_volume(p.diameter, d))
     a, b = p.diameter_min, p.diameter_max
@@ -162,7 +166,11 @@ def gas_from_config(config) -> RunGas:
     (``system.packing_fraction`` over the mean particle volume, :func:`mean_particle_volume`;
     the gas's packing fraction is that of mean-diameter particles at that density, as
     ``granulargas analyze`` takes it), the reduced prefactor
-    (:func:`granulargas.run.prepare.reduced_prefactor`), the stop conditions."""
+    (:func:`granulargas.run.prepare.reduced_prefactor`), the stop conditions. A mixture is
+    checked as the one-component gas of its mean particle, mean restitution
+    (:func:`granulargas.run.prepare.mean_restitution`) and mean prefactor: the run checks need
+    its temperature range and collision times, which that gas gives to within the spread of
+    the species' temperatures."""
     s, c = config.system, config.collision
     d = s.dimension
     sigma, mass = mean_particle(config)
@@ -170,11 +178,26 @@ def gas_from_config(config) -> RunGas:
     density = s.packing_fraction / mean_particle_volume(config)
     return RunGas(
         dimension=d, packing_fraction=float(theory.packing_fraction(density, d, sigma)), density=float(density),
-        sigma=sigma, mass=mass, temperature=config.initial.temperature, model=c.model, restitution=c.restitution,
+        sigma=sigma, mass=mass, temperature=config.initial.temperature, model=c.model,
+        restitution=mean_restitution(config) if c.model == "constant" else c.restitution,
         prefactor=k, end=c.contact_end, end_time=config.run.end_time,
         collisions_per_particle=config.run.collisions_per_particle,
-        tc_time=c.tc_time, material=c.material, source=config.source, duration=c.duration,
+        tc_time=c.tc_time, material=_mean_material(config), source=config.source, duration=c.duration,
     )
+
+
+def _mean_material(config):
+    """``[collision.material]``; a mixture's: the contact stiffness of its mean pair, Y / (1 - nu^2)
+    = sum_ij w_ij 2 Y*_ij (weights :func:`granulargas.run.prepare.pair_weights`, Y* the pair's
+    effective modulus; nu = 0), for the collision times of the mean particle."""
+    m = config.collision.material
+    if m is None or not config.species:
+        return m
+    consts = [(sp.young_modulus or m.young_modulus, sp.poisson_ratio if sp.poisson_ratio is not None
+               else m.poisson_ratio) for sp in config.species]
+    w = pair_weights(config)
+    stiffness = sum(w[i, j] * 2.0 * effective_modulus(*a, *b) for i, a in enumerate(consts) for j, b in enumerate(consts))
+    return replace(m, young_modulus=float(stiffness), poisson_ratio=0.0)
 
 
 # ---------------------------------------------------------------- t_c / t_free
@@ -412,6 +435,8 @@ def check_run(config) -> RunValidity:
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = viscoelastic_cooling(gas)
     t_end, ln_T_end = predicted_end(gas, curve)
+    if not isinstance(config, RunGas) and config.species and gas.model != "elastic":
+        t_end, ln_T_end = _mixture_end(config, gas)
     T_end = math.exp(ln_T_end)
     if curve is not None:
         spread = restitution_spread(gas, gas.temperature, max(T_end, 1e-300))
@@ -446,6 +471,14 @@ def check_run(config) -> RunValidity:
         if clock:
             rv.errors.append(clock)
     return rv
+
+
+def _mixture_end(config, gas) -> tuple[float, float]:
+    """(t_end, ln T_end) of a mixture: its own Maxwellian theory, every species cooling at its
+    rate (:meth:`granulargas.theory.mixture.Mixture.predicted_end`); T = sum x_i T_i."""
+    mix = mixture_of_config(config)
+    t_end, temps = mix.predicted_end(gas.temperature, gas.end_time, gas.collisions_per_particle)
+    return float(t_end), math.log(float(mix.fractions @ temps))
 
 
 def _clock_error(gas, t_end: float, ln_T_end: float, key: str) -> str | None:

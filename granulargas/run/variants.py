@@ -10,7 +10,8 @@ line a run prints before it compiles it), the tiny run that compiles it, and
 which runs use it. What does *not* make a variant: the dimension (2D runs use the
 3D kernels with z = 0), the collision rule (elastic, constant, viscoelastic and
 the TC model share one loop), walls and polydispersity (run-time data), the
-numbers of particles and of snapshots.
+numbers of particles and of snapshots. Species do (``[[species]]``: the loops with the
+law per pair of species).
 
 A feature that adds a compiled variant adds one entry here: its tiny config (the
 keys that select it, on top of :data:`TINY`), the variants it builds on
@@ -44,24 +45,29 @@ _MATERIAL = {
 }
 _DRIVEN = {"driving.model": "white_noise", "driving.heating_rate": 0.005}
 _DSMC = {"run.method": "dsmc", "system.particles": 256}
+#: a mixture: two species, the law per pair of species (the loops compiled with the species record)
+_MIXTURE = {"species": [{"name": "a", "fraction": 0.5}, {"name": "b", "fraction": 0.5, "diameter": 0.8}],
+            "collision.damping": {"a-a": 0.1, "a-b": 0.1, "b-b": 0.1}}
 
 
 def _placement(config: RunConfig) -> bool:
     return config.run.method == "edmd" and not config.initial.from_file
 
 
-def _engine(mode: str, resolved: bool = False, driven: bool = False) -> Callable[[RunConfig, str], bool]:
+def _engine(mode: str, resolved: bool = False, driven: bool = False,
+            mixture: bool = False) -> Callable[[RunConfig, str], bool]:
     """Runs of the event-driven engine in neighbour mode ``mode`` (with collisions that take
-    time: ``resolved``; ``driven``: the driven ones only)."""
+    time: ``resolved``; ``driven``: the driven ones only; ``mixture``: those with species)."""
     def uses(config: RunConfig, neighbours: str) -> bool:
         return (config.run.method == "edmd" and neighbours == mode
                 and (config.collision.duration == "resolved") == resolved
-                and (config.driving is not None or not driven))
+                and (config.driving is not None or not driven) and bool(config.species) == mixture)
     return uses
 
 
-def _dsmc(driven: bool = False) -> Callable[[RunConfig, str], bool]:
-    return lambda config, neighbours: config.run.method == "dsmc" and (config.driving is not None or not driven)
+def _dsmc(driven: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
+    return lambda config, neighbours: (config.run.method == "dsmc" and (config.driving is not None or not driven)
+                                       and bool(config.species) == mixture)
 
 
 @dataclass(frozen=True)
@@ -120,6 +126,17 @@ VARIANTS = (
             _engine("lists", resolved=True, driven=True), after=("resolved",)),
     Variant("dsmc", "the DSMC", _DSMC, _dsmc()),
     Variant("dsmc-driven", "its driving step", {**_DSMC, **_DRIVEN}, _dsmc(driven=True), after=("dsmc",)),
+    Variant("lists-mixture", "the neighbour-list engine of mixtures", {"run.neighbours": "lists", **_MIXTURE},
+            _engine("lists", mixture=True), after=("placement", "lists")),
+    Variant("cells-mixture", "the cell-crossing engine of mixtures", {"run.neighbours": "cells", **_MIXTURE},
+            _engine("cells", mixture=True), after=("placement", "cells")),
+    Variant("lists-mixture-driven", "its driving step", {"run.neighbours": "lists", **_MIXTURE, **_DRIVEN},
+            _engine("lists", driven=True, mixture=True), after=("lists-mixture",)),
+    Variant("cells-mixture-driven", "its driving step", {"run.neighbours": "cells", **_MIXTURE, **_DRIVEN},
+            _engine("cells", driven=True, mixture=True), after=("cells-mixture",)),
+    Variant("dsmc-mixture", "the DSMC of mixtures", {**_DSMC, **_MIXTURE}, _dsmc(mixture=True), after=("dsmc",)),
+    Variant("dsmc-mixture-driven", "its driving step", {**_DSMC, **_MIXTURE, **_DRIVEN},
+            _dsmc(driven=True, mixture=True), after=("dsmc-mixture",)),
 )
 BY_NAME = {v.name: v for v in VARIANTS}
 
@@ -152,6 +169,7 @@ def describe(variants) -> str:
 def tiny_config(variant: Variant, directory) -> RunConfig:
     """The tiny run that compiles ``variant`` (its output file in ``directory``)."""
     keys = {**TINY, **variant.config, "output.file": str(Path(directory) / f"{variant.name}.h5")}
+    species = keys.pop("species", [])
     sections: dict[str, dict] = {}
     for key, value in keys.items():
         if value is None:
@@ -161,5 +179,15 @@ def tiny_config(variant: Variant, directory) -> RunConfig:
     text = []
     for section, values in sections.items():
         text.append(f"[{section}]")
-        text += [f"{name} = {json.dumps(value)}" for name, value in values.items()]
+        text += [f"{name} = {_toml(value)}" for name, value in values.items()]
+    for table in species:
+        text.append("[[species]]")
+        text += [f"{name} = {_toml(value)}" for name, value in table.items()]
     return parse_config("\n".join(text) + "\n", source=f"<{variant.name}>")
+
+
+def _toml(value) -> str:
+    """A value of a tiny config as TOML (inline tables for dicts)."""
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{json.dumps(k)} = {_toml(v)}" for k, v in value.items()) + " }"
+    return json.dumps(value)

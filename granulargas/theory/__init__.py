@@ -13,10 +13,13 @@ import theory; theory.haff_tau0(...)``):
   impact speeds, the spread of eps, the cooling curve, the instability length of
   a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there);
 * :mod:`~granulargas.theory.driven` -- the white-noise driven steady state
-  (temperature, a2, kick interval; viscoelastic: effective restitution).
+  (temperature, a2, kick interval; viscoelastic: effective restitution);
+* :mod:`~granulargas.theory.mixture` -- mixtures of species: cooling rates and the
+  temperature of each species in the homogeneous cooling and the driven states
+  (Garzó & Dufty 1999), contact values of a mixture (import it from there).
 """
 
-from granulargas.theory import driven, enskog, gas, viscoelastic  # noqa: F401
+from granulargas.theory import driven, enskog, gas, mixture, viscoelastic  # noqa: F401
 from granulargas.theory.driven import *  # noqa: F401,F403
 from granulargas.theory.enskog import *  # noqa: F401,F403
 from granulargas.theory.viscoelastic import *  # noqa: F401,F403

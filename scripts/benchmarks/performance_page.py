@@ -185,6 +185,16 @@ def block_initial(data):
     return t.markdown()
 
 
+def block_scene_costs(data):
+    t = Table(["scene", "against", "d", "N", "packing", "neighbours", "CPU per collision, ratio", "rounds"],
+              ["---", "---", "--:", "--:", "--:", "---", "--:", "--:"])
+    for r in sorted(by_table(data, "scene_cost"), key=lambda r: (r["scene"], r["n"], r["packing"])):
+        spread = f" ({fmt(r['quartiles'])})" if r.get("quartiles") else ""
+        t.add([r["scene"], r["reference"], str(r["dim"]), str(r["n"]), fmt(r["packing"]), r["neighbours"],
+               f"**×{r['ratio']:.2f}**{spread}", str(r["rounds"])], r)
+    return t.markdown()
+
+
 def block_dsmc(data):
     t = Table(["d", "N", "DSMC, M collisions/s (CPU)", "acceptance", "engine at packing 0.02", "engine at 0.3",
                "DSMC / engine at 0.02", "at 0.3"], ["--:", "--:", "--:", "--:", "--:", "--:", "--:", "--:"])

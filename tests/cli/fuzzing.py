@@ -70,6 +70,25 @@ BASES = {
         "run": {"end_time": 0.5},
         "output": {"file": "out.h5", "snapshots": 2},
     },
+    "mixture-3d": {
+        "species": [{"name": "big", "count": 24, "diameter": 1.3, "mass": 3.0},
+                    {"name": "small", "count": 40, "diameter": 0.8, "density": 2.0}],
+        "system": {"dimension": 3, "packing_fraction": 0.1, "seed": 6},
+        "collision": {"model": "constant", "restitution": {"big-big": 0.9, "big-small": 0.8, "small-small": 0.85}},
+        "run": {"end_time": 1.0},
+        "output": dict(_OUTPUT),
+    },
+    "mixture-material-dsmc-2d": {
+        "species": [{"name": "glass", "fraction": 0.6, "young_modulus": 6.3e10, "poisson_ratio": 0.24,
+                     "dissipation_time": 2e-9},
+                    {"name": "steel", "fraction": 0.4, "diameter": 0.9, "density": 3.1, "young_modulus": 2.1e11,
+                     "poisson_ratio": 0.29, "dissipation_time": 1e-9}],
+        "system": {"dimension": 2, "particles": 100, "packing_fraction": 0.05, "seed": 7},
+        "collision": {"model": "viscoelastic",
+                      "material": {"diameter": 0.001, "density": 2500.0, "speed_unit": 0.5}},
+        "run": {"collisions_per_particle": 2.0, "method": "dsmc"},
+        "output": {"file": "out.h5", "snapshots": 3},
+    },
 }
 
 #: values the brief of the fuzz tests names, and neighbours of them
@@ -125,7 +144,22 @@ def _paths(doc: dict, prefix=()) -> list[tuple]:
         out.append(prefix + (key,))
         if isinstance(value, dict):
             out += _paths(value, prefix + (key,))
+        elif isinstance(value, list) and value and all(isinstance(x, dict) for x in value):  # [[species]]
+            for k, item in enumerate(value):
+                out.append(prefix + (key, k))
+                out += _paths(item, prefix + (key, k))
     return out
+
+
+def _override_key(doc: dict, path: tuple) -> str | None:
+    """The ``--set`` key of a path (a species' key by the species' name), or None if it has none."""
+    if len(path) > 1 and isinstance(path[1], int):
+        item = _get(doc, path[:2])
+        name = item.get("name") if isinstance(item, dict) else None
+        if len(path) != 3 or not isinstance(name, str) or not name or any(c in name for c in ".=\"\\ "):
+            return None
+        return f"{path[0]}.{name}.{path[2]}"
+    return ".".join(map(str, path))
 
 
 @dataclass
@@ -207,9 +241,10 @@ def mutated_config(draw, bases=tuple(BASES)):
             m = Mutation("set", (draw(st.sampled_from(["sytem", "runs", "outputs", "extra"])),),
                          {draw(_KEY_NAMES): draw(_toml_values(0))})
         # a set of a key two levels deep or less may go through --set instead of the file
-        if m.kind == "set" and 2 <= len(m.path) <= 3 and not isinstance(m.value, dict) and draw(st.booleans()):
+        key = _override_key(doc, m.path) if m.kind == "set" else None
+        if key is not None and 2 <= len(m.path) <= 3 and not isinstance(m.value, dict) and draw(st.booleans()):
             m.as_override = True
-            overrides.append(f"{'.'.join(m.path)}={_value(m.value)}")
+            overrides.append(f"{key}={_value(m.value)}")
         else:
             _apply(doc, m)
         done.append(m)
@@ -224,11 +259,12 @@ def _plausible(draw, doc, paths):
     except ImportError:
         return None
     keys = {tuple(k.dotted.split(".")): k for k in config_schema()}
-    known = [p for p in paths if p in keys and keys[p].type != "table"]
+    schema_path = lambda p: (p[0], p[2]) if len(p) == 3 and isinstance(p[1], int) else p  # noqa: E731
+    known = [p for p in paths if schema_path(p) in keys and keys[schema_path(p)].type != "table"]
     if not known:
         return None
     path = draw(st.sampled_from(known))
-    key, old = keys[path], _get(doc, path)
+    key, old = keys[schema_path(path)], _get(doc, path)
     if key.choices is not None:
         return Mutation("set", path, draw(st.sampled_from(list(key.choices))))
     if key.type == "string" or isinstance(old, (dict, str, bool)) or not isinstance(old, (int, float)):
@@ -259,11 +295,19 @@ def _get(doc, path):
 def _apply(doc, m: Mutation):
     node = doc
     for part in m.path[:-1]:
+        if isinstance(node, list):  # an entry of an array of tables
+            node = node[part]
+            continue
         nxt = node.get(part)
-        if not isinstance(nxt, dict):
+        if not isinstance(nxt, (dict, list)) or (isinstance(nxt, list) and not all(isinstance(x, dict) for x in nxt)):
             nxt = node[part] = {}
         node = nxt
-    if m.kind == "drop":
+    if isinstance(node, list):  # a whole entry of an array of tables
+        if m.kind == "drop":
+            del node[m.path[-1]]
+        else:
+            node[m.path[-1]] = m.value
+    elif m.kind == "drop":
         node.pop(m.path[-1], None)
     else:
         node[m.path[-1]] = m.value
@@ -426,7 +470,7 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
     return Outcome(code, out.getvalue(), err.getvalue(), time.perf_counter() - start, fired.is_set(), exc)
 
 
-KEY_RE = re.compile(r"\b(system|particles|initial|collision|run|output)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
+KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|run|output|species)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
 
 
 def check_outcome(o: Outcome, before: dict, after: dict, *, output_made: bool = True, long_runs: bool = False):

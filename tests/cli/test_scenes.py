@@ -45,6 +45,8 @@ EXAMPLES = {
     "clustering_2d_constant": ({"system.particles": 2000, "run.end_time": 20.0}, ("edmd", "cooling")),
     "clustering_2d_viscoelastic": ({"system.particles": 1000, "run.end_time": 100.0,
                                     "output.first_snapshot": 0.5}, ("edmd", "cooling")),
+    "mixture_hcs_3d": ({"system.particles": 20000, "run.collisions_per_particle": 30}, ("dsmc", "cooling")),
+    "glass_steel_3d": ({"system.particles": 1000, "run.collisions_per_particle": 20}, ("edmd", "cooling")),
 }
 
 

@@ -55,3 +55,39 @@ def test_validity_range_warns_outside():
     with pytest.warns(material.ContactValidityWarning, match="speed of sound"):
         assert not material.check_validity(impact_speed=500.0, speed_of_sound=2000.0)
     assert len(material.validity_problems(beta=3.0, impact_speed=500.0, speed_of_sound=2000.0)) == 2
+
+
+# --- two materials in contact (mixtures)
+
+GLASS = (6.3e10, 0.24, 2.0e-9)
+STEEL = (2.1e11, 0.29, 1.0e-9)
+
+
+def test_one_material_pair_is_the_material_prefactor_exactly():
+    assert material.pair_prefactor_from_materials(*GLASS, *GLASS) == material.prefactor_from_material(*GLASS)
+    y, nu, a = GLASS
+    assert material.effective_modulus(y, nu, y, nu) == pytest.approx(y / (2 * (1 - nu**2)), rel=1e-15)
+    assert material.pair_dissipation_time(y, nu, a, y, nu, a) == pytest.approx(a, rel=1e-15)
+    # the general expression agrees with the one-material prefactor to rounding
+    k = 1.5 * a * (4.0 * material.effective_modulus(y, nu, y, nu) / 3.0) ** 0.4
+    assert k == pytest.approx(material.prefactor_from_material(*GLASS), rel=1e-14)
+
+
+def test_two_materials_pair_is_symmetric_and_between_the_two():
+    k_gs = material.pair_prefactor_from_materials(*GLASS, *STEEL)
+    assert k_gs == material.pair_prefactor_from_materials(*STEEL, *GLASS)
+    # Y* of glass on steel: 1 / ((1 - 0.24^2)/6.3e10 + (1 - 0.29^2)/2.1e11) = 4.8e10 Pa
+    assert material.effective_modulus(6.3e10, 0.24, 2.1e11, 0.29) == pytest.approx(
+        1.0 / ((1 - 0.24**2) / 6.3e10 + (1 - 0.29**2) / 2.1e11), rel=1e-15)
+    a = material.pair_dissipation_time(*GLASS, *STEEL)
+    assert STEEL[2] < a < GLASS[2]
+    # the softer glass takes most of the compression: its A weighs more
+    assert a > 0.5 * (GLASS[2] + STEEL[2])
+
+
+def test_rigid_partner_limit():
+    """Against a body that does not deform (Y_j -> inf) the contact is the first material's
+    against a rigid plane: Y* = Y_i / (1 - nu_i^2) and A_ij = A_i."""
+    y, nu, a = GLASS
+    assert material.effective_modulus(y, nu, 1e300, 0.3) == pytest.approx(y / (1 - nu**2), rel=1e-12)
+    assert material.pair_dissipation_time(y, nu, a, 1e300, 0.3, 5e-9) == pytest.approx(a, rel=1e-12)

@@ -274,3 +274,73 @@ def test_polydisperse_equal_masses_is_one_type(tmp_path):
     assert data["types"] == 1
     np.testing.assert_allclose(data["Atoms"][:, 2], 2 * fresh_state(config).radii, rtol=1e-15)
     assert data["Atoms"][:, 2].std() > 0.05
+
+
+GLASS_STEEL = """
+[system]
+dimension = 3
+packing_fraction = 0.1
+seed = 5
+
+[[species]]
+name = "glass"
+count = 70
+young_modulus = 6.3e10
+poisson_ratio = 0.24
+dissipation_time = 1e-7
+
+[[species]]
+name = "steel"
+count = 50
+diameter = 0.8
+material_density = 7800
+young_modulus = 2.1e11
+poisson_ratio = 0.29
+dissipation_time = 5e-8
+
+[collision]
+model = "viscoelastic"
+
+[collision.material]
+diameter = 1e-3
+density = 2500
+speed_unit = 1.0
+
+[run]
+end_time = 0.2
+"""
+
+
+@pytest.mark.parametrize("stiffness", ["contact_fraction", "material"])
+def test_export_of_a_mixture_has_a_type_and_a_contact_per_species(tmp_path, stiffness):
+    """Species are atom types; each pair of types has its own contact: the pair's prefactor k_ij
+    (read back from E, eta_n0, nu of its pair_coeff line), and on the material route the pair's
+    effective modulus 1/Y* = (1 - nu_i^2)/Y_i + (1 - nu_j^2)/Y_j (E / (1 - nu^2) = 2 Y*)."""
+    from granulargas.contact.material import effective_modulus
+    from granulargas.run.prepare import pair_prefactors, reference_mass_si
+
+    config = parse_config(GLASS_STEEL)
+    fraction = 0.02 if stiffness == "contact_fraction" else None
+    ex = export_lammps(config, tmp_path, contact_fraction=fraction)
+    data = read_data_file(ex.data_file)
+    assert data["types"] == 2
+    np.testing.assert_array_equal(data["Atoms"][:, 1], [1] * 70 + [2] * 50)
+    cmds = read_input(ex.input_file)
+    steel_mass = 7800 / 2500 * 0.8**3
+    assert cmds["set"] == [["type", "1", "mass", "1"], ["type", "2", "mass", repr(steel_mass)]]
+    masses = {1: 1.0, 2: steel_mass}
+    k = pair_prefactors(config)
+    m = config.collision.material
+    unit = m.diameter**3 / (reference_mass_si(m) * m.speed_unit**2)
+    consts = {1: (6.3e10, 0.24), 2: (2.1e11, 0.29)}
+    for pc in cmds["pair_coeff"]:
+        i, j = int(pc[0]), int(pc[1])
+        Y, eta_n0, nu = float(pc[3]), float(pc[4]), float(pc[5])
+        m_eff = masses[i] * masses[j] / (masses[i] + masses[j])
+        A = eta_n0 * m_eff * (1 - nu**2) / Y  # eta_n0 = A Y / ((1 - nu^2) m_eff)
+        k_back = 1.5 * A * (2 * Y / (3 * (1 - nu**2))) ** 0.4
+        assert k_back == pytest.approx(k[i - 1, j - 1], rel=1e-12)
+        if stiffness == "material":
+            y_star = effective_modulus(*consts[i], *consts[j]) * unit
+            assert Y / (1 - nu**2) == pytest.approx(2 * y_star, rel=1e-12)
+    assert len(cmds["pair_coeff"]) == 3

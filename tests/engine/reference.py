@@ -136,15 +136,41 @@ def collide_resolved(pos, vel, radii, masses, box, i, j, rule):
     return out.duration
 
 
-def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None, rule=None):
+def pair_restitution(eps, species, i, j, un, radii, masses):
+    """eps of a collision of i and j: ``eps`` one number, a table (S, S) indexed by the two
+    particles' ``species``, or a function ``eps(s_i, s_j, g_n, r_eff, m_eff)``."""
+    si, sj = (0, 0) if species is None else (int(species[i]), int(species[j]))
+    if callable(eps):
+        r_eff = radii[i] * radii[j] / (radii[i] + radii[j])
+        m_eff = masses[i] * masses[j] / (masses[i] + masses[j])
+        return float(eps(si, sj, abs(un), r_eff, m_eff))
+    return float(eps) if np.ndim(eps) == 0 else float(np.asarray(eps)[si, sj])
+
+
+def wall_restitution(wall_eps, species, i, vn, radii, masses):
+    """eps of particle i against a wall: one number, one per species, or a function
+    ``wall_eps(s_i, |v_n|, R_i, m_i)``."""
+    si = 0 if species is None else int(species[i])
+    if callable(wall_eps):
+        return float(wall_eps(si, abs(vn), radii[i], masses[i]))
+    return float(wall_eps) if np.ndim(wall_eps) == 0 else float(np.asarray(wall_eps)[si])
+
+
+def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None, rule=None,
+                  species=None):
     """Event sequence [(time, i, j)] of the first ``ncoll`` events, global clock; a wall
     collision of particle i with a wall of axis a appears as (time, i, -1 - a).
 
     ``rule``: a resolved CollisionRule (collisions that take time; no walls): a pair in
-    contact is not predicted until its contact ends."""
+    contact is not predicted until its contact ends.
+    ``species`` (N,) ints: a mixture; ``eps`` is then a table (S, S) or a function of the
+    pair (:func:`pair_restitution`), ``wall_eps`` one per species (:func:`wall_restitution`)."""
     pos = pos.copy()
     vel = vel.copy()
-    wall_eps = eps if wall_eps is None else wall_eps
+    if wall_eps is None:
+        wall_eps = eps if species is None else (
+            np.diagonal(np.asarray(eps)) if not callable(eps) else
+            (lambda s, g, r, m: eps(s, s, g, r, m)))
     t = 0.0
     out = []
     n = len(pos)
@@ -174,9 +200,15 @@ def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_e
                 pos[:, a] %= box[a]
         t += dt
         if kind == "pair":
-            collide(pos, vel, radii, masses, box, i, j, eps, walls)
+            dr = pos[i] - pos[j]
+            for a in range(len(box)):
+                if a not in walls:
+                    dr[a] -= box[a] * np.round(dr[a] / box[a])
+            un = float(np.dot(vel[i] - vel[j], dr / np.linalg.norm(dr)))
+            e = pair_restitution(eps, species, i, j, un, radii, masses)
+            collide(pos, vel, radii, masses, box, i, j, e, walls)
             out.append((t, min(i, j), max(i, j)))
         else:
-            bounce(vel, i, j, wall_eps)
+            bounce(vel, i, j, wall_restitution(wall_eps, species, i, vel[i, j], radii, masses))
             out.append((t, i, -1 - j))
     return out, pos, vel

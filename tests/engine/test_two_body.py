@@ -103,3 +103,19 @@ def test_overlapping_receding_pair_is_left_alone():
     sim = two_spheres([1.0, 2, 2], [1.0 + 1.0 - 1e-10, 2, 2], [-0.1, 0, 0], [0.1, 0, 0], box=6.0)
     sim.run(2.0)  # next meeting across the boundary: gap 6 - 2 = 4 at speed 0.2 -> t = 20
     assert sim.collisions == 0
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_small_box_keeps_three_cells_per_side(d):
+    """A shell cut to fit three cells per side (box 10, diameters ~0.99): L / cut must not round
+    to just below 3, which would leave two cells per side and a pair unseen (the engine once
+    found this head-on collision only after thousands of time units, through the images)."""
+    ri, rj, g, theta = 0.498126803435622, 0.49335244643445886, 0.4519051153908879, 0.5055283632726897
+    n = np.array([math.sin(theta), math.cos(theta)] + [0.0] * (d - 2))
+    centre = np.full(d, 5.0)
+    rij = (ri + rj + 0.1) * n
+    sim = two_spheres(centre + 0.5 * rij, centre - 0.5 * rij, -0.5 * g * n, 0.5 * g * n, box=10.0,
+                      radii=(ri, rj), masses=(1.0001, 7.3))
+    assert sim.shell < sim.box.min() / 3.0 - 2 * ri
+    sim.run(np.inf, max_collisions=1)
+    assert sim.time == pytest.approx(0.1 / g, rel=1e-12)

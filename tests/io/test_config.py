@@ -105,7 +105,7 @@ BAD = [
     ("[system]\ndimension = 2\npacking_fraction = 0.95", "system.packing_fraction = 0.95: must be a number in (0, 0.9069) (below the densest packing of spheres / disks in 2D)"),
     ("[system]\npacking_fraction = 0", "system.packing_fraction = 0: must be a number in (0,"),
     ("[system]\nsede = 1", "system.sede = 1: unknown key; did you mean `seed`?"),
-    ("[sytem]\nseed = 1", "[sytem]: unknown section (allowed: [system], [particles], [initial], [collision], [driving], [run], [output]); did you mean [system]?"),
+    ("[sytem]\nseed = 1", "[sytem]: unknown section (allowed: [system], [particles], [initial], [collision], [driving], [run], [output], [[species]]); did you mean [system]?"),
     ('[collision]\nmodel = "hertz"', 'collision.model = "hertz": must be one of "elastic", "constant", "viscoelastic"'),
     ('[collision]\nmodel = "constant"\nrestitution = 1.2', "collision.restitution = 1.2: must be a number in (0, 1]"),
     ('[collision]\nmodel = "constant"\nrestitution = 0', "collision.restitution = 0: must be a number in (0, 1]"),

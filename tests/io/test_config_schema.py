@@ -112,7 +112,7 @@ def test_every_key_round_trips_through_to_toml():
     again = parse_config(cfg.to_toml(), "c.toml")
     assert dataclasses.astuple(again)[:6] == dataclasses.astuple(cfg)[:6]
     written = cfg.to_toml()
-    for key in SCHEMA:
+    for key in (k for k in SCHEMA if not k.per_species):  # [[species]]: tests/io/test_config_species.py
         value = None if key.section in c.SUBTABLES else getattr(getattr(cfg, key.section), key.attribute, None)
         if value is not None and "." not in key.key and key.dotted not in c.SUBTABLES:
             assert f"{key.key} = " in written, key.dotted

@@ -178,3 +178,41 @@ def test_dask_gives_identical_results(tmp_path):
         np.testing.assert_array_equal(p, pos)
         np.testing.assert_array_equal(v, vel)
     assert json.loads((tmp_path / "out" / "index.json").read_text())["runs"][0]["status"] == "done"
+
+
+MIXTURE_BASE = """\
+[system]
+dimension = 2
+packing_fraction = 0.2
+[[species]]
+name = "big"
+count = 30
+diameter = 1.2
+[[species]]
+name = "small"
+count = 34
+diameter = 0.8
+[collision]
+model = "constant"
+restitution = { "big-big" = 0.9, "big-small" = 0.8, "small-small" = 0.85 }
+[run]
+end_time = 0.5
+"""
+
+
+def test_a_sweep_varies_a_species_key_and_a_pair_law(tmp_path):
+    from granulargas.io.config import load_config
+
+    (tmp_path / "base.toml").write_text(MIXTURE_BASE)
+    (tmp_path / "out").mkdir()
+    (tmp_path / "s.toml").write_text('base = "base.toml"\noutput_dir = "out"\n[vary]\n'
+                                     'species.big.mass = [2.0, 4.0]\n"collision.restitution.small-big" = [0.7, 0.75]\n')
+    sweep = load_sweep(tmp_path / "s.toml")
+    assert len(sweep.runs) == 4
+    for spec in sweep.runs:
+        cfg = load_config(tmp_path / "base.toml", spec.overrides)
+        assert cfg.species[0].mass == spec.parameters["species.big.mass"]
+        assert cfg.collision.restitution["big-small"] == spec.parameters["collision.restitution.small-big"]
+    (tmp_path / "bad.toml").write_text('base = "base.toml"\noutput_dir = "out"\n[vary]\nspecies.huge.mass = [2.0]\n')
+    with pytest.raises(ConfigError, match="no species named huge"):
+        load_sweep(tmp_path / "bad.toml")

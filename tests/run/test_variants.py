@@ -31,6 +31,8 @@ EXAMPLES = {
     "elastic_3d.toml": ["placement", "lists"],
     "hcs_dsmc_3d.toml": ["dsmc"],
     "clustering_2d_constant.toml": ["placement", "placement-large", "lists"],
+    "mixture_hcs_3d.toml": ["dsmc-mixture"],
+    "glass_steel_3d.toml": ["placement", "cells-mixture"],
 }
 
 
@@ -43,7 +45,8 @@ def test_example_configs_name_the_variants_they_compile(name, expected):
 def test_every_example_config_compiles_a_named_variant():
     for path in (ROOT / "configs").glob("*.toml"):
         names = [v.name for v in variants_for(load_config(path))]
-        assert any(n in ("lists", "cells", "resolved", "dsmc") for n in names), (path.name, names)
+        assert any(n in ("lists", "cells", "resolved", "dsmc", "lists-mixture", "cells-mixture", "dsmc-mixture")
+                   for n in names), (path.name, names)
 
 
 def test_each_variant_tiny_run_selects_it(tmp_path):
