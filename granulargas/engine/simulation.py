@@ -339,9 +339,8 @@ class Simulation:
             want = default_shell(self.packing_fraction, d) if shell is None else float(shell)
         if want <= 0 and self.neighbours == "lists":
             raise ConfigError(f"shell = {want}: must be > 0")
-        # at least 3 cells per side so that the 27 neighbour cells are distinct (the margin keeps
-        # floor(L / cut) at 3 when the shell is cut to fit: L / (L / 3) can round to just below 3)
-        fit = float(bx.min()) / 3.0 * (1.0 - 1e-12) - dmax
+        # at least 3 cells per side so that the 27 neighbour cells are distinct
+        fit = float(bx.min()) / 3.0 - dmax
         if float(bx.min()) < MIN_BOX_DIAMETERS * dmax:
             short = [f"{'xyz'[a]} ({self.boundary[a]})" for a in range(d)
                      if bx[a] < MIN_BOX_DIAMETERS * dmax]
@@ -349,6 +348,12 @@ class Simulation:
                               f">= {MIN_BOX_DIAMETERS * dmax:.4g} ({MIN_BOX_DIAMETERS:g} largest "
                               f"diameters); too short: {', '.join(short)}")
         self.shell = min(want * dmax, fit)
+        # a shell cut to fit: L / (L/3 - dmax + dmax) can round to just below 3 cells, so the
+        # shell steps down by units in the last place until floor(L / cut) is 3
+        for _ in range(64):
+            if self.shell <= 0 or math.floor(float(bx.min()) / (dmax + self.shell)) >= 3:
+                break
+            self.shell = float(np.nextafter(self.shell, 0.0))
         cut = dmax + self.shell
         box3 = np.ones(3)
         box3[:d] = bx

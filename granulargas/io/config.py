@@ -1289,17 +1289,36 @@ def _section_keys(section: str) -> list[str]:
     return list(dict.fromkeys(k.key.split(".")[0] for k in SCHEMA if k.section == section))
 
 
+def _nearest_key(parts: list[str]) -> str | None:
+    """The schema key nearest a dotted key whose section is misspelt: the nearest section,
+    then the nearest key in it (``sytem.particle``: ``system.particles``), else a key of that
+    name in any section, else the section alone."""
+    close = difflib.get_close_matches(parts[0], SECTIONS, n=1, cutoff=0.6)
+    if not close:
+        return None
+    section = close[0]
+    in_section = [k.dotted[len(section) + 1:] for k in SCHEMA if k.section.split(".")[0] == section]
+    key = difflib.get_close_matches(".".join(parts[1:]), in_section, n=1, cutoff=0.6)
+    if key:
+        return f"{section}.{key[0]}"
+    by_name = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA}
+    name = difflib.get_close_matches(parts[-1], list(by_name), n=1, cutoff=0.75)
+    return by_name[name[0]] if name else section
+
+
 def apply_overrides(data: dict, overrides: dict[str, Any], source: str = "<config>") -> set[str]:
     """Set dotted keys in a nested dict in place; return the set of keys set."""
     done = set()
     for dotted, value in overrides.items():
         parts = str(dotted).split(".")
-        if len(parts) < 2 or not all(parts) or parts[0] not in SECTIONS:
-            hint = _suggest(parts[0], SECTIONS) if parts and parts[0] and len(parts) >= 2 else ""
-            raise ConfigError(
-                f"override {dotted} = {_show(value)}: key must be section.key with section one of "
-                f"{', '.join(SECTIONS)}{hint}"
-            )
+        if len(parts) < 2 or not all(parts):
+            raise ConfigError(f"override: {dotted} = {_show(value)}: key must be section.key with section "
+                              f"one of {', '.join(SECTIONS)}")
+        if parts[0] not in SECTIONS:
+            near = _nearest_key(parts)
+            hint = f"; did you mean `{near}`?" if near else ""
+            raise ConfigError(f"override: {dotted} = {_show(value)}: unknown section {parts[0]} (allowed: "
+                              f"{', '.join(SECTIONS)}){hint}")
         node = data
         if parts[0] in ARRAY_SECTIONS:
             node = _species_override(data, parts, dotted, value)
@@ -1307,7 +1326,7 @@ def apply_overrides(data: dict, overrides: dict[str, Any], source: str = "<confi
         for part in parts[:-1]:
             nxt = node.setdefault(part, {})
             if not isinstance(nxt, dict):
-                raise ConfigError(f"override {dotted}: {part} is not a table")
+                raise ConfigError(f"override: {dotted} = {_show(value)}: {part} is not a table")
             node = nxt
         if len(parts) == 3 and parts[0] == "collision" and parts[1] in ("restitution", "damping"):
             a, _, b = parts[2].partition("-")

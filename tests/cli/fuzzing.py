@@ -470,7 +470,10 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
     return Outcome(code, out.getvalue(), err.getvalue(), time.perf_counter() - start, fired.is_set(), exc)
 
 
-KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|run|output|species)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]|\.(toml|h5|png|gsd)\b")
+#: what names a key or a file in a one-line error: a dotted key of a known section, a [section], a
+#: file name, or the key of a ``--set`` override as given (``override: sytem.particle = 0: ...``)
+KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|run|output|species)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]"
+                    r"|\.(toml|h5|png|gsd)\b|^error: override: [^ ]+ = ")
 
 
 def check_outcome(o: Outcome, before: dict, after: dict, *, output_made: bool = True, long_runs: bool = False):

@@ -84,7 +84,7 @@ def test_export_lammps(here, capsys):
 def test_unknown_key_suggests_the_nearest(here, capsys):
     (here / "c.toml").write_text(CONFIG.replace("particles = 64", "partcles = 64"))
     _refused(capsys, ["run", "c.toml"], here, "system.partcles = 64: unknown key; did you mean `particles`?")
-    _refused(capsys, ["run", "c.toml", "--set", "sytem.seed=2"], here, "did you mean `system`?")
+    _refused(capsys, ["run", "c.toml", "--set", "sytem.seed=2"], here, "did you mean `system.seed`?")
     (here / "c.toml").write_text(CONFIG.replace("[run]", "[rnu]"))
     _refused(capsys, ["run", "c.toml"], here, "[rnu]: unknown section")
 

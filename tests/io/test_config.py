@@ -91,6 +91,35 @@ def test_overrides_are_validated_like_file_values():
         parse_config(FULL, "x.toml", overrides={"system.temperature": 3})
 
 
+SECTIONS_ALLOWED = "(allowed: system, particles, initial, collision, driving, run, output)"
+
+
+@pytest.mark.parametrize("dotted, nearest", [
+    ("sytem.particle", "; did you mean `system.particles`?"),  # section and key misspelt
+    ("runs.end_time", "; did you mean `run.end_time`?"),
+    ("collison.material.youngs", "; did you mean `collision.material.young_modulus`?"),  # a sub-table's key
+    ("sytem.temprature", "; did you mean `initial.temperature`?"),  # a key of another section
+    ("sytem.xyz", "; did you mean `system`?"),  # no key near: the section
+    ("extra.particle", ""),  # nothing near
+])
+def test_override_of_an_unknown_section_names_the_key_and_the_nearest(dotted, nearest):
+    message = f"override: {dotted} = 0: unknown section {dotted.split('.')[0]} {SECTIONS_ALLOWED}{nearest}"
+    with pytest.raises(ConfigError) as info:
+        parse_config(FULL, "x.toml", overrides={dotted: 0})
+    assert str(info.value) == message
+
+
+@pytest.mark.parametrize("dotted, message", [
+    ("system", "override: system = 0: key must be section.key with section one of system, particles, "
+               "initial, collision, driving, run, output"),
+    ("system.particles.x", "override: system.particles.x = 0: particles is not a table"),
+])
+def test_override_that_is_no_section_key(dotted, message):
+    with pytest.raises(ConfigError) as info:
+        parse_config(FULL, "x.toml", overrides={dotted: 0})
+    assert str(info.value) == message
+
+
 def test_integer_valued_float_accepted_for_counts():
     c = parse_config(FULL.replace("particles = 10000", "particles = 1e4"), "x.toml")
     assert c.system.particles == 10000 and isinstance(c.system.particles, int)
