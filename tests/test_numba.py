@@ -73,3 +73,60 @@ def test_source_stamp_changes_with_any_source_file_and_only_with_sources(tmp_pat
     assert s1 != s0
     (sub / "b.py").rename(sub / "c.py")
     assert stamp(str(tmp_path)) not in (s0, s1)
+
+
+_LOADED = """
+import numpy as np
+
+from granulargas._numba import jit, kernel
+
+
+@jit
+def histogram(keys):
+    counts = {keys[0]: 0}  # a dict: hashing, reference-counted memory
+    for k in keys:
+        counts[k] = counts.get(k, 0) + 1
+    out = np.zeros(keys.max() + 1, dtype=np.int64)  # an allocation (the reference-counting runtime)
+    for k, n in counts.items():
+        out[k] = n
+    return out
+
+
+@kernel
+def total(values):
+    s = 0.0
+    for v in values:
+        s += v
+    return s
+"""
+
+
+def test_a_cached_function_loads_without_refreshing_numbas_target_context(tmp_path):
+    """Loaded machine code runs (allocation, hashing) without the context refresh that a
+    compilation needs; a compilation still refreshes it."""
+    pkg = tmp_path / "loadedpkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "funcs.py").write_text(_LOADED)
+    code = textwrap.dedent("""
+        import numpy as np
+        from numba.core.base import BaseContext
+        refreshed = []
+        original = BaseContext.refresh
+        BaseContext.refresh = lambda self: (refreshed.append(1), original(self))[1]
+        from loadedpkg.funcs import histogram, total
+        h = histogram(np.array([3, 1, 3, 2, 3], dtype=np.int64))
+        t = total(np.arange(5.0))
+        hits = sum(histogram.stats.cache_hits.values()) + sum(total.stats.cache_hits.values())
+        print(h.tolist(), t, hits, len(refreshed) > 0)
+    """)
+    path = [str(tmp_path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("GRANULARGAS_NO_CACHE", None)
+
+    def run():
+        return subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
+                              check=True).stdout.strip()
+
+    assert run() == "[0, 1, 1, 3] 10.0 0 True"  # compiled: numba refreshes its context
+    assert run() == "[0, 1, 1, 3] 10.0 2 False"  # loaded: no refresh

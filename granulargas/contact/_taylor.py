@@ -28,6 +28,17 @@ The same recurrences carry the sensitivities d/dbeta of (w, p, t), which give
 d eps/d beta and d tau/d beta by implicit differentiation of the end condition;
 the restitution table uses them for cubic Hermite interpolation.
 
+The step is the largest h on the ladder (j / 8) 2^k (j = 8, ..., 15; at most
+2^``MAX_STEP_EXPONENT``) with |c_m| h^m <= tol max(1, |w|, |p|) for the last six
+orders m of w and p (:func:`step_size`): the power of two from the binary
+exponents alone (frexp and integer arithmetic, exact), then the largest j/8 whose
+powers, made by repeated multiplication, keep every term within the limit. The
+usual h = min_m (tol / |c_m|)^(1/m) needs ``pow``, whose last bit differs between
+C libraries and between numpy's SIMD kernels (AVX-512 or not); the ladder's step
+is at most 9/8 shorter. Every operation is then an IEEE addition, multiplication,
+division or comparison (or the exact frexp, ldexp), so a contact's results are the
+same bits on every machine, and so is the restitution table built from them.
+
 Everything here sees floats and arrays only (numba leaf module).
 """
 
@@ -47,6 +58,8 @@ STATUS_BAD_INPUT = 2
 ORDER = 28
 TOLERANCE = 1e-17
 MAX_STEPS = 200000
+#: steps are at most 2^10 = 1024 (in s)
+MAX_STEP_EXPONENT = 10
 
 
 @jit
@@ -100,6 +113,54 @@ def _coefficients(beta, K, W, P, T, Wb, Pb, Tb, Q, R, F, Qb, Rb, Fb):
         Wb[k + 1] = 0.5 * Pb[k] * inv
         Pb[k + 1] = -(r + beta * rb + Fb[k]) * inv
         Tb[k + 1] = Wb[k] * inv
+
+
+@jit
+def step_exponent(a, fr, er, m):
+    """The largest integer k with a 2^(k m) <= fr 2^er (a > 0, m >= 1; fr, er = frexp(limit)).
+
+    With a = fa 2^ea (fa in [0.5, 1), frexp), a 2^(k m) <= fr 2^er holds iff
+    k m <= er - ea - [fa > fr]: exact integer arithmetic, no pow."""
+    fa, ea = math.frexp(a)
+    d = er - ea
+    if fa > fr:
+        d -= 1
+    return d // m
+
+
+@jit
+def mantissa_power(j, m):
+    """(j / 8)^m by m - 1 multiplications, in this order."""
+    mu = j / 8.0
+    v = mu
+    for _ in range(m - 1):
+        v *= mu
+    return v
+
+
+@jit
+def step_size(W, P, K, limit):
+    """The largest h = (j / 8) 2^k (j = 8..15, k <= MAX_STEP_EXPONENT, h <= 2^MAX_STEP_EXPONENT)
+    with |c_m| h^m <= limit for the last six orders m of W and P (module docstring)."""
+    fr, er = math.frexp(limit)
+    k = MAX_STEP_EXPONENT
+    for c in (W, P):
+        for m in range(K - 5, K + 1):
+            a = abs(c[m])
+            if a > 0.0:
+                km = step_exponent(a, fr, er, m)
+                if km < k:
+                    k = km
+    if k < MAX_STEP_EXPONENT:
+        for j in range(15, 8, -1):
+            fits = True
+            for c in (W, P):
+                for m in range(K - 5, K + 1):
+                    if math.ldexp(abs(c[m]) * mantissa_power(j, m), k * m) > limit:
+                        fits = False
+            if fits:
+                return math.ldexp(j / 8.0, k)
+    return math.ldexp(1.0, k)
 
 
 @jit
@@ -206,18 +267,9 @@ def contact_solve(beta, end, order, tol, out):
         Tb[0] = tb
         _coefficients(beta, K, W, P, T, Wb, Pb, Tb, Q, R, F, Qb, Rb, Fb)
         scale = max(1.0, abs(w), abs(p))
-        # step from the last few non-zero coefficients (Jorba & Zou); several
-        # orders because the first step's series is lacunary (w = s/2 + O(s^6))
-        h = 1e300
-        for c in (W, P):
-            for m in range(K - 5, K + 1):
-                a = abs(c[m])
-                if a > 0.0:
-                    hm = (tol * scale / a) ** (1.0 / m)
-                    if hm < h:
-                        h = hm
-        if h > 1e3:
-            h = 1e3
+        # step from the last few coefficients (Jorba & Zou); several orders because
+        # the first step's series is lacunary (w = s/2 + O(s^6)); found without pow
+        h = step_size(W, P, K, tol * scale)
         w1 = horner(W, K, h)
         g0 = w * w + beta * p
         found = False

@@ -6,13 +6,25 @@ needs no compilation. The restitution table is built with it: a fresh numba
 cache (as in CI) would otherwise pay ~3 s of compile time for the compiled
 kernel before the first table. For a single beta the compiled kernel is ~1000
 times faster; both agree to ~1e-14 (tests/contact).
+
+The same bits on every machine. Each beta's result is a fixed sequence of IEEE
+additions, multiplications, divisions and comparisons (plus the exact frexp and
+ldexp), so it does not depend on the platform or on the other betas of the call:
+
+* steps are chosen on a ladder without ``pow`` (:func:`_step_size`; numpy's
+  AVX-512 ``power`` and the C library's differ in the last bit);
+* Cauchy products are summed in the order j = 0, 1, ..., k by
+  ``np.add.accumulate``, whose result is defined element by element, not by
+  ``einsum``, whose kernels may use fused multiply-adds or another order;
+* the safeguarded Newton iteration stops each beta where its own test is met,
+  as the scalar kernel does, whatever the other betas still need.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from granulargas.contact._taylor import END_FORCE, MAX_STEPS, ORDER, TOLERANCE
+from granulargas.contact._taylor import END_FORCE, MAX_STEP_EXPONENT, MAX_STEPS, ORDER, TOLERANCE
 
 
 def _horner(C, x):
@@ -32,7 +44,39 @@ def _horner_d(C, x):
 
 
 def _cauchy(A, B, k):
-    return np.einsum("jm,jm->m", A[: k + 1], B[k::-1])
+    """sum_{j<=k} A_j B_{k-j}, added in the order j = 0, 1, ..., k."""
+    return np.add.accumulate(A[: k + 1] * B[k::-1], axis=0)[k]
+
+
+def _mantissa_power(j, m):
+    """(j / 8)^m by m - 1 multiplications, in the order of :func:`granulargas.contact._taylor.mantissa_power`."""
+    mu = j / 8.0
+    v = mu
+    for _ in range(m - 1):
+        v *= mu
+    return v
+
+
+def _step_size(W, P, order, limit):
+    """:func:`granulargas.contact._taylor.step_size` for every column at once."""
+    fr, er = np.frexp(limit)
+    terms = [(np.abs(C[m]), m) for C in (W, P) for m in range(order - 5, order + 1)]
+    k = np.full(limit.shape, MAX_STEP_EXPONENT, dtype=er.dtype)
+    for a, m in terms:
+        fa, ea = np.frexp(a)
+        d = er - ea - (fa > fr).astype(er.dtype)
+        k = np.where(fa > 0.0, np.minimum(k, d // m), k)
+    h = np.ldexp(1.0, k)
+    open_ = k < MAX_STEP_EXPONENT
+    for j in range(15, 8, -1):
+        if not np.any(open_):
+            break
+        fits = open_.copy()
+        for a, m in terms:
+            fits &= ~(np.ldexp(a * _mantissa_power(j, m), k * m) > limit)
+        h = np.where(fits, np.ldexp(j / 8.0, k), h)
+        open_ &= ~fits
+    return h
 
 
 def _root(f, a, b, iterations=100):
@@ -40,6 +84,7 @@ def _root(f, a, b, iterations=100):
     x = 0.5 * (a + b)
     a = a.copy()
     b = b.copy()
+    active = np.ones(x.shape, dtype=bool)  # a converged root stays as it is (as in the scalar kernel)
     for _ in range(iterations):
         v, d = f(x)
         pos = v > 0.0
@@ -50,8 +95,9 @@ def _root(f, a, b, iterations=100):
         bad = ~((a < xn) & (xn < b))
         xn = np.where(bad, 0.5 * (a + b), xn)
         done = (np.abs(xn - x) <= 1e-15 * np.maximum(1.0, np.abs(x))) | (b - a <= 4e-16 * np.maximum(1.0, np.abs(x)))
-        x = xn
-        if np.all(done):
+        x = np.where(active, xn, x)
+        active &= ~done
+        if not np.any(active):
             break
     return x
 
@@ -94,14 +140,7 @@ def solve_many(betas, end_code, order=ORDER, tol=TOLERANCE):
             Pb[k + 1] = -(R[k] + b * Rb[k] + Fb[k]) * inv
             Tb[k + 1] = Wb[k] * inv
         scale = np.maximum(1.0, np.maximum(np.abs(w), np.abs(p)))
-        h = np.full(m, 1e300)
-        with np.errstate(divide="ignore"):
-            for C in (W, P):
-                for mm in range(K - 5, K + 1):
-                    a = np.abs(C[mm])
-                    hm = np.where(a > 0.0, (tol * scale / np.where(a > 0.0, a, 1.0)) ** (1.0 / mm), 1e300)
-                    h = np.minimum(h, hm)
-        h = np.minimum(h, 1e3)
+        h = _step_size(W, P, K, tol * scale)
         w1 = _horner(W, h)
         p1 = _horner(P, h)
         cross_w = (w > 0.0) & (w1 <= 0.0)

@@ -54,7 +54,9 @@ from granulargas.contact.lookup import table_beta_limit, table_lookup_many
 from granulargas.contact.ode import end_code, solve_many
 from granulargas.errors import TableRangeError
 
-FORMAT_VERSION = 2
+#: 3: steps without ``pow`` and each beta converged on its own (:mod:`granulargas.contact._taylor_np`),
+#: so that a cached table's bits depend neither on the machine nor on the largest table built before
+FORMAT_VERSION = 3
 DEFAULT_INTERVALS_PER_UNIT = 128
 MAX_ERROR = 1e-8
 # Largest beta a table may cover. The model is physical only for beta well below ~3; beyond

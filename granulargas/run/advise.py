@@ -559,7 +559,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         if chosen is not None:
             adv.duration, adv.duration_reason = chosen
     if scene.shows("constant_or_viscoelastic") and gas.model == "viscoelastic":
-        curve = V.viscoelastic_cooling(gas)
+        curve = V.cooling_of(gas)
         curve = _curve_through(gas, curve, t_end)
         adv.eps_best, adv.error = best_constant(gas, curve, t_end)
         adv.constant_ok = adv.error <= tolerance
@@ -585,7 +585,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
                          "at this rate")
         else:
             ve = replace(gas, model="viscoelastic", prefactor=k)
-            curve = _curve_through(ve, V.viscoelastic_cooling(ve), t_end)
+            curve = _curve_through(ve, V.cooling_of(ve), t_end)
             adv.damping_equivalent = damping_from_prefactor(k)
             adv.error = constant_error(ve, eps, curve, t_end)
             adv.constant_ok = adv.error <= tolerance

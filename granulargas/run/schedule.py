@@ -42,6 +42,22 @@ class Schedule:
             object.__setattr__(self, "sample", np.ones(len(self.targets), dtype=bool))
 
 
+#: significant digits of computed output times (the mean free time, log-spaced snapshots)
+TIME_DIGITS = 9
+
+
+def rounded_time(t: float) -> float:
+    """``t`` rounded to ``TIME_DIGITS`` significant digits.
+
+    The engine resynchronises at every snapshot, so a trajectory depends on the last
+    bits of the snapshot times, and those of a computed time (``np.geomspace``'s
+    ``power``, the powers in the mean free time) can differ between numpy's SIMD kernels
+    (AVX-512 or not) and between C libraries. Rounded to 9 digits, the times are the
+    same on every machine unless the exact time lies within ~1e-15 of a rounding
+    boundary."""
+    return float(f"{t:.{TIME_DIGITS}g}")
+
+
 def mean_free_time(config: RunConfig) -> float:
     """Enskog estimate of the mean time between collisions of a particle at the
     initial temperature (:func:`granulargas.theory.collision_frequency`), with the
@@ -50,13 +66,14 @@ def mean_free_time(config: RunConfig) -> float:
     chi is the closed form (Carnahan-Starling, Henderson), fixed: the schedule only
     needs an estimate, and its output times must not move when the theory's chi is
     refined, because a run resynchronises at every snapshot and so its trajectory
-    depends on the snapshot times."""
+    depends on the snapshot times. For the same reason it is rounded to ``TIME_DIGITS``
+    significant digits (:func:`rounded_time`)."""
     d = config.system.dimension
     sigma, mass = mean_particle(config)
     eta = config.system.packing_fraction
     n = theory.number_density(eta, d, sigma)
     chi = theory.contact_value(eta, d, "closed")
-    return 1.0 / float(theory.collision_frequency(n, config.initial.temperature, d, sigma, mass, chi=chi))
+    return rounded_time(1.0 / float(theory.collision_frequency(n, config.initial.temperature, d, sigma, mass, chi=chi)))
 
 
 def collision_budget(config: RunConfig) -> int:
@@ -76,6 +93,13 @@ def _even(interval: float, end: float) -> np.ndarray:
     return np.append(t[t < end * (1 - 1e-12)], end)
 
 
+def log_spaced(first: float, end: float, count: int) -> np.ndarray:
+    """``count`` times from ``first`` to ``end`` (both exactly) equally spaced in log t,
+    those between rounded by :func:`rounded_time`."""
+    t = np.geomspace(first, end, count)
+    return np.array([float(first)] + [rounded_time(x) for x in t[1:-1]] + [float(end)])[:count]
+
+
 def output_schedule(config: RunConfig) -> Schedule:
     """The output schedule of a config (start time 0; a restart skips the
     targets at or before its start)."""
@@ -92,7 +116,7 @@ def output_schedule(config: RunConfig) -> Schedule:
             if first >= end:
                 snaps = np.linspace(0.0, end, nsnap)[1:]
             else:
-                snaps = np.geomspace(first, end, nsnap - 1)
+                snaps = log_spaced(first, end, nsnap - 1)
         obs_dt = out.observables_interval or end / DEFAULT_OBSERVABLE_SAMPLES
         obs = _even(obs_dt, end)
         clock = "time"
@@ -130,7 +154,7 @@ def pacing_stops(config: RunConfig) -> np.ndarray:
     if not (first > 0 and math.isfinite(first)) or end is None or first >= end:
         return np.empty(0)
     count = int(math.floor(math.log2(end / first))) + 1
-    return first * np.exp2(np.arange(count))
+    return np.ldexp(first, np.arange(count, dtype=np.intc))  # exact, as exp2 need not be
 
 
 def output_counts(config: RunConfig) -> tuple[float, float]:

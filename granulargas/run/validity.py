@@ -74,8 +74,9 @@ Runner API (one line each, for the run summary)
 
 from __future__ import annotations
 
+import functools
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -113,6 +114,7 @@ __all__ = [
     "restitution_spread",
     "effective_inelasticity",
     "viscoelastic_cooling",
+    "cooling_of",
     "run_temperature_range",
     "contact_time_ratio",
     "box_length",
@@ -142,6 +144,19 @@ class RunGas(Gas):
     material: object = None
     source: str = "<config>"
     duration: str = "instantaneous"
+
+
+def cooling_of(gas: Gas) -> CoolingCurve:
+    """:func:`viscoelastic_cooling` of ``gas``, solved once per process for each gas: the run's
+    checks, the advice and the run summary all predict with it. The curve is a function of the
+    gas alone (not of when the run stops, nor of a :class:`RunGas`'s other fields)."""
+    return _cooling(Gas(**{f.name: getattr(gas, f.name) for f in fields(Gas)
+                           if f.name not in ("end_time", "collisions_per_particle")}))
+
+
+@functools.lru_cache(maxsize=16)
+def _cooling(gas: Gas) -> CoolingCurve:
+    return viscoelastic_cooling(gas)
 
 
 def mean_particle_volume(config) -> float:
@@ -433,7 +448,7 @@ def check_run(config) -> RunValidity:
     src = gas.source
     spread = curve = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
-        curve = viscoelastic_cooling(gas)
+        curve = cooling_of(gas)
     t_end, ln_T_end = predicted_end(gas, curve)
     if not isinstance(config, RunGas) and config.species and gas.model != "elastic":
         t_end, ln_T_end = _mixture_end(config, gas)

@@ -165,7 +165,8 @@ def block_memory(data):
 def block_startup(data):
     t = Table(["run", "CPU of the process (s)", "of it compiling (s)"], ["---", "--:", "--:"])
     for r in sorted(by_table(data, "startup"), key=lambda r: r["id"]):
-        t.add([r["what"], f"**{fmt(r['cpu_seconds'])}**", fmt(r["compile_seconds"])], r)
+        spread = f" ({fmt(r['cpu_range'])})" if r.get("cpu_range") else ""
+        t.add([r["what"], f"**{fmt(r['cpu_seconds'])}**{spread}", fmt(r["compile_seconds"])], r)
     return t.markdown()
 
 
@@ -271,13 +272,15 @@ def headline(data, plain=False):
         return fmt(r["rate_cpu"], 3)
 
     n4, n5, n6 = m("N \\approx 10^4", "N ≈ 10⁴"), m("10^5", "10⁵"), m("10^6", "10⁶")
+    compiling = (f", {fmt(quick['compile_seconds'])} s of it compiling (once)" if quick.get("compile_seconds")
+                 else ", most of it compiling (once)")
     return (f"Elastic hard spheres at packing 0.3, one core, side by side with a compiled C reference code: "
             f"{x(dense[0])} at {n4}, {x(dense[1])} at {n5} and "
             f"{x(dense[2])} at {n6} ({rate(dense[0])}, {rate(dense[1])} and {rate(dense[2])} million "
             f"collisions per CPU second). Dilute gases (cell crossings): {x(dilute[0])} at packing 0.05 and "
             f"{x(dilute[1])} at 0.1 for {n4}, {x(dilute5)} at 0.05 for "
             f"{n5}. The quickstart's first run on a fresh install: {fmt(quick['cpu_seconds'])} s of "
-            f"CPU, {fmt(quick['compile_seconds'])} s of it compiling (once). Engine state {min(lists)}–{max(lists)} "
+            f"CPU{compiling}. Engine state {min(lists)}–{max(lists)} "
             f"bytes per particle. The initial state of {n6} spheres at packing 0.5 in "
             f"{fmt(init['wall_seconds'])} s (two threads). The DSMC: {fmt(min(dsmc))}–{fmt(max(dsmc))} million "
             f"collisions per CPU second.\n")

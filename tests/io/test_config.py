@@ -91,7 +91,7 @@ def test_overrides_are_validated_like_file_values():
         parse_config(FULL, "x.toml", overrides={"system.temperature": 3})
 
 
-SECTIONS_ALLOWED = "(allowed: system, particles, initial, collision, driving, run, output)"
+SECTIONS_ALLOWED = "(allowed: system, particles, initial, collision, driving, run, output, species)"
 
 
 @pytest.mark.parametrize("dotted, nearest", [
@@ -111,7 +111,7 @@ def test_override_of_an_unknown_section_names_the_key_and_the_nearest(dotted, ne
 
 @pytest.mark.parametrize("dotted, message", [
     ("system", "override: system = 0: key must be section.key with section one of system, particles, "
-               "initial, collision, driving, run, output"),
+               "initial, collision, driving, run, output, species"),
     ("system.particles.x", "override: system.particles.x = 0: particles is not a table"),
 ])
 def test_override_that_is_no_section_key(dotted, message):

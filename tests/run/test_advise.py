@@ -78,6 +78,21 @@ def test_summary_line():
     assert "damping" in A.summary_line(config('model = "constant"\nrestitution = 0.9'))
 
 
+def test_a_run_solves_its_cooling_curve_once(monkeypatch):
+    """The run's checks, the advice and the summary line share one solution of the cooling
+    law (each for a run of a different length: the curve does not depend on it)."""
+    solved = []
+    solve = V.viscoelastic_cooling
+    monkeypatch.setattr(V, "viscoelastic_cooling", lambda gas: solved.append(gas) or solve(gas))
+    V._cooling.cache_clear()
+    for t_end in (40.0, 80.0):
+        cfg = config('model = "viscoelastic"\ndamping = 0.0123', f"end_time = {t_end}")
+        V.raise_if_invalid(cfg)
+        A.advise(cfg)
+        assert A.summary_line(cfg).startswith("advice       eps")
+    assert len(solved) == 1
+
+
 def test_cli(capsys):
     assert main(["advise", str(CONFIGS / "quickstart.toml")]) == 0
     out = capsys.readouterr().out
