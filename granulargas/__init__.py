@@ -11,7 +11,7 @@ in the module that ``_PUBLIC`` below names:
   :class:`Result` (the observables as a table, the snapshots, the analysis),
   :func:`analyze`;
 * the engine and its initial states: :class:`Simulation`,
-  :class:`CollisionRule`, :class:`WhiteNoise`, :class:`DSMC`,
+  :class:`CollisionRule`, :class:`TangentialRule` (rough particles), :class:`WhiteNoise`, :class:`DSMC`,
   :func:`random_state`, :class:`State` (the state a simulation takes whole);
 * the contact: :func:`restitution` (eps of one impact's damping beta).
 
@@ -35,6 +35,7 @@ _PUBLIC = {
     # the engine and the initial states
     "Simulation": "granulargas.engine:Simulation",
     "CollisionRule": "granulargas.engine:CollisionRule",
+    "TangentialRule": "granulargas.engine:TangentialRule",
     "WhiteNoise": "granulargas.engine:WhiteNoise",
     "DSMC": "granulargas.dsmc:DSMC",
     "random_state": "granulargas.initial:random_state",

@@ -22,6 +22,17 @@ about -2/(d N).
 A compiled two-pass kernel does the sums without temporary arrays; it reads
 the first ``d`` columns of a (N, >= d) velocity array, so padded layouts need
 no copy.
+
+Rough particles (spins w, moments of inertia I_i = kappa m_i R_i^2): with
+``x_i = m_i c_i^2`` and ``y_i = I_i w_i^2`` (no mean is subtracted from the spins),
+``T_tr = <x>/d_t``, ``T_rot = <y>/d_r`` and the cumulants of Megías & Santos (2023)
+
+    a20 = d_t/(d_t+2) <x^2>/<x>^2 - 1,   a02 = d_r/(d_r+2) <y^2>/<y>^2 - 1,
+    a11 = <x y>/(<x><y>) - 1,
+
+i.e. ``<c^4>``, ``<w^4>`` and ``<c^2 w^2>`` of the velocities scaled by the translational
+and the spins by the rotational temperature; a20 is a2 above. 2D: d_t = 2, d_r = 1 (the
+spin along z), 3D: 3 and 3 (:func:`rough_moments`).
 """
 
 from __future__ import annotations
@@ -103,6 +114,91 @@ def kinetic_energy_momentum(v, dim, masses):
             p2 += m * v[i, 2]
         e += m * w2
     return 0.5 * e, p0, p1, p2
+
+
+@jit
+def rough_moments(v, dim, masses, w, inertia):
+    """(T_tr, T_rot, a20, a02, a11) of velocities ``v[:, :dim]`` and spins ``w`` (module docstring).
+
+    ``w`` (N, 3) or (N, 1): 3D uses its three columns, 2D its last (the z spin); ``inertia``
+    (N,) the moments of inertia I_i or one shared value (1,); ``masses`` as
+    :func:`energy_moments`. Velocities and spins are scaled by their largest components
+    (no underflow in gases cooled far below unit speeds). nan cumulants when either
+    temperature is 0.
+    """
+    n = v.shape[0]
+    shared = masses.shape[0] == 1
+    ishared = inertia.shape[0] == 1
+    dr = 3 if dim == 3 else 1
+    c0 = w.shape[1] - dr  # first spin column used
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    msum = 0.0
+    vmax = 0.0
+    wmax = 0.0
+    for i in range(n):
+        m = masses[0] if shared else masses[i]
+        msum += m
+        p0 += m * v[i, 0]
+        p1 += m * v[i, 1]
+        vmax = max(vmax, abs(v[i, 0]), abs(v[i, 1]))
+        if dim == 3:
+            p2 += m * v[i, 2]
+            vmax = max(vmax, abs(v[i, 2]))
+        for a in range(dr):
+            wmax = max(wmax, abs(w[i, c0 + a]))
+    vs = 1.0 / vmax if vmax > 0.0 else 1.0
+    ws = 1.0 / wmax if wmax > 0.0 else 1.0
+    u0 = p0 / msum * vs
+    u1 = p1 / msum * vs
+    u2 = p2 / msum * vs
+    sx = 0.0
+    sxx = 0.0
+    sy = 0.0
+    syy = 0.0
+    sxy = 0.0
+    for i in range(n):
+        m = masses[0] if shared else masses[i]
+        q0 = v[i, 0] * vs - u0
+        q1 = v[i, 1] * vs - u1
+        x = q0 * q0 + q1 * q1
+        if dim == 3:
+            q2 = v[i, 2] * vs - u2
+            x += q2 * q2
+        x *= m
+        y = 0.0
+        for a in range(dr):
+            y += (w[i, c0 + a] * ws) ** 2
+        y *= inertia[0] if ishared else inertia[i]
+        sx += x
+        sxx += x * x
+        sy += y
+        syy += y * y
+        sxy += x * y
+    t_tr = sx / (dim * n) / (vs * vs)
+    t_rot = sy / (dr * n) / (ws * ws)
+    a20 = dim / (dim + 2.0) * sxx * n / (sx * sx) - 1.0 if sx > 0.0 else np.nan
+    a02 = dr / (dr + 2.0) * syy * n / (sy * sy) - 1.0 if sy > 0.0 else np.nan
+    a11 = sxy * n / (sx * sy) - 1.0 if sx > 0.0 and sy > 0.0 else np.nan
+    return t_tr, t_rot, a20, a02, a11
+
+
+def rotational_observables(velocities, spins, masses, inertia) -> dict:
+    """``temperature``, ``rotational_temperature``, ``cumulant_a20``, ``cumulant_a02``,
+    ``cumulant_a11`` of a sample of rough particles (:func:`rough_moments`).
+
+    ``spins`` (N, 3) in 3D, (N, 1) or (N, 3) in 2D (the z spin last); ``inertia`` the moments
+    of inertia I_i (N,) or one value.
+    """
+    v, m = _arrays(velocities, masses)
+    w = np.ascontiguousarray(spins, dtype=np.float64)
+    if w.ndim != 2 or w.shape[0] != v.shape[0] or w.shape[1] not in ((3,) if v.shape[1] == 3 else (1, 3)):
+        raise ValueError(f"spins: shape {w.shape}, expected ({v.shape[0]}, {3 if v.shape[1] == 3 else 1})")
+    inertia = np.ascontiguousarray(np.atleast_1d(inertia), dtype=np.float64)
+    t, tr, a20, a02, a11 = rough_moments(v, v.shape[1], m, w, inertia)
+    return {"temperature": float(t), "rotational_temperature": float(tr), "cumulant_a20": float(a20),
+            "cumulant_a02": float(a02), "cumulant_a11": float(a11)}
 
 
 def _arrays(velocities, masses):

@@ -40,6 +40,11 @@ def _scalar(d: int) -> tuple:
     return ()
 
 
+def _spin(d: int) -> tuple:
+    """Angular velocity: 3 components in 3D, the one about z in 2D."""
+    return (3,) if d == 3 else (1,)
+
+
 @dataclass(frozen=True)
 class ParticleField:
     """One per-particle quantity of the state (a row of :data:`PARTICLE_FIELDS`)."""
@@ -80,6 +85,11 @@ PARTICLE_FIELDS = (
                   "the end times of contacts under way (collisions that take time; -inf: none)"),
     ParticleField("contact_partner", np.int64, _scalar, -1, "contact_partner", True, True,
                   "the partners of contacts under way (collisions that take time; -1: none)"),
+    ParticleField("angular_velocities", np.float64, _spin, 0.0, "angular_velocity", True, False,
+                  "angular velocities of rough particles (3D: 3 components; 2D: the one about z)"),
+    ParticleField("inertia", np.float64, _scalar, None, "inertia", False, False,
+                  "kappa = I / (m R^2) of rough particles, I the moment of inertia about a centre "
+                  "axis (2/5: uniform sphere, 1/2: uniform disk)"),
 )
 FIELDS = {f.name: f for f in PARTICLE_FIELDS}
 
@@ -155,6 +165,11 @@ class State:
     contact_until, contact_partner : arrays (N,), optional
         Collisions that take time: when each particle's contact under way ends (-inf:
         none) and the particle id of its partner (-1: none).
+    angular_velocities : array (N, 3) in 3D, (N, 1) in 2D, optional
+        Rough particles: the angular velocities (2D: about z; default 0).
+    inertia : array (N,), optional
+        Rough particles: kappa = I / (m R^2) (I the moment of inertia; no default: a rough
+        simulation without it takes that of a uniform sphere or disk, 2/5 or 1/2).
     time : float
         The state's time.
     collisions, events, wall_collisions, three_body_contacts : int

@@ -121,3 +121,58 @@ def test_sample_history_runs_and_samples_either_method():
         assert h[-1, 0] == pytest.approx(np.mean(np.sum(c * c, axis=1)) / 3, rel=1e-12)
         assert h[-1, 1] == pytest.approx(sonine_coefficients(sim.velocities)[0], rel=1e-12)
         assert np.all(np.diff(h[:, 0]) < 0) and np.all(np.diff(h[:, 2]) > 0)  # a cooling gas
+
+
+# ---------------------------------------------------------------- rough particles
+
+
+def _direct_rough(v, w, m, inertia, dim):
+    c = v - (m[:, None] * v).sum(0) / m.sum()
+    x = m * np.sum(c**2, 1)
+    y = inertia * np.sum(w**2, 1)
+    dr = 3 if dim == 3 else 1
+    return (x.mean() / dim, y.mean() / dr, dim / (dim + 2) * np.mean(x**2) / x.mean() ** 2 - 1,
+            dr / (dr + 2) * np.mean(y**2) / y.mean() ** 2 - 1, np.mean(x * y) / (x.mean() * y.mean()) - 1)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_rough_moments_are_the_definitions(dim):
+    from granulargas.observables import rotational_observables, sonine_a2
+
+    rng = np.random.default_rng(4)
+    n = 500
+    v = rng.normal(size=(n, dim)) * rng.uniform(0.5, 2.0, (n, 1))  # correlated with the spins below
+    w = rng.normal(size=(n, 3 if dim == 3 else 1)) * np.linalg.norm(v, axis=1)[:, None]
+    m = rng.uniform(0.5, 2.0, n)
+    inertia = 0.4 * m * rng.uniform(0.3, 0.6, n) ** 2
+    out = rotational_observables(v, w, m, inertia)
+    expected = _direct_rough(v, w, m, inertia, dim)
+    names = ("temperature", "rotational_temperature", "cumulant_a20", "cumulant_a02", "cumulant_a11")
+    for name, e in zip(names, expected):
+        assert out[name] == pytest.approx(e, rel=1e-12, abs=1e-14)
+    assert out["cumulant_a11"] > 0.1  # the spins grow with the speeds
+    assert out["cumulant_a20"] == pytest.approx(sonine_a2(v, m), rel=1e-12)
+    # 2D spins may come as (N, 3) with the z spin last
+    if dim == 2:
+        w3 = np.zeros((n, 3))
+        w3[:, 2] = w[:, 0]
+        assert rotational_observables(v, w3, m, inertia) == out
+    # scale-free: units of velocity and spin drop out of the cumulants
+    scaled = rotational_observables(v * 1e-80, w * 1e90, m, inertia)
+    for name in names[2:]:
+        assert scaled[name] == pytest.approx(out[name], rel=1e-10)
+    assert scaled["rotational_temperature"] == pytest.approx(out["rotational_temperature"] * 1e180, rel=1e-12)
+
+
+def test_rough_moments_of_a_maxwellian_vanish():
+    from granulargas.observables import rotational_observables
+
+    rng = np.random.default_rng(5)
+    n = 200_000
+    out = rotational_observables(rng.normal(size=(n, 3)), rng.normal(size=(n, 3)) * 3.0, None, 0.1)
+    assert out["temperature"] == pytest.approx(1.0, rel=0.01)
+    assert out["rotational_temperature"] == pytest.approx(0.9, rel=0.01)
+    for name in ("cumulant_a20", "cumulant_a02", "cumulant_a11"):
+        assert abs(out[name]) < 0.02
+    still = rotational_observables(rng.normal(size=(10, 3)), np.zeros((10, 3)), None, 0.1)
+    assert still["rotational_temperature"] == 0.0 and np.isnan(still["cumulant_a02"])

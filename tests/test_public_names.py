@@ -36,6 +36,7 @@ FRONT_DOOR = {
     "load_config": "granulargas.io.config", "simulate": "granulargas.api", "load_run": "granulargas.api",
     "Result": "granulargas.api", "analyze": "granulargas.api",
     "Simulation": "granulargas.engine", "CollisionRule": "granulargas.engine", "WhiteNoise": "granulargas.engine",
+    "TangentialRule": "granulargas.engine",
     "DSMC": "granulargas.dsmc", "random_state": "granulargas.initial", "State": "granulargas.state",
     "restitution": "granulargas.contact",
 }

@@ -61,6 +61,10 @@ SECTION_TEXT = {
     "collision.material": "Instead of `damping`: the viscoelastic contact from material constants "
                           "(SI; all keys required), converted once to the reduced pair prefactor "
                           "k = (3/2) A (2Y / (3(1 − ν²)))^(2/5) (σ u / m²)^(1/5).",
+    "collision.tangential": "Optional: rough particles that spin ([Rough grains](rough.md)). Without the "
+                            "table the particles are smooth. Sign convention: the tangential velocity "
+                            "of the contact points becomes −β_t times itself, so β_t = −1 is smooth and "
+                            "+1 perfectly rough.",
     "driving": "Optional: white-noise driving (a heated granular gas in a steady state).",
     "species": "Optional, in place of `[particles]`: an array of tables `[[species]]`, one per species of "
                "a mixture ([Mixtures](mixtures.md)). Each key below is checked per species and named "

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from granulargas.analysis.driven import analyze_driven
 from granulargas.analysis.elastic import analyze_elastic
+from granulargas.analysis.rough import analyze_rough
 from granulargas.analysis.run import RunInfo, analyze_cooling
 from granulargas.errors import InputFileError
 from granulargas.io.scene import MODELS
@@ -27,6 +28,7 @@ ANALYSES = {
     "cooling": analyze_cooling,
     "elastic": analyze_elastic,
     "driven": analyze_driven,
+    "rough": analyze_rough,
 }
 
 

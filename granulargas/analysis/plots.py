@@ -16,7 +16,8 @@ from granulargas import theory
 from granulargas.analysis.run import A2_ERROR_METHOD
 from granulargas.theory.hcs import FIRST_SONINE
 
-__all__ = ["PLOTS", "plot_analysis", "ratio_limits", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic", "plot_sweep"]
+__all__ = ["PLOTS", "plot_analysis", "ratio_limits", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic",
+           "plot_rough", "plot_sweep"]
 
 
 def _plt():
@@ -365,6 +366,66 @@ def plot_driven(analysis, path):
 
 
 PLOTS["driven"] = plot_driven
+
+
+def plot_rough(analysis, path):
+    """T_tr(t), T_rot(t), theta(t) against the two-temperature theory, and the cumulants.
+
+    Parameters
+    ----------
+    analysis : granulargas.analysis.rough.RoughAnalysis
+    path : str or Path
+    """
+    plt = _plt()
+    a, info = analysis, analysis.info
+    h = a.history
+    t = h.time
+    s = a.summary()
+    fig, axes = plt.subplots(3, 1, figsize=(7.0, 9.0), sharex=True)
+    tt = np.linspace(t[0], t[-1], 400) if a.driven else np.geomspace(max(t[0], t[1] * 1e-3) if t[0] == 0 else t[0],
+                                                                      t[-1], 400)
+    ax = axes[0]
+    ax.plot(t, h.translational, "-", color="C0", lw=1.2, label="$T_{tr}$")
+    ax.plot(t, h.rotational, "-", color="C3", lw=1.2, label="$T_{rot}$")
+    ax.plot(tt, a.curve.translational_at(tt), "--", color="k", lw=1, label="theory (Maxwellian energy balances)")
+    ax.plot(tt, a.curve.rotational_at(tt), ":", color="k", lw=1)
+    ax.set_ylabel("temperature")
+    if not a.driven:
+        ax.set_xscale("symlog", linthresh=max(t[1] - t[0], 1e-12) if t.size > 1 else 1.0)
+        ax.set_yscale("log")
+    ax.legend(fontsize=7.5, framealpha=0.7)
+    kind = "driven" if a.driven else "freely cooling"
+    ax.set_title(_title(info, f"Rough particles ({kind}): two temperatures against theory"), fontsize=9)
+    ax = axes[1]
+    ax.plot(t, h.ratio, "-", color="C2", lw=1.2, label="$\\theta = T_{rot}/T_{tr}$")
+    ax.plot(tt, a.curve.ratio_at(tt), "--", color="k", lw=1, label="theory")
+    name = "steady state" if a.driven else "homogeneous cooling state"
+    if math.isfinite(a.theta_theory):
+        ax.axhline(a.theta_theory, color="0.5", lw=0.8, ls=":", label=f"{name} {a.theta_theory:.4g}")
+    if s.get("theta") is not None and math.isfinite(a.t_relaxed):
+        err = s.get("theta_error") or 0.0
+        ax.fill_between([a.t_relaxed, t[-1]], s["theta"] - err, s["theta"] + err, color="C2", alpha=0.3, lw=0,
+                        label=f"simulation, relaxed part: {s['theta']:.4g} $\\pm$ {err:.2g}")
+        ax.axvline(a.t_relaxed, color="0.8", lw=0.8, ls=":")
+    ax.set_ylabel("$\\theta$")
+    ax.legend(fontsize=7.5, framealpha=0.7)
+    ax = axes[2]
+    for name, color in (("a20", "C0"), ("a02", "C3"), ("a11", "C4")):
+        ax.plot(t, getattr(h, name), "-", color=color, lw=1, label=f"$a_{{{name[1:]}}}$")
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    ax.set_ylabel("cumulants")
+    ax.legend(fontsize=7.5, framealpha=0.7)
+    ax.set_xlabel("time t  [$\\sigma\\,(m/T_0)^{1/2}$]")
+    if not a.driven:
+        for ax in axes[1:]:
+            ax.set_xscale("symlog", linthresh=max(t[1] - t[0], 1e-12) if t.size > 1 else 1.0)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+PLOTS["rough"] = plot_rough
 
 
 def plot_density_profiles(info, walls: dict, path):

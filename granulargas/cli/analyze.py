@@ -5,7 +5,8 @@
 PATH is a run's H5MD file (the analysis of its kind, :mod:`granulargas.analysis.kinds`:
 cooling runs against the kinetic theory of :mod:`granulargas.theory.gas`, elastic runs
 against the equation of state and Enskog's collision frequency, driven runs' steady
-state against :mod:`granulargas.theory.driven`; a run with walls also gets the wall
+state against :mod:`granulargas.theory.driven`, runs of rough particles' two temperatures
+against :mod:`granulargas.theory.rough`; a run with walls also gets the wall
 pressure and the density across the walls, :mod:`granulargas.analysis.walls`, and
 ``--plot`` a second figure of the density profile; a mixture also gets the temperature of each
 species against :mod:`granulargas.analysis.species` and a figure of T_i/T_j) or a sweep's output
@@ -245,8 +246,46 @@ def driven_report(a, rows: int = 10) -> str:
     return "\n".join(lines)
 
 
+def rough_report(a, rows: int = 10) -> str:
+    """Text report of a :class:`granulargas.analysis.rough.RoughAnalysis`."""
+    from granulargas.analysis.rough import RELAXATION_COLLISIONS
+
+    s = a.summary()
+    g = a.gas
+    lines = _header(a.info)
+    law = (f"Walton's model, beta_0 = {g.tangential_restitution:g}, mu = {g.friction:g}" if g.tangential == "coulomb"
+           else f"tangential restitution beta_t = {g.tangential_restitution:g}")
+    lines.append(f"  rough particles: {law}, kappa = {g.inertia:g}")
+    if a.driven:
+        lines.append(f"  driving: white noise, H = {g.heating_rate:.4g}, fraction on the spins {g.rotational_fraction:g}")
+    lines.append(f"  theory: {a.theory_name}")
+    where = "steady state" if a.driven else "homogeneous cooling state"
+    if math.isfinite(a.t_relaxed):
+        lines.append(f"  relaxed from t = {a.t_relaxed:.4g}; errors from block means")
+        lines.append(f"  theta = T_rot/T_tr = {_pm(s.get('theta'), s.get('theta_error'))}; theory over the same "
+                     f"samples {_fmt(s.get('theta_theory_samples'), '.5g')}"
+                     f"{_dev(s.get('theta'), s.get('theta_theory_samples'))}; {where} (Maxwellian) "
+                     f"{_fmt(s.get('theta_theory'), '.5g')}{_dev(s.get('theta'), s.get('theta_theory'))}")
+        if a.driven:
+            lines.append(f"  T_tr = {_pm(s.get('T_steady'), s.get('T_steady_error'))}; theory "
+                         f"{_fmt(s.get('T_steady_theory'), '.5g')}{_dev(s.get('T_steady'), s.get('T_steady_theory'))}")
+        lines.append("  cumulants (relaxed): " + ", ".join(
+            f"{k} = {_pm(s.get('cumulant_' + k), s.get('cumulant_' + k + '_error'), '+.4f')}" for k in ("a20", "a02", "a11")))
+    else:
+        lines.append(f"  the run is too short for theta to relax ({RELAXATION_COLLISIONS:g} collisions per particle): "
+                     f"{where} theta (Maxwellian) {_fmt(s.get('theta_theory'), '.5g')}")
+    h = a.history
+    t = h.time
+    Tt, Rt = a.curve.translational_at(t), a.curve.rotational_at(t)
+    lines += ["", f"  {'t':>11} {'T_tr':>11} {'theory':>11} {'T_rot':>11} {'theory':>11} {'theta':>8} {'theory':>8}"]
+    for i in np.unique(np.linspace(0, t.size - 1, max(rows, 2)).astype(int)):
+        lines.append(f"  {t[i]:11.5g} {h.translational[i]:11.5g} {Tt[i]:11.5g} {h.rotational[i]:11.5g} "
+                     f"{Rt[i]:11.5g} {h.ratio[i]:8.4f} {Rt[i] / Tt[i]:8.4f}")
+    return "\n".join(lines)
+
+
 #: kind -> text report ``f(analysis, rows) -> str``
-REPORTS = {"cooling": cooling_report, "elastic": elastic_report, "driven": driven_report}
+REPORTS = {"cooling": cooling_report, "elastic": elastic_report, "driven": driven_report, "rough": rough_report}
 
 
 def walls_report(w: dict) -> str:

@@ -63,6 +63,10 @@ def export_lammps(config, directory, *, contact_fraction: float | None = 0.01, s
     if config.driving is not None and config.driving.heating_rate > 0.0:
         raise ConfigError(f"{config.source}: [driving]: LAMMPS export does not write the white-noise "
                           "driving; export an undriven config")
+    if c.tangential is not None:
+        raise ConfigError(f"{config.source}: collision.tangential = {{...}}: LAMMPS export writes the normal "
+                          "viscoelastic contact only (no tangential law for rough particles); export a config "
+                          "without [collision.tangential]")
     end_time = config.run.end_time if end_time is None else end_time
     if end_time is None:
         raise ConfigError(f"{config.source}: run.end_time is not set: LAMMPS runs for a fixed time (use --end-time)")

@@ -19,6 +19,11 @@ drawn directly from that weight, without building k:
   (-pi/2, pi/2), so sin(theta) = 2U - 1 is uniform; with c^2 = 1 - sin^2,
   p = c^2 g + c sin(theta) g_perp (g_perp = g rotated by +90 degrees), g_n^2 = c^2 |g|^2.
 
+Rough particles (:func:`apply_rough_update`): the tangential law needs the unit normal
+itself, ``n = -p / g_n`` (from j to i, as in the engine), and then the engine's rough law
+(:mod:`granulargas.engine._rough`) with the spins; one square root and one division more
+per collision than the smooth update.
+
 The velocity update is the smooth-sphere rule of
 :mod:`granulargas.engine._collide`:
 
@@ -38,6 +43,7 @@ import numpy as np
 
 from granulargas._numba import inlined
 from granulargas.dsmc._random import next_u64
+from granulargas.engine._rough import contact_slip, rough_pair_collision
 
 _MASK32 = np.uint64(0xFFFFFFFF)
 _S32 = np.uint64(32)
@@ -91,3 +97,45 @@ def apply_pair_update(rec, i, j, dim, px, py, pz, eps, mi, mj):
     if dim == 3:
         rec[i, 2] -= fi * pz
         rec[j, 2] += fj * pz
+
+
+@inlined
+def apply_rough_update(rec, spins, i, j, dim, px, py, pz, gn2, eps, mi, mj, ri, rj):
+    """Rough update of the pair (i, j) from the normal part p of their relative velocity
+    (k = p / |p| from i to j); ``spins``: the engine's :class:`~granulargas.engine._state.Spins`
+    record (``w`` (N, 3), 2D the z column; ``kappa`` (N,) or one shared value (1,)).
+    Returns the energy lost (translation and rotation)."""
+    gn = math.sqrt(gn2)
+    if not gn > 0.0:  # a grazing candidate (probability zero): nothing to do
+        return 0.0
+    inv = -1.0 / gn
+    nx = px * inv
+    ny = py * inv
+    nz = pz * inv
+    w = spins.w
+    kap = spins.kappa
+    ki = kap[0] if kap.shape[0] == 1 else kap[i]
+    kj = kap[0] if kap.shape[0] == 1 else kap[j]
+    uz = rec[i, 2] - rec[j, 2] if dim == 3 else 0.0
+    un, gx, gy, gz = contact_slip(rec[i, 0] - rec[j, 0], rec[i, 1] - rec[j, 1], uz, nx, ny, nz,
+                                  ri * w[i, 0] + rj * w[j, 0], ri * w[i, 1] + rj * w[j, 1],
+                                  ri * w[i, 2] + rj * w[j, 2])
+    fi, fj, ti, tj, si, sj, loss, _ = rough_pair_collision(un, gx * gx + gy * gy + gz * gz, mi, mj, ki, kj, ri, rj,
+                                                           eps, spins.model, spins.beta, spins.mu)
+    rec[i, 0] -= fi * nx + ti * gx
+    rec[i, 1] -= fi * ny + ti * gy
+    rec[j, 0] += fj * nx + tj * gx
+    rec[j, 1] += fj * ny + tj * gy
+    if dim == 3:
+        rec[i, 2] -= fi * nz + ti * gz
+        rec[j, 2] += fj * nz + tj * gz
+    cx = ny * gz - nz * gy
+    cy = nz * gx - nx * gz
+    cz = nx * gy - ny * gx
+    w[i, 0] += si * cx
+    w[i, 1] += si * cy
+    w[i, 2] += si * cz
+    w[j, 0] += sj * cx
+    w[j, 1] += sj * cy
+    w[j, 2] += sj * cz
+    return loss

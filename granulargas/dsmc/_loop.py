@@ -44,7 +44,7 @@ pairs come from the counter-based pair stream, so the rows of the pairs
 import math
 
 from granulargas._numba import inlined, jit
-from granulargas.dsmc._collide import apply_pair_update, normal_part_2d, normal_part_3d
+from granulargas.dsmc._collide import apply_pair_update, apply_rough_update, normal_part_2d, normal_part_3d
 from granulargas.dsmc._majorant import build_histogram, class_edge, speed_class, top_classes
 from granulargas.dsmc._random import pair_of, uniform
 from granulargas.engine._collide import VISCOELASTIC, restitution
@@ -132,7 +132,7 @@ def recentre(rec, mass, mono, dim, hist):
 
 @jit
 def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, target, budget,
-            recentre_every, ring, scal, iscal, species):
+            recentre_every, ring, scal, iscal, species, rough=None):
     """Collide until ``until``, ``target`` collisions or about ``budget`` candidates.
 
     Parameters
@@ -162,6 +162,10 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
     species : None or Species
         A mixture's law per pair of species, acceptance weights and pair counts
         (:class:`granulargas.engine._state.Species`, particle order = id order).
+    rough : Spins or None
+        Rough particles: the spins and the tangential law
+        (:class:`granulargas.engine._state.Spins`; :func:`apply_rough_update`). None: smooth
+        particles (the loop is then compiled without the rough update).
 
     Returns
     -------
@@ -280,8 +284,13 @@ def advance(rec, radius, mass, mono, dim, hist, rng, kind, fpar, coeffs, until, 
             break
         oi = _class_of(rec, i, dim)
         oj = _class_of(rec, j, dim)
-        apply_pair_update(rec, i, j, dim, px, py, pz, eps, mi, mj)
-        dissipated += 0.5 * (1.0 - eps * eps) * m_eff * gn2
+        if rough is not None:
+            ri = r0 if mono else radius[i]
+            rj = r0 if mono else radius[j]
+            dissipated += apply_rough_update(rec, rough, i, j, dim, px, py, pz, gn2, eps, mi, mj, ri, rj)
+        else:
+            apply_pair_update(rec, i, j, dim, px, py, pz, eps, mi, mj)
+            dissipated += 0.5 * (1.0 - eps * eps) * m_eff * gn2
         count_pair(species, i, j)
         time = t_next
         pi = -1

@@ -18,10 +18,19 @@ from granulargas.dsmc import _loop
 from granulargas.dsmc._majorant import build_histogram, class_edge, largest_component, new_histogram, top_classes
 from granulargas.dsmc._random import STATE_WORDS, seed_state
 from granulargas.engine._drive import kick_scale, kick_velocities
-from granulargas.engine.driving import WhiteNoise
+from granulargas.engine._spin import kick_spin_rows
 from granulargas.engine._state import species_record
-from granulargas.engine.rules import CollisionRule
+from granulargas.engine._state import spins as spins_record
+from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.pairs import pair_count_matrix, species_of_state
+from granulargas.engine.rules import CollisionRule
+from granulargas.engine.tangential import (
+    TangentialRule,
+    public_spins,
+    rotational_temperature,
+    spin_kick_scale,
+    spins_of,
+)
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
 from granulargas.observables import energy_moments, kinetic_energy_momentum
 from granulargas.state import PARTICLE_FIELDS, DSMCContinuation, State
@@ -85,7 +94,13 @@ class DSMC:
         particle id), from the state's ``kick_step`` on (None: the first after
         ``time``). After a kick the pending collision, accepted against the old
         velocities, is dropped and the majorant restarts from the kick time (the
-        majorant process is memoryless, so this is exact).
+        majorant process is memoryless, so this is exact). Rough particles: its
+        ``rotational_fraction`` of the power goes to the spins, as in the engine.
+    tangential : TangentialRule, optional
+        Rough particles (:class:`granulargas.engine.TangentialRule`): the state's
+        ``angular_velocities`` (default 0) and ``inertia`` (default 2/5 or 1/2) and the
+        engine's rough collision law (:func:`granulargas.dsmc._collide.apply_rough_update`).
+        None: smooth particles.
 
     Notes
     -----
@@ -101,7 +116,7 @@ class DSMC:
 
     def __init__(self, state: State, rule: CollisionRule, *, number_density: float | None = None,
                  packing_fraction: float | None = None, volume: float | None = None, chi: float | None = None,
-                 seed: int = 0, driving: WhiteNoise | None = None):
+                 seed: int = 0, driving: WhiteNoise | None = None, tangential: TangentialRule | None = None):
         if not isinstance(state, State):
             raise TypeError("state must be a granulargas.state.State")
         state.check_shapes()
@@ -114,10 +129,17 @@ class DSMC:
         if not np.all(np.isfinite(vel)):
             raise ConfigError("velocities: non-finite values")
         rad, mas = state.radii.copy(), state.masses.copy()
+        if tangential is not None and not isinstance(tangential, TangentialRule):
+            raise TypeError("tangential must be a granulargas.engine.TangentialRule or None")
+        if isinstance(driving, WhiteNoise) and driving.rotational_fraction > 0.0 and tangential is None:
+            raise ConfigError(f"driving: rotational_fraction = {driving.rotational_fraction}: smooth particles "
+                              "have no spins to drive (give a tangential rule)")
+        self.tangential = tangential
+        own = OWN_FIELDS + (("angular_velocities", "inertia") if tangential is not None else ())
         # per-particle fields the DSMC does not use (a homogeneous gas has no positions and images):
         # kept as they are, returned by ``state``
         self._carried = {f.name: getattr(state, f.name).copy() for f in PARTICLE_FIELDS
-                         if f.name not in OWN_FIELDS + ("positions", "images") and getattr(state, f.name) is not None}
+                         if f.name not in own + ("positions", "images") and getattr(state, f.name) is not None}
         for name, arr in (("radii", rad), ("masses", mas)):
             if not (np.all(arr > 0) and np.all(np.isfinite(arr))):
                 raise ConfigError(f"{name}: every value must be finite and > 0")
@@ -251,6 +273,14 @@ class DSMC:
                 scal[_loop.S_NEXT] = cont.pending_time
         self.frame_velocity = frame
         self._rng = rng
+        # rough particles: spins (N, 3) in id order and the tangential law (None: smooth)
+        self._spins = None
+        if tangential is not None:
+            w3, kappa = spins_of(state)
+            self._kappa = kappa
+            shared = bool(np.all(kappa == kappa[0]))
+            self._spins = spins_record(w3, kappa[:1] if shared else kappa, tangential.code, tangential.restitution,
+                                       tangential.friction, tangential.wall_beta, tangential.wall_mu)
         self._hist = new_histogram()
         iscal[_loop.I_TOP] = build_histogram(rec, d, self._hist)
         self._scal, self._iscal = scal, iscal
@@ -275,7 +305,10 @@ class DSMC:
                                       f"time {time} ((k + 1/2) interval > time)")
             self._kick_mass = mas
             self._kick_ident = np.arange(n, dtype=np.int32)
-            self._kick_scale = kick_scale(driving.heating_rate, dt, n)
+            self._kick_scale = kick_scale(driving.translational_rate, dt, n)
+            if tangential is not None:
+                self._kick_inertia = self._kappa * mas * rad**2
+                self._spin_kick_scale = spin_kick_scale(driving, d)
 
     # ------------------------------------------------------------------ helpers
     def _rate(self):
@@ -335,6 +368,9 @@ class DSMC:
         self._scal[_loop.S_TIME] = (self._kick_step + 0.5) * self.driving.interval
         self._injected += kick_velocities(self._rec, 0, self._kick_mass, self._kick_ident, d,
                                           np.uint64(self.driving.seed), self._kick_step, self._kick_scale)
+        if self._spins is not None:
+            self._injected += kick_spin_rows(self._spins.w, self._kick_inertia, d, np.uint64(self.driving.seed),
+                                             self._kick_step, self._spin_kick_scale)
         self._kick_step += 1
         self._iscal[_loop.I_TOP] = build_histogram(self._rec, d, self._hist)
         self._iscal[_loop.I_PENDING_I] = self._iscal[_loop.I_PENDING_J] = -1
@@ -352,9 +388,15 @@ class DSMC:
         chunk = max(1 << 21, 4 * self.n)
         s = self._scal
         while True:
-            status = _loop.advance(self._rec, self._rad_k, self._mas_k, self._mono, d, self._hist,
-                                   self._rng, self._kind, self._fpar, self._coeffs, until, target,
-                                   chunk, self._recentre_every, self._ring, s, self._iscal, self._species)
+            if self._spins is None:  # smooth particles: the loop without the rough update
+                status = _loop.advance(self._rec, self._rad_k, self._mas_k, self._mono, d, self._hist,
+                                       self._rng, self._kind, self._fpar, self._coeffs, until, target,
+                                       chunk, self._recentre_every, self._ring, s, self._iscal, self._species)
+            else:
+                status = _loop.advance(self._rec, self._rad_k, self._mas_k, self._mono, d, self._hist,
+                                       self._rng, self._kind, self._fpar, self._coeffs, until, target,
+                                       chunk, self._recentre_every, self._ring, s, self._iscal, self._species,
+                                       self._spins)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
@@ -427,6 +469,8 @@ class DSMC:
                      dissipated_energy=self.dissipated_energy, injected_energy=self.injected_energy,
                      kick_step=None if self.driving is None else self.kick_step, dsmc=self.continuation,
                      species_collisions=self.species_collisions,
+                     **({} if self._spins is None else {"angular_velocities": self.angular_velocities,
+                                                        "inertia": self._kappa.copy()}),
                      **{name: value.copy() for name, value in self._carried.items()})
 
     @property
@@ -441,6 +485,31 @@ class DSMC:
         if self._species is None:
             return None
         return pair_count_matrix(self._species.pairs, self.rule.species)
+
+    @property
+    def angular_velocities(self) -> np.ndarray | None:
+        """Rough particles: angular velocities, (N, 3) in 3D and (N, 1) (about z) in 2D (None: smooth)."""
+        return None if self._spins is None else public_spins(self._spins.w, self.dimension)
+
+    @property
+    def inertia(self) -> np.ndarray | None:
+        """Rough particles: kappa = I / (m R^2) of each particle (None: smooth)."""
+        return None if self._spins is None else self._kappa.copy()
+
+    @property
+    def rotational_temperature(self) -> float:
+        """Rough particles: T_rot = sum I |w|^2 / (d_r N) (nan for smooth particles)."""
+        if self._spins is None:
+            return math.nan
+        return rotational_temperature(self._spins.w, self._kappa, np.broadcast_to(self.masses, (self.n,)),
+                                      np.broadcast_to(self.radii, (self.n,)), self.dimension)
+
+    @property
+    def rotational_energy(self) -> float:
+        """Rough particles: sum I |w|^2 / 2 (0 for smooth particles)."""
+        if self._spins is None:
+            return 0.0
+        return 0.5 * self.rotational_temperature * (3 if self.dimension == 3 else 1) * self.n
 
     # ------------------------------------------------------------- observables
     def _moments(self):

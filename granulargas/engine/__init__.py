@@ -2,11 +2,12 @@
 
 Public API (contract in ARCHITECTURE.md)::
 
-    from granulargas.engine import Simulation, CollisionRule, WhiteNoise
+    from granulargas.engine import Simulation, CollisionRule, TangentialRule, WhiteNoise
 """
 
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
 from granulargas.engine.simulation import Simulation
+from granulargas.engine.tangential import TangentialRule
 
-__all__ = ["Simulation", "CollisionRule", "WhiteNoise"]
+__all__ = ["Simulation", "CollisionRule", "TangentialRule", "WhiteNoise"]

@@ -107,6 +107,7 @@ from granulargas.engine._geometry import collision_delay, exit_delay, min_image,
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._resolved import resolved_pair
 from granulargas.engine._species import count_pair, pair_law, wall_law
+from granulargas.engine._spin import kick_spins, rough_pair, rough_wall
 from granulargas.engine._probe import (
     COLLIDE,
     PEEK,
@@ -273,6 +274,41 @@ def _collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
         i, j, te, dx, dy, dz, p, contacts, c, rule, period)
 
 
+def collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
+    """:func:`granulargas.engine._spin.rough_pair` (``spins`` None: never called)."""
+
+
+def bounce_rough(i, a, side, eps, rec, mass, spins, elastic):
+    """:func:`granulargas.engine._spin.rough_wall` (``spins`` None: never called)."""
+
+
+def kick_rough(rec, mass, ident, dims, spins, seed, step):
+    """:func:`granulargas.engine._spin.kick_spins` (``spins`` None: never called)."""
+
+
+@overload(collide_rough)
+def _collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
+    if isinstance(spins, types.NoneType):
+        return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
+    return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: rough_pair(
+        i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic)
+
+
+@overload(bounce_rough)
+def _bounce_rough(i, a, side, eps, rec, mass, spins, elastic):
+    if isinstance(spins, types.NoneType):
+        return lambda i, a, side, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
+    return lambda i, a, side, eps, rec, mass, spins, elastic: rough_wall(i, a, side, eps, rec, mass, spins,
+                                                                         elastic)
+
+
+@overload(kick_rough)
+def _kick_rough(rec, mass, ident, dims, spins, seed, step):
+    if isinstance(spins, types.NoneType):
+        return lambda rec, mass, ident, dims, spins, seed, step: 0.0
+    return lambda rec, mass, ident, dims, spins, seed, step: kick_spins(rec, mass, ident, dims, spins, seed, step)
+
+
 @inlined
 def predict_wall(i, t, rec, space):
     """Earliest wall collision of particle i (streamed to t): (time, wall index 2 a + side).
@@ -407,14 +443,16 @@ def _collapse_watch(i, te, p, prm):
 
 
 @inlined_ir
-def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, species):
+def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins, species):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
     Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
     ``c.err_j`` set). With ``contacts`` (the resolved rule; None otherwise) the pair collides by
-    :func:`granulargas.engine._resolved.resolved_pair`. With ``species`` (a mixture; None
-    otherwise) the pair's law comes from the species table and the collision is counted per
-    pair of species (:mod:`granulargas.engine._species`).
+    :func:`granulargas.engine._resolved.resolved_pair`; with ``spins`` (rough particles; None
+    otherwise) by :func:`granulargas.engine._spin.rough_pair`, except the TC model's elastic
+    collisions, which are also frictionless. With ``species`` (a mixture; None otherwise) the
+    pair's normal law comes from the species table and the collision is counted per pair of
+    species (:mod:`granulargas.engine._species`); the tangential law is the same for every pair.
     """
     rec = p.rec
     period = prm.space.period
@@ -455,13 +493,18 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
                 c.err_i = i
                 c.err_j = j
                 return TABLE_RANGE
-        fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
-        rec[i, 3] -= fi * nx
-        rec[i, 4] -= fi * ny
-        rec[i, 5] -= fi * nz
-        rec[j, 3] += fj * nx
-        rec[j, 4] += fj * ny
-        rec[j, 5] += fj * nz
+        if spins is not None:
+            elastic = rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time)
+            loss, impulse, drot = collide_rough(i, j, nx, ny, nz, un, eps, rec, p.mass, spins, elastic)
+            c.sum_mv2 -= 2.0 * drot
+        else:
+            fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
+            rec[i, 3] -= fi * nx
+            rec[i, 4] -= fi * ny
+            rec[i, 5] -= fi * nz
+            rec[j, 3] += fj * nx
+            rec[j, 4] += fj * ny
+            rec[j, 5] += fj * nz
         c.dissipated += loss
         c.sum_mv2 -= 2.0 * loss
         c.virial -= impulse * dist
@@ -515,9 +558,11 @@ def execute_crossing(i, face, te, p, grid, c, prm):
 
 
 @kernel(python=False)
-def execute_wall(i, wall, te, p, c, walls, prm, species):
+def execute_wall(i, wall, te, p, c, walls, prm, spins, species):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
-    m_eff = m_i (a mixture: the law of i's species). Returns DONE or TABLE_RANGE."""
+    m_eff = m_i (rough particles: :func:`granulargas.engine._spin.rough_wall`, except the TC
+    model's elastic collisions; a mixture: the normal law of i's species). Returns DONE or
+    TABLE_RANGE."""
     rec = p.rec
     rule = prm.rule
     stream(i, te, rec, p.img, prm.space.period)
@@ -536,8 +581,13 @@ def execute_wall(i, wall, te, p, c, walls, prm, species):
                 c.err_i = i
                 c.err_j = -1
                 return TABLE_RANGE
-        v_new, loss, impulse = wall_collision(vn, mi, eps)
-        rec[i, 3 + a] = v_new
+        if spins is not None:
+            elastic = rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time
+            loss, impulse, drot = bounce_rough(i, a, side, eps, rec, p.mass, spins, elastic)
+            c.sum_mv2 -= 2.0 * drot
+        else:
+            v_new, loss, impulse = wall_collision(vn, mi, eps)
+            rec[i, 3 + a] = v_new
         c.dissipated += loss
         c.sum_mv2 -= 2.0 * loss
         walls.impulse[a, side] += impulse
@@ -552,15 +602,18 @@ def execute_wall(i, wall, te, p, c, walls, prm, species):
 
 
 @kernel(python=False)
-def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts):
-    """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1);
-    every event predicted anew and the calendar rebuilt (O(N))."""
+def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins):
+    """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1; rough
+    particles' spins too, :func:`granulargas.engine._spin.kick_spins`); every event predicted
+    anew and the calendar rebuilt (O(N))."""
     rec = p.rec
     n = rec.shape[0]
     for i in range(n):
         stream(i, t, rec, p.img, prm.space.period)
     c.injected += kick_velocities(rec, 3, p.mass, p.ident, prm.space.dims, prm.kick_seed,
                                   c.kick_step, prm.kick_scale)
+    if spins is not None:
+        c.injected += kick_rough(rec, p.mass, p.ident, prm.space.dims, spins, prm.kick_seed, c.kick_step)
     s = 0.0
     for i in range(n):
         s += p.mass[i] * (rec[i, 3] * rec[i, 3] + rec[i, 4] * rec[i, 4] + rec[i, 5] * rec[i, 5])
@@ -697,6 +750,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
     c = engine.counters[0]
     walls = engine.walls
     contacts = engine.contacts
+    spins = engine.spins
     species = engine.species
     rec = p.rec
     time = c.time
@@ -745,7 +799,8 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if onlists is not None:  # j's list row is in cache: start the misses of predict(j)
                 for k in range(lists.nbn[j]):
                     prefetch(rec, lists.nbl[j, k])
-            status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, species)
+            status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins,
+                                  species)
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
@@ -758,7 +813,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if status != DONE:
                 break
         elif j == WALL:
-            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, species)
+            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, spins, species)
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:
@@ -826,7 +881,7 @@ def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisi
         if status != DONE or t_kick > until:
             return status
         status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
-                              engine.calendar, c, prm, engine.contacts)
+                              engine.calendar, c, prm, engine.contacts, engine.spins)
         c.events += 1
         if status != DONE or c.time >= until:
             return status

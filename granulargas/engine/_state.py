@@ -64,6 +64,11 @@ Record layout
   contact's partner (-1: none); work space ``work`` (3,) and ``out`` (5,) f8 of
   the table lookup. None for the other rules, whose loop then compiles without
   any of this (:func:`granulargas.engine._loop.in_contact`).
+* ``spins`` :class:`Spins` -- rough particles (:mod:`granulargas.engine._spin`):
+  ``w`` (N, 3) f8 angular velocities (2D: the z column), ``kappa`` (N,) f8 = I / (m R^2),
+  and the tangential law (``model``, ``beta``, ``mu``, ``wall_beta``, ``wall_mu``) and the
+  spin-kick scale of the driving (``kick_scale``). None for smooth particles, whose
+  loop then compiles without any of this.
 * ``species`` :class:`Species` -- the collision law per pair of species
   (:mod:`granulargas.engine._species`): ``of`` i4 the species of each slot, ``count``
   the number S of species, ``eps`` and ``prefactor`` (S*S,) f8 the pair table,
@@ -87,10 +92,11 @@ Grid = namedtuple("Grid", ["head", "cell", "width", "pair_t", "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
 Walls = namedtuple("Walls", ["impulse"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
+Spins = namedtuple("Spins", ["w", "kappa", "model", "beta", "mu", "wall_beta", "wall_mu", "kick_scale"])
 Species = namedtuple("Species", ["of", "count", "eps", "prefactor", "wall_eps", "wall_prefactor", "weight",
                                  "pairs"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
-                               "walls", "contacts", "species"])
+                               "walls", "contacts", "spins", "species"])
 
 # Read-only parameters.
 #: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
@@ -161,6 +167,12 @@ def contacts(n: int, until=None, partner=None) -> Contacts:
     return Contacts(u, q, np.zeros(3), np.zeros(5))
 
 
+def spins(w, kappa, model: int, beta: float, mu: float, wall_beta: float, wall_mu: float,
+          kick_scale: float = 0.0) -> Spins:
+    """A :class:`Spins` record with the dtypes the kernels are compiled for (``w`` (N, 3),
+    ``kappa`` (N,), both in memory order)."""
+    return Spins(np.ascontiguousarray(w, dtype=np.float64), np.ascontiguousarray(kappa, dtype=np.float64),
+                 int(model), float(beta), float(mu), float(wall_beta), float(wall_mu), float(kick_scale))
 def species_record(of, table, pairs=None, weight=None) -> Species:
     """A :class:`Species` record for the slots' species ``of`` and a
     :class:`granulargas.engine.pairs.PairTable` (``pairs``: the counts to continue from;

@@ -31,6 +31,13 @@ from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.pairs import pair_count_matrix, species_of_state
 from granulargas.engine.rules import CollisionRule
+from granulargas.engine.tangential import (
+    TangentialRule,
+    public_spins,
+    rotational_temperature,
+    spin_kick_scale,
+    spins_of,
+)
 from granulargas.errors import (
     ConfigError,
     InelasticCollapseError,
@@ -44,6 +51,8 @@ _INT_MAX = np.iinfo(np.int64).max
 #: the others as it was given them
 OWN_FIELDS = ("positions", "velocities", "images", "radii", "masses", "last_collision", "contact_until",
               "contact_partner")
+#: and, with a tangential rule (rough particles), these too
+ROUGH_FIELDS = ("angular_velocities", "inertia")
 #: boundary conditions of an axis
 BOUNDARIES = ("periodic", "wall")
 #: neighbour search: neighbour lists with a shell, cell crossings (no lists), or the
@@ -202,6 +211,13 @@ class Simulation:
         Remove the centre-of-mass velocity that round-off accumulates on the
         periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
         e.g. a mean flow given on purpose.
+    tangential : TangentialRule, optional
+        Rough particles (:class:`granulargas.engine.TangentialRule`): the particles spin, with
+        the state's ``angular_velocities`` (default 0) and ``inertia`` kappa = I / (m R^2)
+        (default 2/5 for spheres, 1/2 for disks), and collisions (pairs and walls) change the
+        tangential velocity of the contact points by that rule (:mod:`granulargas.engine._rough`).
+        None: smooth particles (the loop is compiled without spins). The driving's
+        ``rotational_fraction`` of the power goes to the spins.
 
     Notes
     -----
@@ -222,7 +238,7 @@ class Simulation:
 
     def __init__(self, state: State, rule: CollisionRule, *, driving: WhiteNoise | None = None,
                  neighbours: str = "lists", shell: float | None = None, collapse_count: int = 100,
-                 remove_drift: bool = True):
+                 remove_drift: bool = True, tangential: TangentialRule | None = None):
         if not isinstance(state, State):
             raise TypeError("state must be a granulargas.state.State")
         if state.positions is None:
@@ -281,13 +297,25 @@ class Simulation:
             raise ConfigError("contact_partner: particle ids in [0, N) or -1; contact_until: no NaN")
         self._contact_until, self._contact_partner = cu, cp
         self._three_body = state.three_body_contacts
+        # rough particles: spins (N, 3) and kappa in id order (engine.tangential)
+        if tangential is not None and not isinstance(tangential, TangentialRule):
+            raise TypeError("tangential must be a granulargas.engine.TangentialRule or None")
+        if tangential is not None and rule.resolved:
+            raise ConfigError('tangential: rough particles need instantaneous collisions (the resolved '
+                              'contact, duration = "resolved", is frictionless)')
+        if driving is not None and driving.rotational_fraction > 0.0 and tangential is None:
+            raise ConfigError(f"driving: rotational_fraction = {driving.rotational_fraction}: smooth particles "
+                              "have no spins to drive (give a tangential rule)")
+        self.tangential = tangential
+        self._spins, self._kappa = spins_of(state) if tangential is not None else (None, None)
         # a mixture: the species of every particle index the rule's pair table
         self._species_of = self._pair_counts = None
         if rule.pairs is not None:
             self._species_of, self._pair_counts = species_of_state(state, rule)
         # per-particle fields the engine does not use: kept as they are, returned by ``state``
+        own = OWN_FIELDS + (ROUGH_FIELDS if tangential is not None else ())
         self._carried = {f.name: getattr(state, f.name).copy() for f in PARTICLE_FIELDS
-                         if f.name not in OWN_FIELDS and getattr(state, f.name) is not None}
+                         if f.name not in own and getattr(state, f.name) is not None}
 
         self._positions, self._velocities, self._images, self._last_collision = pos, vel, img, lc
         self._radii, self._masses, self._box = rad, mas, bx
@@ -478,11 +506,15 @@ class Simulation:
         c["three_body"] = self._three_body
         c["err_i"] = c["err_j"] = -1
         walls = _state.Walls(impulse=self._wall_impulse.copy())
+        tg = self.tangential  # rough particles; None: the loop compiles without spins
+        spins = None if tg is None else _state.spins(
+            self._spins[order], self._kappa[order], tg.code, tg.restitution, tg.friction, tg.wall_beta, tg.wall_mu,
+            spin_kick_scale(self.driving, self.dimension))
         # a rule without a pair table compiles the loop without the species (None)
         species = None if self._species_of is None else _state.species_record(
             self._species_of[order], self.rule.pairs, self._pair_counts)
         self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts,
-                                     species)
+                                     spins, species)
         self._place_events(self._time)
         self._built = True
 
@@ -529,7 +561,7 @@ class Simulation:
         scale = 2.0 * float(self._radii.min()) / math.sqrt(v2) if v2 > 0 else 1.0
         drv = self.driving
         kick = {} if drv is None else dict(
-            kick_interval=drv.interval, kick_scale=kick_scale(drv.heating_rate, drv.interval, self.n),
+            kick_interval=drv.interval, kick_scale=kick_scale(drv.translational_rate, drv.interval, self.n),
             kick_seed=drv.seed)
         return _state.params(self.rule.compiled(), self._space, self.shell, float(self._radii.max()),
                              1e-10 * scale, self.collapse_count, **kick)
@@ -722,6 +754,9 @@ class Simulation:
             self._kick_step = int(c["kick_step"])
             self._three_body = int(c["three_body"])
             self._wall_impulse = e.walls.impulse.copy()
+            if e.spins is not None:
+                self._spins = np.empty((n, 3))
+                self._spins[inv] = e.spins.w
             if e.species is not None:
                 self._pair_counts = e.species.pairs.copy()
             if e.contacts is not None:
@@ -830,6 +865,38 @@ class Simulation:
         out[self._order] = self._engine.particles.lastcoll
         return out
 
+    def _spin_rows(self) -> np.ndarray:
+        """The spins (N, 3) in id order (2D: the last column)."""
+        if not self._built:
+            return self._spins
+        out = np.empty((self.n, 3))
+        out[self._order] = self._engine.spins.w
+        return out
+
+    @property
+    def angular_velocities(self) -> np.ndarray | None:
+        """Rough particles: angular velocities, (N, 3) in 3D and (N, 1) (about z) in 2D (None: smooth)."""
+        return None if self.tangential is None else public_spins(self._spin_rows(), self.dimension)
+
+    @property
+    def inertia(self) -> np.ndarray | None:
+        """Rough particles: kappa = I / (m R^2) of each particle (None: smooth)."""
+        return None if self._kappa is None else self._kappa.copy()
+
+    @property
+    def rotational_temperature(self) -> float:
+        """Rough particles: T_rot = sum I |w|^2 / (d_r N) (nan for smooth particles)."""
+        if self.tangential is None:
+            return math.nan
+        return rotational_temperature(self._spin_rows(), self._kappa, self._masses, self._radii, self.dimension)
+
+    @property
+    def rotational_energy(self) -> float:
+        """Rough particles: sum I |w|^2 / 2 (0 for smooth particles)."""
+        if self.tangential is None:
+            return 0.0
+        return 0.5 * self.rotational_temperature * (3 if self.dimension == 3 else 1) * self.n
+
     @property
     def radii(self) -> np.ndarray:
         return self._radii.copy()
@@ -875,6 +942,8 @@ class Simulation:
             dissipated_energy=self.dissipated_energy, wall_collisions=self.wall_collisions,
             injected_energy=self.injected_energy, kick_step=None if self.driving is None else self.kick_step,
             three_body_contacts=self.three_body_contacts, species_collisions=self.species_collisions,
+            **({} if self.tangential is None else {"angular_velocities": self.angular_velocities,
+                                                   "inertia": self._kappa.copy()}),
             **{name: value.copy() for name, value in self._carried.items()})
 
     # ------------------------------------------------------------ observables

@@ -636,6 +636,14 @@ def maxwell_velocities(masses, dimension, temperature=1.0, seed=0, rng=None):
     return v
 
 
+def maxwell_spins(moments, dimension, temperature=1.0, rng=None):
+    """Maxwell-Boltzmann angular velocities of rough particles with moments of inertia
+    ``moments`` (N,): (N, 3) in 3D, (N, 1) (about z) in 2D, zero total spin angular momentum
+    sum I w = 0 and rotational temperature sum I |w|^2 / (d_r N) exactly ``temperature``
+    (d_r = 3 or 1; :func:`maxwell_velocities` with the moments in place of the masses)."""
+    return maxwell_velocities(moments, 3 if dimension == 3 else 1, temperature, rng=rng)
+
+
 #: smallest wall axis in largest diameters: the placement box is one diameter shorter
 #: than the wall axis and needs the engine's 3.15 (three cells) itself
 MIN_WALL_AXIS_DIAMETERS = 4.15

@@ -69,6 +69,14 @@ CONTACT_ENDS = ("overlap", "force")
 DURATIONS = ("instantaneous", "resolved")
 BOUNDARIES = ("periodic", "wall")
 DRIVING_MODELS = ("white_noise",)
+#: ``[collision.tangential] model``: a constant tangential restitution, or Walton's Coulomb model
+TANGENTIAL_MODELS = ("constant", "coulomb")
+#: ``particles.inertia`` kappa = 4 I / (m sigma^2): uniform sphere 2/5, uniform disk 1/2 (also
+#: ``granulargas.theory.rough.DEFAULT_INERTIA``)
+DEFAULT_INERTIA = {3: 0.4, 2: 0.5}
+#: largest kappa: all the mass on the surface, a thin shell 2/3 or a ring 1
+#: (``granulargas.theory.rough.MAX_INERTIA``)
+MAX_INERTIA = {3: 2.0 / 3.0, 2: 1.0}
 #: ``run.method``: event-driven molecular dynamics, or DSMC of the homogeneous Enskog-Boltzmann equation
 METHODS = ("edmd", "dsmc")
 #: ``run.neighbours``: the engine's neighbour search (``engine.simulation.NEIGHBOURS``)
@@ -120,6 +128,7 @@ class ParticlesConfig:
     diameter_max: float | None = None
     mass: float | None = 1.0
     density: float | None = None
+    inertia: float | None = None  # kappa of rough particles (None: smooth, no spins)
 
     @property
     def polydisperse(self) -> bool:
@@ -156,10 +165,12 @@ class SpeciesConfig:
 
 @dataclass(frozen=True)
 class InitialConfig:
-    """``[initial]``: Maxwell-Boltzmann temperature, or a file to continue from."""
+    """``[initial]``: Maxwell-Boltzmann temperature, or a file to continue from;
+    ``rotational_temperature`` of the spins of rough particles (None: smooth particles)."""
 
     temperature: float = 1.0
     from_file: str | None = None  # TOML key "from"
+    rotational_temperature: float | None = None
 
 
 @dataclass(frozen=True)
@@ -179,6 +190,21 @@ class MaterialConfig:
     diameter: float
     density: float
     speed_unit: float
+
+
+@dataclass(frozen=True)
+class TangentialConfig:
+    """``[collision.tangential]``: rough particles. ``model = "constant"``: the tangential
+    restitution beta_t = ``restitution`` (-1 smooth, +1 perfectly rough); ``"coulomb"``:
+    Walton's model, sticking contacts get beta_0 = ``restitution``, sliding ones the Coulomb
+    limit of ``friction`` mu. ``wall_restitution``, ``wall_friction``: the same for
+    particle-wall contacts (default: the pair values)."""
+
+    model: str = "constant"
+    restitution: float = -1.0
+    friction: float | None = None
+    wall_restitution: float | None = None
+    wall_friction: float | None = None
 
 
 @dataclass(frozen=True)
@@ -209,6 +235,12 @@ class CollisionConfig:
     tc_time: float | None = None
     wall_restitution: float | dict | None = None
     duration: str = "instantaneous"
+    tangential: TangentialConfig | None = None
+
+    @property
+    def rough(self) -> bool:
+        """Rough particles (spins and a tangential restitution)."""
+        return self.tangential is not None
 
     @staticmethod
     def pair_table(value, names) -> list:
@@ -245,11 +277,19 @@ class DrivingConfig:
     Gaussian velocity kicks (momentum-conserving) that raise the temperature at
     ``heating_rate`` (dT/dt of the driving alone, T0 per time unit); ``interval``
     between kicks (default: 0.02 of the theoretical steady state's cooling time,
-    :func:`granulargas.theory.driving_interval`)."""
+    :func:`granulargas.theory.driving_interval`). Rough particles: ``rotational_fraction``
+    of the power (``d/2 heating_rate`` per particle) goes to the spins (the splitting
+    thermostat of Megías & Santos 2022)."""
 
     model: str = "white_noise"
     heating_rate: float = 0.0
     interval: float | None = None
+    rotational_fraction: float | None = None  # None: 0, the translation alone
+
+    @property
+    def spin_fraction(self) -> float:
+        """The fraction of the power that goes to the spins (0 when ``rotational_fraction`` is absent)."""
+        return 0.0 if self.rotational_fraction is None else self.rotational_fraction
 
 
 @dataclass(frozen=True)
@@ -490,6 +530,11 @@ SCHEMA: tuple[Key, ...] = (
         "Instead of `mass`: mass = density × π d³/6 (3D) or π d²/4 (2D); the masses it gives must "
         "lie in the range of `mass`.", unit="reference mass per reference volume",
         low=0.0, low_open=True, high=1e250, reason="finite; the masses it gives are checked like `mass`"),
+    Key("particles", "inertia", "number",
+        "Rough particles (`[collision.tangential]`): κ = 4I/(mσ²), the moment of inertia I in units "
+        "of m σ²/4; a uniform sphere has 2/5, a uniform disk 1/2, and all particles share it.",
+        default_text="2/5 (spheres), 1/2 (disks)", low=0.0, low_open=True, high_by_dimension=MAX_INERTIA,
+        reason="no mass outside the surface: at most a thin shell (2/3) or a ring (1)"),
     # [initial]
     Key("initial", "temperature", "number",
         "Maxwell–Boltzmann velocities with zero total momentum and exactly this temperature "
@@ -499,6 +544,11 @@ SCHEMA: tuple[Key, ...] = (
         "collisions and dissipated energy continue; box, radii and masses come from the file; "
         "`dimension` and `particles` must match). Same as `--restart`.",
         field="from_file", run_check="the file must exist and hold a complete snapshot"),
+    Key("initial", "rotational_temperature", "number",
+        "Rough particles (`[collision.tangential]`): Maxwell–Boltzmann spins with zero total angular "
+        "momentum and exactly this rotational temperature T_rot = I⟨ω²⟩/d_r (d_r = 3 for spheres, 1 "
+        "for disks); 0 starts without spin.", default_text="`temperature`", unit="T0",
+        low=0.0, high=SCALE_RANGE[1], reason="spin speeds within float64 as for `temperature`"),
     # [collision]
     Key("collision", "model", "string",
         "The coefficient of restitution: elastic, constant, or the viscoelastic ε(g) of the contact law.",
@@ -540,6 +590,9 @@ SCHEMA: tuple[Key, ...] = (
     Key("collision", "material", "table",
         "Instead of `damping`: the viscoelastic contact from material constants "
         "(`[collision.material]`, below)."),
+    Key("collision", "tangential", "table",
+        "Rough particles: spins and a tangential restitution (`[collision.tangential]`, below); "
+        "without it the particles are smooth and do not spin."),
     # [collision.material]
     Key("collision.material", "young_modulus", "number",
         "Young's modulus Y (a mixture: of the species that give none).", unit="Pa",
@@ -560,6 +613,27 @@ SCHEMA: tuple[Key, ...] = (
     Key("collision.material", "speed_unit", "number",
         "The reduced velocity unit √(T0/m); time is then in diameter / speed_unit.", unit="m/s",
         low=SI_RANGE[0], high=SI_RANGE[1], reason="the reduced prefactor stays finite", required_in_table=True),
+    # [collision.tangential]
+    Key("collision.tangential", "model", "string",
+        '`"constant"`: the tangential restitution β_t = `restitution` reverses the tangential velocity '
+        'of the contact points, g_t → −β_t g_t; `"coulomb"`: Walton\'s model, a contact sticks with '
+        "β_t = `restitution` unless the tangential impulse would exceed `friction` × the normal one, "
+        "and then slides (β_t then depends on the impact angle).", default="constant",
+        choices=TANGENTIAL_MODELS),
+    Key("collision.tangential", "restitution", "number",
+        "The tangential restitution β_t (`model = \"coulomb\"`: of sticking contacts): −1 smooth "
+        "(no spin exchange), 0 the tangential contact velocity stopped, +1 perfectly rough "
+        "(reversed, no loss). Not the viscoelastic `damping`.", low=-1.0, high=1.0,
+        reason="|beta_t| <= 1: a collision cannot create energy", required_in_table=True),
+    Key("collision.tangential", "friction", "number",
+        '`model = "coulomb"` only: the friction coefficient μ of the Coulomb limit.',
+        low=0.0, high=SI_RANGE[1], reason="a friction coefficient is >= 0"),
+    Key("collision.tangential", "wall_restitution", "number",
+        "With walls: β_t of particle–wall contacts (default: `restitution`).", low=-1.0, high=1.0,
+        reason="|beta_t| <= 1: a collision cannot create energy"),
+    Key("collision.tangential", "wall_friction", "number",
+        '`model = "coulomb"` with walls: μ of particle–wall contacts (default: `friction`).',
+        low=0.0, high=SI_RANGE[1], reason="a friction coefficient is >= 0"),
     # [[species]]
     Key("species", "name", "string",
         "The species' name (letters, digits and `_`): it names the species in the per-pair tables "
@@ -610,6 +684,11 @@ SCHEMA: tuple[Key, ...] = (
         "Time between kicks; observables are sampled half-way between kicks.",
         default_text="0.02 of the cooling time of the theoretical steady state", unit="reduced time",
         low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
+    Key("driving", "rotational_fraction", "number",
+        "Rough particles (`[collision.tangential]`): the fraction of the driving's power that goes to "
+        "the spins as random angular-velocity kicks (the splitting thermostat of Megías & Santos 2022); "
+        "the power per particle is d/2 × `heating_rate`, so 0 heats the translation alone at "
+        "`heating_rate`.", default_text="0", low=0.0, high=1.0, reason="a fraction of the power"),
     # [run]
     Key("run", "end_time", "number",
         "Stop at this time (give `end_time`, `collisions_per_particle` or both; the first reached stops).",
@@ -661,7 +740,8 @@ SCHEMA: tuple[Key, ...] = (
 #: section -> its dataclass (sub-tables: the dataclass of the table)
 SECTION_CLASSES = {
     "system": SystemConfig, "particles": ParticlesConfig, "initial": InitialConfig,
-    "collision": CollisionConfig, "collision.material": MaterialConfig, "driving": DrivingConfig,
+    "collision": CollisionConfig, "collision.material": MaterialConfig,
+    "collision.tangential": TangentialConfig, "driving": DrivingConfig,
     "run": RunSection, "output": OutputConfig, "species": SpeciesConfig,
 }
 SECTIONS = ("system", "particles", "initial", "collision", "driving", "run", "output", "species")
@@ -674,7 +754,7 @@ _NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123
 #: sections that may be left out as a whole (absent: None in RunConfig)
 OPTIONAL_SECTIONS = ("driving",)
 #: keys whose value is a sub-table with its own section in SCHEMA
-SUBTABLES = {"collision.material": "collision.material"}
+SUBTABLES = {"collision.material": "collision.material", "collision.tangential": "collision.tangential"}
 #: keys that take a number or an inline table of sub-keys (dotted in SCHEMA)
 INLINE_TABLES = {"particles.diameter": ("min", "max")}
 
@@ -980,6 +1060,39 @@ def _check_dsmc_supported(v: Values):
                                     'method = "dsmc" (a homogeneous DSMC gas shows no inelastic collapse)')
 
 
+_ROUGH_KEYS = ("particles.inertia", "initial.rotational_temperature", "driving.rotational_fraction")
+
+
+def _check_rough_keys_need_tangential(v: Values):
+    if v.has("collision.tangential"):
+        return
+    for dotted in _ROUGH_KEYS:
+        if v.has(dotted):
+            v.fail(dotted, "is for rough particles: give a [collision.tangential] table (model, restitution) "
+                           "to let the particles spin")
+
+
+def _check_tangential(v: Values):
+    if not v.has("collision.tangential"):
+        return
+    model = v.get("collision.tangential.model")
+    if model == "coulomb" and not v.has("collision.tangential.friction"):
+        v.fail("collision.tangential.friction", 'missing; model = "coulomb" needs friction >= 0 (the Coulomb '
+                                                "limit of the tangential impulse)")
+    for key in ("friction", "wall_friction"):
+        if model != "coulomb" and v.has(f"collision.tangential.{key}"):
+            v.fail(f"collision.tangential.{key}", f'is only used with model = "coulomb" (model = "{model}": '
+                                                  "a constant tangential restitution has no friction)")
+    boundary = v.get("system.boundary")
+    for key in ("wall_restitution", "wall_friction"):
+        if v.has(f"collision.tangential.{key}") and (boundary is None or "wall" not in boundary):
+            v.fail(f"collision.tangential.{key}", 'is only used with walls (system.boundary with a "wall" entry)')
+    if v.get("collision.duration") == "resolved":
+        v.fail("collision.tangential", 'rough particles need instantaneous collisions: the resolved contact '
+                                       '(collision.duration = "resolved") is frictionless', _Shown("{...}"))
+    if v.species:
+        v.fail("collision.tangential", "a config takes rough particles of one kind, not a mixture ([[species]]): "
+                                       "rough mixtures run from Python (docs/rough.md)", _Shown("{...}"))
 # ------------------------------------------------------------------ [[species]]
 
 
@@ -1224,6 +1337,12 @@ RULES: tuple[Rule, ...] = (
     Rule("`[driving]` needs `heating_rate`.", _check_driving_needs_heating_rate),
     Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls and no `tc_time`.',
          _check_dsmc_supported),
+    Rule("`inertia`, `rotational_temperature` and `rotational_fraction` are for rough particles: they need "
+         "`[collision.tangential]`.", _check_rough_keys_need_tangential),
+    Rule('`[collision.tangential]`: `model = "coulomb"` needs `friction`; `friction` and `wall_friction` '
+         'are only used with `"coulomb"`, `wall_restitution` and `wall_friction` only with walls; rough '
+         'particles need `duration = "instantaneous"` and one kind of particle (no `[[species]]`).',
+         _check_tangential),
 )
 
 
@@ -1465,14 +1584,23 @@ def _assemble(values: Values, source: str, text: str) -> RunConfig:
         v["output.file"] = default_output(source)
     if v.get("system.boundary") is None:
         v["system.boundary"] = ("periodic",) * v["system.dimension"]
-    material = None
+    material = tangential = None
     if values.has("collision.material"):
         material = MaterialConfig(**{k.attribute: v[k.dotted] for k in SCHEMA if k.section == "collision.material"})
+    if values.has("collision.tangential"):
+        tangential = TangentialConfig(**{k.attribute: v[k.dotted] for k in SCHEMA
+                                         if k.section == "collision.tangential"})
+        # rough particles: the defaults that depend on other keys
+        if v.get("particles.inertia") is None:
+            v["particles.inertia"] = DEFAULT_INERTIA[v["system.dimension"]]
+        if v.get("initial.rotational_temperature") is None:
+            v["initial.rotational_temperature"] = v["initial.temperature"]
 
     def section(name):
         kwargs = {k.attribute: v[k.dotted] for k in SCHEMA if k.section == name and k.dotted not in SUBTABLES}
         if name == "collision":
             kwargs["material"] = material
+            kwargs["tangential"] = tangential
         return SECTION_CLASSES[name](**kwargs)
 
     parts = {s: section(s) if s not in OPTIONAL_SECTIONS or s in values.sections else None
@@ -1514,8 +1642,11 @@ def dump_toml(config: RunConfig) -> str:
     lines = [f"# resolved from {config.source}"]
     objects = {s: getattr(config, s) for s in SECTIONS if s not in ARRAY_SECTIONS}
     objects["collision.material"] = config.collision.material
-    if config.species:
-        objects["particles"] = None  # [[species]] in its place
+    objects["collision.tangential"] = config.collision.tangential
+    # [[species]] in place of [particles], which then holds at most the rough particles' inertia
+    mixed = {"particles": ("inertia",)} if config.species else {}
+    if config.species and config.particles.inertia is None:
+        objects["particles"] = None
     for name in tuple(objects):
         obj = objects[name]
         if obj is None:
@@ -1523,6 +1654,8 @@ def dump_toml(config: RunConfig) -> str:
         lines.append(f"\n[{name}]")
         for key in SCHEMA:
             if key.section != name or key.dotted in SUBTABLES or key.dotted.startswith(tuple(f"{t}." for t in INLINE_TABLES)):
+                continue
+            if name in mixed and key.key not in mixed[name]:
                 continue
             if key.dotted in INLINE_TABLES and getattr(obj, "polydisperse", False):
                 subs = ", ".join(f"{s} = {getattr(obj, f'{key.key}_{s}')!r}" for s in INLINE_TABLES[key.dotted])

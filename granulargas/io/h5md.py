@@ -113,6 +113,8 @@ DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_p
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
 RESOLVED_OBSERVABLES = ("three_body_contacts",)
+#: observables of runs of rough particles (those that store angular velocities)
+ROUGH_OBSERVABLES = ("rotational_temperature", "cumulant_a20", "cumulant_a02", "cumulant_a11")
 #: observables of a mixture of S species: one value per species, the collisions (S, S) per pair
 SPECIES_OBSERVABLES = ("species_temperature", "species_sonine_a2", "species_collisions")
 _SPECIES_DESCRIPTIONS = {
@@ -224,6 +226,7 @@ class H5MDWriter:
         self.boundary = state.boundary
         extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
                  + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ())
+                 + (ROUGH_OBSERVABLES if "angular_velocities" in self.fields else ())
                  + (SPECIES_OBSERVABLES if species else ()))
         self.species = int(species)
         names = SCALAR_OBSERVABLES + ("momentum",) + extra
@@ -357,7 +360,8 @@ class H5MDWriter:
         groups.append(e)
         self._frame_groups = groups
         for fld in PARTICLE_FIELDS:
-            if not fld.per_frame:  # time-independent: written once
+            # time-independent: written once (a field without a default only when the state has it)
+            if not fld.per_frame and (fld.default is not None or getattr(state, fld.name) is not None):
                 _dataset(part, fld.element, data=state.array(fld.name))
                 part[fld.element].attrs["description"] = _describe(fld)
 
@@ -389,6 +393,15 @@ class H5MDWriter:
             "(mass-weighted; granulargas.observables)")
         obs["sonine_a3"].attrs["description"] = (
             "third Sonine coefficient of the peculiar velocities (granulargas.observables)")
+        if "rotational_temperature" in obs:
+            obs["rotational_temperature"].attrs["description"] = (
+                "rotational temperature sum I |w|^2 / (d_r N) of rough particles (d_r = 3 for spheres, 1 for "
+                "disks); temperature is the translational one")
+            for name, what in (("cumulant_a20", "d_t/(d_t+2) <c^4>/<c^2>^2 - 1 of the peculiar velocities"),
+                               ("cumulant_a02", "d_r/(d_r+2) <w^4>/<w^2>^2 - 1 of the spins"),
+                               ("cumulant_a11", "<c^2 w^2>/(<c^2><w^2>) - 1")):
+                obs[name].attrs["description"] = (
+                    f"{what} (c weighted by m, w by I: granulargas.observables.rough_moments)")
         for name, text in _SPECIES_DESCRIPTIONS.items():
             if name in obs:
                 obs[name].attrs["description"] = text
@@ -571,6 +584,8 @@ class Snapshot:
     contact_until: np.ndarray | None = None  # (N,) collisions that take time only
     contact_partner: np.ndarray | None = None  # (N,) int64, collisions that take time only
     boundary: tuple = ()  # "periodic" or "wall" per axis
+    angular_velocities: np.ndarray | None = None  # (N, 3) / (N, 1) in 2D, rough particles only
+    inertia: np.ndarray | None = None  # (N,) kappa = I / (m R^2), rough particles only
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
@@ -686,6 +701,12 @@ def _check_layout(f, path):
             if not isinstance(value, h5py.Dataset) or value.shape[1:] != want:
                 raise InputFileError(f"{path}: damaged H5MD file: particles/all/{fld.element}/value is missing "
                                      f"or not (frames{''.join(f', {x}' for x in want)})")
+    for fld in PARTICLE_FIELDS:  # time-independent fields a file may hold (e.g. inertia)
+        if not fld.per_frame and fld.element in part and fld.element not in expect:
+            value = part[fld.element]
+            if not isinstance(value, h5py.Dataset) or value.shape != (n,) + fld.shape(d):
+                raise InputFileError(f"{path}: damaged H5MD file: particles/all/{fld.element} is not an array "
+                                     f"of shape ({n},)")
     if not isinstance(f.get("observables"), h5py.Group):
         raise InputFileError(f"{path}: damaged H5MD file: observables/ is missing")
     if not isinstance(f.get("parameters"), h5py.Group):
@@ -739,6 +760,9 @@ def _snapshot(f, k, static) -> Snapshot:
     if "contact_until" in part and "contact_partner" in part:
         snap = dataclasses.replace(snap, contact_until=_read(part["contact_until/value"], k),
                                    contact_partner=_read(part["contact_partner/value"], k))
+    if "angular_velocity" in part:
+        snap = dataclasses.replace(snap, angular_velocities=_read(part["angular_velocity/value"], k),
+                                   inertia=part["inertia"][()] if "inertia" in part else None)
     for name in ("positions", "velocities", "box") if snap.positions is not None else ("velocities", "box"):
         if not np.all(np.isfinite(getattr(snap, name))) or (name == "box" and not np.all(snap.box > 0)):
             raise InputFileError(f"{f.filename}: damaged H5MD file: frame {k} holds non-finite {name}")

@@ -18,8 +18,9 @@ A scene is a handful of orthogonal fields:
   (white-noise driving), ``"elastic"`` (conserved) or ``"unknown"``;
 * ``walls``, ``resolved`` (collisions that take time), ``polydisperse``, ``tc_model``
   (the TC model's elastic collisions), ``material`` (the material route: the contact
-  stiffness and so the contact time is known), ``mixture`` (species, ``[[species]]``:
-  the temperature of each species; the one-component theory is that of the mean particle).
+  stiffness and so the contact time is known), ``rough`` (rough particles: spins and a
+  tangential law; two temperatures), ``mixture`` (species, ``[[species]]``: the temperature
+  of each species; the one-component theory is that of the mean particle).
 
 A new scene (another boundary, a force field, a tangential law, species) adds a field
 here, sets it in both constructors, and adjusts the predicates of the statements it
@@ -56,6 +57,7 @@ class Scene:
     polydisperse: bool = False
     tc_model: bool = False
     material: bool = False
+    rough: bool = False
     mixture: bool = False
 
     @property
@@ -84,6 +86,7 @@ class Scene:
             polydisperse=bool(not mixture and p.polydisperse and p.diameter_max > p.diameter_min),
             tc_model=c.tc_time is not None,
             material=c.material is not None, mixture=mixture,
+            rough=c.tangential is not None,
         )
 
     @classmethod
@@ -109,7 +112,7 @@ class Scene:
             kind=_kind(model, _float(coll.get("restitution"), None), _float(coll.get("prefactor"), None), driven),
             walls="wall" in tuple(boundary), resolved=bool(contacts) or coll.get("duration") == "resolved",
             polydisperse=poly, tc_model=_float(coll.get("tc_time"), None) is not None, material=material,
-            mixture=mixture,
+            mixture=mixture, rough=isinstance(parameters.get("tangential"), dict),
         )
 
     @classmethod
@@ -129,7 +132,8 @@ class Scene:
         parts.append(law)
         parts += [name for name, on in (("walls", self.walls), ("collisions that take time", self.resolved),
                                         ("polydisperse", self.polydisperse), ("TC model", self.tc_model),
-                                        ("material route", self.material), ("mixture", self.mixture)) if on]
+                                        ("material route", self.material), ("mixture", self.mixture),
+                                        ("rough particles", self.rough)) if on]
         return ", ".join(parts)
 
     def as_dict(self) -> dict:
@@ -182,8 +186,11 @@ STATEMENTS = {
         lambda s: s.model == "viscoelastic" and s.kind in ("cooling", "driven")),
     "constant_or_viscoelastic": Statement(
         "best constant eps against the viscoelastic T(t), or the damping of the same initial cooling rate "
-        "(compares cooling curves of one kind of particle)",
-        lambda s: _cools(s) and s.model in ("constant", "viscoelastic") and not s.mixture),
+        "(compares cooling curves of smooth particles of one kind)",
+        lambda s: _cools(s) and s.model in ("constant", "viscoelastic") and not s.rough and not s.mixture),
+    "rough": Statement(
+        "two temperatures (translation, rotation) by the Maxwellian energy balances, and how far smooth "
+        "particles would take T_tr(t)", lambda s: s.rough and not s.mixture),
     "instability": Statement(
         "box length against the shear-instability length L_c: clusters and shear modes in space",
         lambda s: s.space and _cools(s)),
@@ -212,7 +219,7 @@ STATEMENTS = {
         "the theory is that of identical particles of the mean diameter", lambda s: s.polydisperse),
     "species_temperatures": Statement(
         "the temperature of each species of a mixture (Garzó & Dufty 1999), which equipartition does not fix",
-        lambda s: s.mixture and s.model != "unknown"),
+        lambda s: s.mixture and not s.rough and s.model != "unknown"),
     "mixture_mean_particle": Statement(
         "a mixture's one-component predictions are those of its mean particle and mean law", lambda s: s.mixture),
     "theory_comparison": Statement(

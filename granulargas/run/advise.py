@@ -92,7 +92,9 @@ from granulargas.run import validity as V
 from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, mean_restitution, mixture_of_config,
                                      oblique_bounds, reduced_compression, reduced_prefactor)
 from granulargas.theory.driven import RELAXATION_TIMES
+from granulargas.theory import rough as rough_theory
 from granulargas.theory.gas import cooling_curve
+from granulargas.theory.rough import smooth_deviation
 
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
            "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line", "choose_duration",
@@ -343,10 +345,20 @@ class Advice:
     validity: tuple = ()
     species: tuple = ()
     notes: tuple = ()
+    #: rough particles: the largest relative change of T_tr(t) over the run if the particles
+    #: were smooth (beta_t = -1; :func:`granulargas.theory.rough.smooth_deviation`), and whether
+    #: that is within the tolerance
+    rough_deviation: float | None = None
+    smooth_ok: bool | None = None
 
     def _run_line(self) -> str:
         sc = self.scene
         head = f"run          T 1 -> {self.T_end:.3g} T0 by t = {self.t_end:.4g}"
+        if sc.rough and sc.kind == "driven" and math.isfinite(self.T_steady):
+            return (f"{head}, relaxing to the steady state T_tr = {self.T_steady:.4g} T0 of the driving "
+                    "(two-temperature theory)")
+        if sc.rough:
+            return f"{head} (translational temperature, two-temperature theory)"
         if sc.kind == "driven" and math.isfinite(self.T_steady):
             return (f"{head}, relaxing to the steady state T_ss = {self.T_steady:.4g} T0 of the driving "
                     "(Enskog theory, first Sonine)")
@@ -359,6 +371,11 @@ class Advice:
     def lines(self) -> list[str]:
         sc = self.scene
         out = [self._run_line()] + list(self.species)
+        if self.rough_deviation is not None:
+            verdict = "a smooth model will do" if self.smooth_ok else "keep the rough particles"
+            out.append(f"rough        smooth particles (beta_t = -1) would move T_tr(t) by up to "
+                       f"{100 * self.rough_deviation:.3g} % over this run (tolerance {100 * self.tolerance:g} %) "
+                       f"-> {verdict}")
         if self.model == "elastic":
             out.append("advice       elastic collisions: nothing to choose")
         if sc.kind == "driven" and math.isfinite(self.relaxation_time):
@@ -604,9 +621,24 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
                      f"{gas.sigma:.4g} (mass {gas.mass:.4g}) at the config's number density (packing "
                      f"{gas.packing_fraction:.4g}), as granulargas analyze compares; the mix cools at a rate of "
                      f"its own (configs/polydisperse_3d.toml ends at {POLYDISPERSE_MEASURED:g} of them)")
+    if scene.shows("rough"):
+        _set_rough(adv, config, tolerance, notes)
     adv.notes = tuple(notes)
     _set_method(adv, config)
     return adv
+
+
+def _set_rough(adv: Advice, config, tolerance: float, notes: list):
+    """Rough particles: how far smooth particles would take T_tr(t) over the run
+    (:func:`granulargas.theory.rough.smooth_deviation`); the run's end as the run checks predict."""
+    rough = V.rough_gas_from_config(config)
+    t_end = adv.t_end if math.isfinite(adv.t_end) else V.rough_end(rough, None, config.run.collisions_per_particle)[0]
+    adv.rough_deviation = smooth_deviation(rough, t_end)["max_deviation"]
+    adv.smooth_ok = adv.rough_deviation <= tolerance
+    if adv.smooth_ok:
+        notes.append("leave out [collision.tangential]: the spins change T_tr(t) by less than the tolerance")
+    if adv.scene.kind == "driven":
+        adv.T_steady = float(rough_theory.driven_state(rough)[0]) / rough.translational_temperature
 
 
 def _set_method(adv: Advice, config):
@@ -631,14 +663,21 @@ def method_line(config) -> str | None:
 
 
 def summary_line(config, tolerance: float = DEFAULT_TOLERANCE) -> str | None:
-    """One line for the run summary: the eps spread and whether a constant eps would do.
+    """One line for the run summary: the eps spread and whether a constant eps would do; for
+    rough particles, whether smooth ones would.
 
     Returns None where the scene has no such comparison (elastic and driven runs: the advice
     compares cooling curves).
     """
-    if Scene.from_config(config).shows("species_temperatures"):  # a mixture: the temperatures of its species
+    scene = Scene.from_config(config)
+    if scene.shows("rough"):
+        adv = advise(config, tolerance)
+        verdict = "would do" if adv.smooth_ok else "would not do"
+        return (f"advice       smooth particles (beta_t = -1) {verdict}: T_tr(t) off by up to "
+                f"{100 * adv.rough_deviation:.3g} % over the run (tolerance {100 * tolerance:g} %)")
+    if scene.shows("species_temperatures"):  # a mixture: the temperatures of its species
         return "advice       " + advise(config, tolerance).species[0].split(None, 1)[1]
-    if not Scene.from_config(config).shows("constant_or_viscoelastic"):
+    if not scene.shows("constant_or_viscoelastic"):
         return None
     adv = advise(config, tolerance)
     if adv.model == "viscoelastic" and adv.spread is not None and adv.eps_best is not None:

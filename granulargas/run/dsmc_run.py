@@ -20,6 +20,7 @@ import numpy as np
 
 from granulargas.dsmc import DSMC
 from granulargas.observables import kinetic_energy_momentum, species_moments
+from granulargas.run.rough import rotational_observables
 
 
 class DSMCRun(DSMC):
@@ -57,6 +58,7 @@ class DSMCRun(DSMC):
             "momentum": np.array(p[:self.dimension], dtype=np.float64),
             "sonine_a2": float(a2),
             "sonine_a3": float(a3),
+            **(rotational_observables(self) if self.tangential is not None else {}),
         }
 
 
@@ -76,4 +78,5 @@ def make_dsmc(config, setup) -> DSMCRun:
     (:func:`granulargas.run.prepare.mixture_contact_values`)."""
     dsmc = setup.parameters["dsmc"]
     chi = dsmc.get("chi_pairs", dsmc["chi"])
-    return DSMCRun(setup.state, setup.rule, chi=chi, seed=config.system.seed, driving=setup.driving)
+    return DSMCRun(setup.state, setup.rule, chi=chi, seed=config.system.seed, driving=setup.driving,
+                   tangential=setup.tangential)

@@ -42,10 +42,10 @@ from granulargas.contact import material, oblique_table, restitution_table
 from granulargas.contact.oblique import DELTA_MAX, compression_prefactor
 from granulargas.contact.oblique_grid import BETA_MAX as OBLIQUE_BETA_MAX
 from granulargas import theory
-from granulargas.engine import CollisionRule, WhiteNoise
+from granulargas.engine import CollisionRule, TangentialRule, WhiteNoise
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
-from granulargas.initial import box_for_packing, random_state
+from granulargas.initial import box_for_packing, maxwell_spins, random_state
 from granulargas.initial.lattice_gas import MIN_WALL_AXIS_DIAMETERS, RANDOM_PLACEMENT_MAX, maxwell_velocities
 from granulargas.io.config import TABLE_BETA_MAX, RunConfig
 from granulargas.io.h5md import has_positions, open_run, read_state
@@ -72,6 +72,8 @@ class Setup:
     driving: object = None
     #: the restart file the state was read from (None: a fresh state)
     source: str | None = None
+    #: rough particles: the tangential rule (None: smooth)
+    tangential: object = None
 
 
 # ------------------------------------------------------------------- particles
@@ -491,8 +493,39 @@ def make_driving(config: RunConfig, prefactor: float | None, state: State):
         if config.run.end_time is not None:
             obs_dt = config.output.observables_interval or config.run.end_time / DEFAULT_OBSERVABLE_SAMPLES
             interval = obs_dt / math.ceil(obs_dt / interval * (1.0 - 1e-12))
-    params = {"model": drv.model, "heating_rate": h, "interval": interval, "seed": s.seed}
-    return WhiteNoise(h, interval, seed=s.seed), params
+    params = {"model": drv.model, "heating_rate": h, "interval": interval, "seed": s.seed,
+              "rotational_fraction": drv.spin_fraction}
+    return WhiteNoise(h, interval, seed=s.seed, rotational_fraction=drv.spin_fraction), params
+
+
+def with_spins(config: RunConfig, state: State) -> State:
+    """Rough particles: the state with its ``inertia`` (the config's kappa, unless the state
+    has its own, as a restart file's) and ``angular_velocities`` (unless the state has them:
+    Maxwell-Boltzmann spins at ``initial.rotational_temperature`` with zero total spin angular
+    momentum, from ``numpy.random.default_rng([system.seed, 1])``, a stream of their own that
+    leaves the positions and velocities those of the smooth run). Smooth particles: as it is."""
+    if not config.collision.rough:
+        return state
+    n, d = state.n, state.dimension
+    kappa = state.inertia if state.inertia is not None else np.full(n, config.particles.inertia)
+    if state.angular_velocities is not None:
+        return state.replace(inertia=kappa)
+    moments = kappa * state.masses * state.radii**2
+    rng = np.random.default_rng([config.system.seed, 1])
+    spins = maxwell_spins(moments, d, config.initial.rotational_temperature, rng=rng)
+    return state.replace(inertia=kappa, angular_velocities=spins)
+
+
+def make_tangential(config: RunConfig):
+    """(TangentialRule or None, parameters) of the config's ``[collision.tangential]``."""
+    t = config.collision.tangential
+    if t is None:
+        return None, None
+    if t.model == "coulomb":
+        rule = TangentialRule.coulomb(t.restitution, t.friction, t.wall_restitution, t.wall_friction)
+    else:
+        rule = TangentialRule.constant(t.restitution, t.wall_restitution)
+    return rule, {**rule.parameters(), "inertia": config.particles.inertia}
 
 
 def species_parameters(config: RunConfig) -> dict:
@@ -556,10 +589,10 @@ def mixture_contact_values(config: RunConfig, state: State) -> np.ndarray:
 
 def initial_state(config: RunConfig) -> State:
     """The state a run of ``config`` starts from: the restart file's last snapshot
-    (``initial.from``) or a fresh random state."""
+    (``initial.from``) or a fresh random state (rough particles: with spins, :func:`with_spins`)."""
     if config.initial.from_file:
-        return restart_state(config)
-    return fresh_velocities(config) if config.run.method == "dsmc" else fresh_state(config)
+        return with_spins(config, restart_state(config))
+    return with_spins(config, fresh_velocities(config) if config.run.method == "dsmc" else fresh_state(config))
 
 
 def prepare(config: RunConfig) -> Setup:
@@ -568,6 +601,7 @@ def prepare(config: RunConfig) -> Setup:
     source = str(Path(config.initial.from_file)) if config.initial.from_file else None
     rule, name, k, table, warns, rule_params = make_rule(config, state)
     driving, driving_params = make_driving(config, k, state)
+    tangential, tangential_params = make_tangential(config)
     s = config.system
     vol = particle_volume(2.0 * state.radii, s.dimension).sum()
     parameters = {
@@ -611,4 +645,6 @@ def prepare(config: RunConfig) -> Setup:
     if source:
         parameters["restart"] = {"file": source, "time": state.time, "step": state.events,
                                  "collisions": state.collisions}
-    return Setup(rule, name, state, k, table, parameters, warns, driving, source)
+    if tangential_params is not None:
+        parameters["tangential"] = tangential_params
+    return Setup(rule, name, state, k, table, parameters, warns, driving, source, tangential)

@@ -19,7 +19,8 @@ collision rule (``parameters/collision``: the model, eps, the TC time, the visco
 prefactor, contact end and restitution table, the resolved rule's compression
 prefactor), the boundary, the driving (``parameters/driving``), the method (EDMD or
 DSMC, with the DSMC's chi and number density), the dimension, particle count and
-packing fraction. ``granulargas analyze`` then compares the run with the theory of
+packing fraction; rough particles' tangential law (``parameters/tangential``) and their angular
+velocities in every frame. ``granulargas analyze`` then compares the run with the theory of
 that model; ``granulargas export gsd`` converts it; ``granulargas run CONFIG
 --restart FILE`` continues from its last frame (whose observables sample holds the
 counters a restart needs). The observables are those the runner samples
@@ -37,6 +38,7 @@ from granulargas import __version__, theory
 from granulargas.dsmc import DSMC
 from granulargas.io.h5md import H5MDWriter
 from granulargas.observables import sonine_coefficients, species_moments
+from granulargas.run.rough import rotational_observables
 from granulargas.state import State
 
 __all__ = ["RunWriter", "run_parameters", "rule_parameters", "observables"]
@@ -97,11 +99,13 @@ def _state(sim) -> State:
 
 def _fields(sim) -> tuple:
     """The per-frame fields a restart of ``sim`` needs besides positions, velocities and images."""
+    rough = ("angular_velocities",) if getattr(sim, "tangential", None) is not None else ()
     if _is_dsmc(sim):
-        return ()
+        return rough
     rule = sim.rule
     tc = rule.kind == "constant" and rule.tc_time is not None
-    return (("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if rule.resolved else ())
+    return ((("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if rule.resolved else ())
+            + rough)
 
 
 def run_parameters(sim) -> dict:
@@ -124,7 +128,12 @@ def run_parameters(sim) -> dict:
     if sim.driving is not None and sim.driving.heating_rate > 0.0:
         drv = sim.driving
         out["driving"] = {"model": "white_noise", "heating_rate": float(drv.heating_rate),
-                          "interval": float(drv.interval), "seed": int(drv.seed)}
+                          "interval": float(drv.interval), "seed": int(drv.seed),
+                          "rotational_fraction": float(drv.rotational_fraction)}
+    tg = getattr(sim, "tangential", None)
+    if tg is not None:  # rough particles: the tangential law and kappa (analysis.rough reads it)
+        kappa = np.asarray(sim.inertia)
+        out["tangential"] = {**tg.parameters(), "inertia": float(kappa.mean())}
     if _is_dsmc(sim):
         out["dsmc"] = {"chi": float(sim.chi), "number_density": float(radii.shape[0] / float(sim.volume))}
         if sim.chi_pairs is not None:
@@ -155,6 +164,7 @@ def observables(sim, pressure: bool) -> dict:
     NaN); a DSMC has none."""
     if hasattr(sim, "observables"):  # a config's DSMC run (run.dsmc_run.DSMCRun)
         return sim.observables()
+    rough = {} if getattr(sim, "tangential", None) is None else rotational_observables(sim)
     if _is_dsmc(sim):
         a2, a3 = sim.sonine_a2, sim.sonine_a3
         driven = {} if sim.driving is None else {"injected_energy": float(sim.injected_energy),
@@ -164,7 +174,7 @@ def observables(sim, pressure: bool) -> dict:
                 "collisions": int(sim.collisions), "events": int(sim.candidates),
                 "dissipated_energy": float(sim.dissipated_energy),
                 "momentum": np.asarray(sim.momentum, dtype=np.float64), "sonine_a2": float(a2),
-                "sonine_a3": float(a3)}
+                "sonine_a3": float(a3), **rough}
     a2, a3 = sonine_coefficients(sim.velocities, sim.masses)
     out = {
         "temperature": float(sim.temperature),
@@ -185,6 +195,7 @@ def observables(sim, pressure: bool) -> dict:
         out["kick_step"] = int(sim.kick_step)
     if sim.rule.resolved:
         out["three_body_contacts"] = int(sim.three_body_contacts)
+    out.update(rough)
     out.update(species_observables(sim))
     return out
 

@@ -318,10 +318,12 @@ def stored_fields(config: RunConfig, sim) -> tuple:
     """The per-frame fields of :data:`granulargas.state.PARTICLE_FIELDS` a run stores besides
     positions, velocities and images: the restart state its model needs
     (:class:`granulargas.io.h5md.H5MDWriter`)."""
+    rough = ("angular_velocities",) if config.collision.rough else ()
     if config.run.method == "dsmc":
-        return ()
+        return rough
     tc = config.collision.model == "constant" and config.collision.tc_time is not None
-    return (("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if sim.rule.resolved else ())
+    return ((("last_collision",) if tc else ()) + (("contact_until", "contact_partner") if sim.rule.resolved else ())
+            + rough)
 
 
 def collapse_message(config: RunConfig, where: str) -> str:
@@ -512,7 +514,8 @@ def _build_simulation(config: RunConfig, setup, st, what):
     if config.run.method == "dsmc":
         sim = make_dsmc(config, setup)
     else:
-        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours)
+        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
+                         tangential=setup.tangential)
         what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     sim.run(until=sim.time)
     return sim

@@ -48,6 +48,13 @@ same float (zero-time events). For an elastic gas this bounds the run to about
 ``1e-6 2^52 = 4.5e9`` mean free times; a cooling gas, whose event spacing grows
 with t, stays resolved much longer.
 
+Rough particles
+---------------
+With ``[collision.tangential]`` the predicted translational temperature is that of the
+two-temperature theory (:mod:`granulargas.theory.rough`, Maxwellian energy balances):
+T_tr(t) from (T0, T_rot0) to the run's end (a stop in collisions per particle: where
+the theory's collision count reaches it), or, driven, towards its steady state.
+
 The shear instability
 ---------------------
 A homogeneous cooling gas in a periodic box longer than the shear-instability
@@ -86,6 +93,7 @@ from granulargas.contact.material import damping_from_prefactor, effective_modul
 from granulargas.errors import ConfigError
 from granulargas.io.config import TABLE_BETA_MAX
 from granulargas.io.scene import Scene
+from granulargas.theory import rough as rough_theory
 from granulargas.theory.moments import speed_quadrature
 from granulargas.run.prepare import (mean_particle, mean_restitution, mixture_of_config, pair_weights, reduced_prefactor,
                                      species_fractions)
@@ -310,15 +318,17 @@ class RunValidity:
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
+        theory_name = "two-temperature theory" if self.scene.rough else "Enskog theory"
         if self.driven and math.isfinite(self.T_steady):
             at = f"at t = {self.t_end:.4g}; " if math.isfinite(self.t_end) else ""
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} ({at}steady state of the driving "
-                   f"{self.T_steady:.4g}, Enskog theory)"]
+                   f"{self.T_steady:.4g}, {theory_name})"]
         elif self.driven:
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (elastic collisions heated by the "
                    f"driving, T0 + H t; predicted by t = {self.t_end:.4g})"]
         else:
-            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (predicted by t = {self.t_end:.4g})"]
+            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (predicted by t = {self.t_end:.4g}"
+                   + (", two-temperature theory)" if self.scene.rough else ")")]
         if self.spread is not None:
             sp = self.spread
             out.append(f"validity     beta {sp['beta_min']:.3g}..{sp['beta_max']:.3g}, "
@@ -357,6 +367,39 @@ def box_length(config) -> float:
     return (s.particles * mean_particle_volume(config) / s.packing_fraction) ** (1.0 / s.dimension)
 
 
+def rough_gas_from_config(config):
+    """The config's rough gas (:class:`granulargas.theory.rough.RoughGas`; None for smooth particles
+    or a gas that is not a config's)."""
+    t = getattr(getattr(config, "collision", None), "tangential", None)
+    if t is None:
+        return None
+    drv = config.driving
+    return rough_theory.RoughGas(
+        gas_from_config(config), config.particles.inertia, tangential=t.model, tangential_restitution=t.restitution,
+        friction=t.friction or 0.0, rotational_temperature=config.initial.rotational_temperature,
+        heating_rate=0.0 if drv is None else drv.heating_rate,
+        rotational_fraction=0.0 if drv is None else drv.spin_fraction)
+
+
+def rough_end(rough, t_end: float | None, collisions: float | None):
+    """(t_end, ln T_tr at t_end) of a rough gas by the two-temperature theory: the first of
+    ``t_end`` and the time its collisions per particle reach ``collisions``."""
+    t = t_end if t_end is not None else 1.0 / rough.gas.collision_frequency
+    for _ in range(200):
+        curve = rough_theory.two_temperature_curve(rough, t, points=50)
+        if collisions is None or curve.collisions[-1] >= collisions or t_end is not None:
+            break
+        t *= 2.0
+    if collisions is not None and curve.collisions[-1] >= collisions:
+        k = int(np.searchsorted(curve.collisions, collisions))
+        lo, hi = curve.time[max(k - 1, 0)], curve.time[k]
+        for _ in range(60):  # bisection on the dense solution
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if curve.collisions_at(mid) < collisions else (lo, mid)
+        t = hi
+    return float(t), float(np.log(curve.translational_at(t)))
+
+
 def driven_end(gas: Gas, heating_rate: float, t_end: float | None) -> tuple[float, float]:
     """(T at ``t_end``, steady temperature) of a driven gas starting at T0: the steady state of
     the moment equations with the heating term (:func:`granulargas.theory.driven_state`, what
@@ -377,7 +420,12 @@ def _check_driven(config, gas, scene) -> RunValidity:
     """Checks of a driven run: it heads for the steady temperature of the driving
     (:mod:`granulargas.theory.driven`) instead of cooling."""
     h = config.driving.heating_rate
-    T_end, T_ss = driven_end(gas, h, gas.end_time)
+    rough = rough_gas_from_config(config)
+    if rough is not None and (gas.model != "elastic" or rough.sticking_factor > 0.0):
+        T_ss = float(rough_theory.driven_state(rough)[0])
+        T_end = T_ss if gas.end_time is None else math.exp(rough_end(rough, gas.end_time, None)[1])
+    else:
+        T_end, T_ss = driven_end(gas, h, gas.end_time)
     spread = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         spread = restitution_spread(gas, max(gas.temperature, T_ss), min(gas.temperature, T_ss))
@@ -450,7 +498,10 @@ def check_run(config) -> RunValidity:
     if gas.model == "viscoelastic" and gas.pair_constant > 0:
         curve = cooling_of(gas)
     t_end, ln_T_end = predicted_end(gas, curve)
-    if not isinstance(config, RunGas) and config.species and gas.model != "elastic":
+    rough = rough_gas_from_config(config)
+    if rough is not None:  # two temperatures: the rough theory's T_tr
+        t_end, ln_T_end = rough_end(rough, gas.end_time, gas.collisions_per_particle)
+    elif not isinstance(config, RunGas) and config.species and gas.model != "elastic":
         t_end, ln_T_end = _mixture_end(config, gas)
     T_end = math.exp(ln_T_end)
     if curve is not None:

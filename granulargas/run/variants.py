@@ -45,6 +45,9 @@ _MATERIAL = {
 }
 _DRIVEN = {"driving.model": "white_noise", "driving.heating_rate": 0.005}
 _DSMC = {"run.method": "dsmc", "system.particles": 256}
+#: rough particles (spins and a tangential restitution): a loop of their own
+_ROUGH = {"collision.tangential.restitution": 0.0}
+_ROUGH_DRIVEN = {**_DRIVEN, "driving.rotational_fraction": 0.5}
 #: a mixture: two species, the law per pair of species (the loops compiled with the species record)
 _MIXTURE = {"species": [{"name": "a", "fraction": 0.5}, {"name": "b", "fraction": 0.5, "diameter": 0.8}],
             "collision.damping": {"a-a": 0.1, "a-b": 0.1, "b-b": 0.1}}
@@ -55,18 +58,21 @@ def _placement(config: RunConfig) -> bool:
 
 
 def _engine(mode: str, resolved: bool = False, driven: bool = False,
-            mixture: bool = False) -> Callable[[RunConfig, str], bool]:
+            rough: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
     """Runs of the event-driven engine in neighbour mode ``mode`` (with collisions that take
-    time: ``resolved``; ``driven``: the driven ones only; ``mixture``: those with species)."""
+    time: ``resolved``; ``driven``: the driven ones only; ``rough``: rough particles;
+    ``mixture``: those with species)."""
     def uses(config: RunConfig, neighbours: str) -> bool:
         return (config.run.method == "edmd" and neighbours == mode
                 and (config.collision.duration == "resolved") == resolved
+                and config.collision.rough == rough
                 and (config.driving is not None or not driven) and bool(config.species) == mixture)
     return uses
 
 
-def _dsmc(driven: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
-    return lambda config, neighbours: (config.run.method == "dsmc" and (config.driving is not None or not driven)
+def _dsmc(driven: bool = False, rough: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
+    return lambda config, neighbours: (config.run.method == "dsmc" and config.collision.rough == rough
+                                       and (config.driving is not None or not driven)
                                        and bool(config.species) == mixture)
 
 
@@ -126,6 +132,17 @@ VARIANTS = (
             _engine("lists", resolved=True, driven=True), after=("resolved",)),
     Variant("dsmc", "the DSMC", _DSMC, _dsmc()),
     Variant("dsmc-driven", "its driving step", {**_DSMC, **_DRIVEN}, _dsmc(driven=True), after=("dsmc",)),
+    Variant("lists-rough", "the neighbour-list engine of rough particles", {"run.neighbours": "lists", **_ROUGH},
+            _engine("lists", rough=True), after=("placement", "lists")),
+    Variant("cells-rough", "the cell-crossing engine of rough particles", {"run.neighbours": "cells", **_ROUGH},
+            _engine("cells", rough=True), after=("placement", "cells")),
+    Variant("lists-rough-driven", "its driving step", {"run.neighbours": "lists", **_ROUGH, **_ROUGH_DRIVEN},
+            _engine("lists", driven=True, rough=True), after=("lists-rough",)),
+    Variant("cells-rough-driven", "its driving step", {"run.neighbours": "cells", **_ROUGH, **_ROUGH_DRIVEN},
+            _engine("cells", driven=True, rough=True), after=("cells-rough",)),
+    Variant("dsmc-rough", "the DSMC of rough particles", {**_DSMC, **_ROUGH}, _dsmc(rough=True), after=("dsmc",)),
+    Variant("dsmc-rough-driven", "its driving step", {**_DSMC, **_ROUGH, **_ROUGH_DRIVEN},
+            _dsmc(driven=True, rough=True), after=("dsmc-rough",)),
     Variant("lists-mixture", "the neighbour-list engine of mixtures", {"run.neighbours": "lists", **_MIXTURE},
             _engine("lists", mixture=True), after=("placement", "lists")),
     Variant("cells-mixture", "the cell-crossing engine of mixtures", {"run.neighbours": "cells", **_MIXTURE},

@@ -14,12 +14,15 @@ import theory; theory.haff_tau0(...)``):
   a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there);
 * :mod:`~granulargas.theory.driven` -- the white-noise driven steady state
   (temperature, a2, kick interval; viscoelastic: effective restitution);
+* :mod:`~granulargas.theory.rough` -- rough grains: the two-temperature (translation,
+  rotation) Maxwellian theory, free cooling, driven steady states, the Mpemba crossing
+  (import it from there: ``from granulargas.theory import rough``);
 * :mod:`~granulargas.theory.mixture` -- mixtures of species: cooling rates and the
   temperature of each species in the homogeneous cooling and the driven states
   (Garzó & Dufty 1999), contact values of a mixture (import it from there).
 """
 
-from granulargas.theory import driven, enskog, gas, mixture, viscoelastic  # noqa: F401
+from granulargas.theory import driven, enskog, gas, mixture, rough, viscoelastic  # noqa: F401
 from granulargas.theory.driven import *  # noqa: F401,F403
 from granulargas.theory.enskog import *  # noqa: F401,F403
 from granulargas.theory.viscoelastic import *  # noqa: F401,F403

@@ -68,7 +68,15 @@ def worker(args):
     out = {}
     for packing in args.packings:
         sims = []
-        for eng, ini in mods:
+        for nm, (eng, ini) in zip(args.order, mods):
+            if args.mode == "dsmc":  # the DSMC of a constant eps = 0.9 gas, Maxwellian start
+                dsmc, state_mod = importlib.import_module(nm + ".dsmc"), importlib.import_module(nm + ".state")
+                v = np.random.default_rng(args.seed).normal(size=(args.n, args.dim))
+                st = state_mod.State(None, v, 0.5, 1.0, None)
+                sim = dsmc.DSMC(st, eng.CollisionRule.constant(0.9), packing_fraction=packing, seed=args.seed)
+                sim.run(math.inf, max_collisions=args.n)
+                sims.append(sim)
+                continue
             st = ini.random_state(args.n, packing, args.dim, seed=args.seed)
             # a tree whose initial state is a set of keyword arguments (as_kwargs) or a state record
             state = ((), st.as_kwargs()) if hasattr(st, "as_kwargs") else ((st,), {})
@@ -93,7 +101,8 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("tree_a")
     ap.add_argument("tree_b")
-    ap.add_argument("--mode", choices=("lists", "cells"), default="lists")
+    ap.add_argument("--mode", choices=("lists", "cells", "dsmc"), default="lists",
+                    help="the engine's neighbour mode, or dsmc (the DSMC of a constant eps = 0.9 gas)")
     ap.add_argument("--n", type=lambda s: int(float(s)), default=10976)
     ap.add_argument("--packings", type=float, nargs="+", default=[0.3])
     ap.add_argument("--dim", type=int, choices=(2, 3), default=3)

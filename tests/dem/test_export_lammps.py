@@ -156,6 +156,13 @@ def test_driven_config_is_refused(tmp_path):
         export_lammps(config, tmp_path)
 
 
+def test_rough_config_is_refused(tmp_path):
+    config = parse_config(config_text(extra="\n[collision.tangential]\nrestitution = 0.0\n"))
+    with pytest.raises(UserError, match="collision.tangential"):
+        export_lammps(config, tmp_path)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_overlap_end_has_no_limit_damping(tmp_path):
     ex = export_lammps(parse_config(config_text(end="overlap")), tmp_path)
     (pc,) = read_input(ex.input_file)["pair_coeff"]

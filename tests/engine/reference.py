@@ -5,6 +5,14 @@ all 3^d periodic images (periodic axes only) of the textbook quadratic root,
 and over every particle and every wall (flat walls at 0 and L on the axes
 listed in ``walls``) of the time to touch it. Used to check the engine's
 event sequence on small systems.
+
+Rough particles (spins ``w``, moments of inertia ``I = kappa m R^2``): the collision is
+computed as a rigid-body impulse problem, independently of the engine's algebra
+(:func:`rough_impulse`): the change of the contact-point relative velocity is linear in the
+impulse J, ``Delta g = K J`` with K built from the masses, inertias and lever arms, and J
+solves ``K J = g' - g`` for the target ``g'`` (normal part ``-eps g_n``, tangential part
+``-beta g_t``); Walton's Coulomb model replaces the tangential part of J by
+``-mu |J_n| g_t/|g_t|`` when the sticking impulse exceeds that.
 """
 
 import itertools
@@ -136,6 +144,98 @@ def collide_resolved(pos, vel, radii, masses, box, i, j, rule):
     return out.duration
 
 
+def _skew(r):
+    """Matrices [r]x with [r]x a = r x a, for r of shape (..., 3)."""
+    z = np.zeros(r.shape[:-1])
+    return np.stack([np.stack([z, -r[..., 2], r[..., 1]], -1),
+                     np.stack([r[..., 2], z, -r[..., 0]], -1),
+                     np.stack([-r[..., 1], r[..., 0], z], -1)], -2)
+
+
+def rough_impulse(vi, vj, wi, wj, n, mi, mj, Ii, Ij, ri, rj, eps, beta, mu=None):
+    """Impulse J on i (-J on j) at the contact of a rough collision; arrays (..., 3), scalars
+    broadcast. n: unit vector from j to i; a wall is ``mj = Ij = inf`` with ``vj = wj = 0``.
+
+    The contact point is at r_i = -R_i n from i and r_j = R_j n from j; the contact
+    velocities are v + w x r, and an impulse J at the contact changes g = c_i - c_j by
+    K J with K = (1/m_i + 1/m_j) 1 - [r_i]x[r_i]x / I_i - [r_j]x[r_j]x / I_j.
+    ``mu`` None: constant beta; else Walton's model with the sticking value beta.
+    """
+    n = np.asarray(n, dtype=float)
+    r_i = -np.asarray(ri, dtype=float)[..., None] * n
+    r_j = np.asarray(rj, dtype=float)[..., None] * n
+    g = (vi + np.cross(wi, r_i)) - (vj + np.cross(wj, r_j))
+    gn = np.sum(g * n, -1)[..., None] * n
+    gt = g - gn
+    eye = np.eye(3)
+    inv_m = 1.0 / np.asarray(mi, dtype=float) + 1.0 / np.asarray(mj, dtype=float)
+    Si, Sj = _skew(r_i), _skew(r_j)
+    K = (inv_m[..., None, None] * eye - Si @ Si / np.asarray(Ii, dtype=float)[..., None, None])
+    with np.errstate(invalid="ignore"):
+        Kj = Sj @ Sj / np.asarray(Ij, dtype=float)[..., None, None]
+    K = K - np.where(np.isfinite(Kj), Kj, 0.0)
+    target = -np.asarray(eps, dtype=float)[..., None] * gn - np.asarray(beta, dtype=float)[..., None] * gt
+    J = np.linalg.solve(K, (target - g)[..., None])[..., 0]
+    if mu is None:
+        return J
+    Jn = np.sum(J * n, -1)
+    Jt = J - Jn[..., None] * n
+    limit = np.asarray(mu, dtype=float) * np.abs(Jn)
+    size = np.linalg.norm(Jt, axis=-1)
+    gsize = np.linalg.norm(gt, axis=-1)
+    slide = size > limit
+    with np.errstate(invalid="ignore", divide="ignore"):
+        Jt_slide = -limit[..., None] * gt / np.where(gsize > 0, gsize, 1.0)[..., None]
+    return np.where(slide[..., None], Jn[..., None] * n + Jt_slide, J)
+
+
+def apply_rough_impulse(vi, vj, wi, wj, n, mi, mj, Ii, Ij, ri, rj, J):
+    """New (vi, vj, wi, wj) after the impulse J on i at the contact (-J on j)."""
+    r_i = -np.asarray(ri, dtype=float)[..., None] * n
+    r_j = np.asarray(rj, dtype=float)[..., None] * n
+    mi = np.asarray(mi, dtype=float)[..., None]
+    mj = np.asarray(mj, dtype=float)[..., None]
+    return (vi + J / mi, vj - J / mj, wi + np.cross(r_i, J) / np.asarray(Ii, dtype=float)[..., None],
+            wj - np.cross(r_j, J) / np.asarray(Ij, dtype=float)[..., None])
+
+
+def collide_rough(pos, vel, spin, radii, masses, inertia, box, i, j, eps, beta, mu=None, walls=()):
+    """Rough collision of i and j (nearest image), in place; ``inertia`` = kappa per particle,
+    ``spin`` (N, 3) (2D: only the z column used). Velocities and positions may be 2D."""
+    d = len(box)
+    dr = pos[i] - pos[j]
+    for a in range(d):
+        if a not in walls:
+            dr[a] -= box[a] * np.round(dr[a] / box[a])
+    n = np.zeros(3)
+    n[:d] = dr / np.linalg.norm(dr)
+    v = np.zeros((2, 3))
+    v[:, :d] = vel[[i, j]]
+    mi, mj = masses[i], masses[j]
+    Ii = inertia[i] * mi * radii[i] ** 2
+    Ij = inertia[j] * mj * radii[j] ** 2
+    J = rough_impulse(v[0], v[1], spin[i], spin[j], n, mi, mj, Ii, Ij, radii[i], radii[j], eps, beta, mu)
+    vi, vj, wi, wj = apply_rough_impulse(v[0], v[1], spin[i], spin[j], n, mi, mj, Ii, Ij, radii[i], radii[j], J)
+    vel[i], vel[j] = vi[:d], vj[:d]
+    spin[i], spin[j] = wi, wj
+
+
+def bounce_rough(vel, spin, radii, masses, inertia, i, axis, eps, beta, mu=None):
+    """Rough particle i against the flat wall normal to ``axis`` it moves into, in place."""
+    d = vel.shape[1]
+    n = np.zeros(3)
+    n[axis] = 1.0 if vel[i, axis] < 0 else -1.0  # into the gas
+    v = np.zeros(3)
+    v[:d] = vel[i]
+    mi = masses[i]
+    Ii = inertia[i] * mi * radii[i] ** 2
+    zero = np.zeros(3)
+    J = rough_impulse(v, zero, spin[i], zero, n, mi, np.inf, Ii, np.inf, radii[i], 0.0, eps, beta, mu)
+    vi, _, wi, _ = apply_rough_impulse(v, zero, spin[i], zero, n, mi, np.inf, Ii, np.inf, radii[i], 0.0, J)
+    vel[i] = vi[:d]
+    spin[i] = wi
+
+
 def pair_restitution(eps, species, i, j, un, radii, masses):
     """eps of a collision of i and j: ``eps`` one number, a table (S, S) indexed by the two
     particles' ``species``, or a function ``eps(s_i, s_j, g_n, r_eff, m_eff)``."""
@@ -156,21 +256,28 @@ def wall_restitution(wall_eps, species, i, vn, radii, masses):
     return float(wall_eps) if np.ndim(wall_eps) == 0 else float(np.asarray(wall_eps)[si])
 
 
-def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None, rule=None,
+def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_eps=None, rule=None, rough=None,
                   species=None):
     """Event sequence [(time, i, j)] of the first ``ncoll`` events, global clock; a wall
     collision of particle i with a wall of axis a appears as (time, i, -1 - a).
 
     ``rule``: a resolved CollisionRule (collisions that take time; no walls): a pair in
     contact is not predicted until its contact ends.
+
+    ``rough``: rough particles, a dict with ``spin`` (N, 3), ``inertia`` (kappa, (N,)),
+    ``beta`` and ``mu`` (None: constant beta), optionally ``wall_beta`` and ``wall_mu``; the
+    spins after the events are then returned as a fourth value.
+
     ``species`` (N,) ints: a mixture; ``eps`` is then a table (S, S) or a function of the
     pair (:func:`pair_restitution`), ``wall_eps`` one per species (:func:`wall_restitution`)."""
     pos = pos.copy()
     vel = vel.copy()
+    spin = None if rough is None else np.array(rough["spin"], dtype=float)
     if wall_eps is None:
         wall_eps = eps if species is None else (
             np.diagonal(np.asarray(eps)) if not callable(eps) else
             (lambda s, g, r, m: eps(s, s, g, r, m)))
+
     t = 0.0
     out = []
     n = len(pos)
@@ -206,9 +313,21 @@ def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_e
                     dr[a] -= box[a] * np.round(dr[a] / box[a])
             un = float(np.dot(vel[i] - vel[j], dr / np.linalg.norm(dr)))
             e = pair_restitution(eps, species, i, j, un, radii, masses)
-            collide(pos, vel, radii, masses, box, i, j, e, walls)
+            if rough is None:
+                collide(pos, vel, radii, masses, box, i, j, e, walls)
+            else:
+                collide_rough(pos, vel, spin, radii, masses, rough["inertia"], box, i, j, e,
+                              rough["beta"], rough.get("mu"), walls)
             out.append((t, min(i, j), max(i, j)))
         else:
-            bounce(vel, i, j, wall_restitution(wall_eps, species, i, vel[i, j], radii, masses))
+            e = wall_restitution(wall_eps, species, i, vel[i, j], radii, masses)
+            if rough is None:
+                bounce(vel, i, j, e)
+            else:
+                bounce_rough(vel, spin, radii, masses, rough["inertia"], i, j, e,
+                             rough.get("wall_beta", rough["beta"]), rough.get("wall_mu", rough.get("mu")))
+
             out.append((t, i, -1 - j))
+    if rough is not None:
+        return out, pos, vel, spin
     return out, pos, vel

@@ -134,3 +134,18 @@ def test_tc_model_makes_quick_recollisions_elastic(tc_time, second_elastic):
 def test_constant_rule_rejects_bad_restitution(bad):
     with pytest.raises(ConfigError, match="restitution"):
         CollisionRule.constant(bad)
+
+
+def test_tangential_rule_bounds():
+    from granulargas.engine import TangentialRule
+    from granulargas.engine._rough import TANGENTIAL_CONSTANT, TANGENTIAL_COULOMB
+
+    r = TangentialRule.constant(0.3)
+    assert (r.code, r.restitution, r.wall_beta, r.wall_mu) == (TANGENTIAL_CONSTANT, 0.3, 0.3, 0.0)
+    c = TangentialRule.coulomb(0.4, 0.2, wall_restitution=-0.5)
+    assert (c.code, c.wall_beta, c.wall_mu) == (TANGENTIAL_COULOMB, -0.5, 0.2)
+    for bad in (lambda: TangentialRule.constant(1.01), lambda: TangentialRule.constant(-1.5),
+                lambda: TangentialRule.coulomb(0.0, -0.1), lambda: TangentialRule.coulomb(0.0, float("nan")),
+                lambda: TangentialRule("stick", 0.0), lambda: TangentialRule("constant", 0.0, 0.3)):
+        with pytest.raises(ConfigError):
+            bad()

@@ -217,3 +217,107 @@ def test_smallest_positive_tc_time_is_accepted_by_config_and_engine():
     assert parse_config(CONSTANT).collision.tc_time is None
     with pytest.raises(ConfigError, match="must be > 0"):
         CollisionRule.constant(0.8, tc_time=0.0)
+
+
+# ------------------------------------------------------------------ rough particles
+
+ROUGH = CONSTANT + "\n[collision.tangential]\nrestitution = 0.2\n"
+
+
+def test_rough_defaults_and_round_trip():
+    c = parse_config(ROUGH, "r.toml")
+    assert c.collision.rough and c.collision.tangential.model == "constant"
+    assert c.collision.tangential.restitution == 0.2
+    assert c.particles.inertia == 0.4 and c.initial.rotational_temperature == 1.0  # sphere, T_tr
+    c2 = parse_config(ROUGH.replace("dimension = 3", "dimension = 2").replace("temperature = 1.0",
+                                                                              "temperature = 2.5"), "r.toml")
+    assert c2.particles.inertia == 0.5 and c2.initial.rotational_temperature == 2.5  # disk
+    again = parse_config(c.to_toml(), "r.toml")
+    assert (again.collision, again.particles, again.initial) == (c.collision, c.particles, c.initial)
+    smooth = parse_config(CONSTANT, "s.toml")
+    assert not smooth.collision.rough and smooth.particles.inertia is None
+    assert smooth.initial.rotational_temperature is None
+    driven = parse_config(CONSTANT + "\n[driving]\nheating_rate = 0.1\n", "d.toml")
+    assert driven.driving.spin_fraction == 0.0
+    assert "rotational_fraction" not in driven.to_toml()
+    parse_config(driven.to_toml(), "d.toml")
+
+
+def test_coulomb_and_walls_round_trip():
+    text = ROUGH.replace("restitution = 0.2\n", 'model = "coulomb"\nrestitution = 0.4\nfriction = 0.3\n'
+                                               "wall_restitution = -0.5\nwall_friction = 0.1\n")
+    text = text.replace("seed = 1", 'seed = 1\nboundary = ["wall", "periodic", "periodic"]')
+    c = parse_config(text + "\n[driving]\nheating_rate = 0.1\nrotational_fraction = 0.25\n", "c.toml")
+    t = c.collision.tangential
+    assert (t.model, t.restitution, t.friction, t.wall_restitution, t.wall_friction) == ("coulomb", 0.4, 0.3, -0.5, 0.1)
+    assert c.driving.spin_fraction == 0.25
+    assert parse_config(c.to_toml(), "c.toml").collision == c.collision
+
+
+ROUGH_BAD = [
+    ("collision.tangential.restitution", 1.5, "must be a number in [-1, 1]"),
+    ("collision.tangential.restitution", -1.0001, "must be a number in [-1, 1]"),
+    ("collision.tangential.model", "stick", 'must be one of "constant", "coulomb"'),
+    ("collision.tangential.friction", 0.3, 'is only used with model = "coulomb"'),
+    ("collision.tangential.wall_restitution", 0.3, "is only used with walls"),
+    ("particles.inertia", 0.7, "must be a number in (0, 0.6667] (no mass outside the surface"),
+    ("particles.inertia", 0.0, "must be a number in (0, 0.6667]"),
+    ("initial.rotational_temperature", -1.0, "must be a number in [0, 1e100]"),
+    ("collision.duration", "resolved", "collision.duration"),
+]
+
+
+@pytest.mark.parametrize("key, value, message", ROUGH_BAD)
+def test_rough_bad_values(key, value, message):
+    with pytest.raises(ConfigError) as err:
+        parse_config(ROUGH, "r.toml", overrides={key: value})
+    msg = str(err.value)
+    assert "\n" not in msg and message in msg
+
+
+def test_coulomb_needs_a_nonnegative_friction():
+    text = ROUGH.replace("restitution = 0.2\n", 'model = "coulomb"\nrestitution = 0.4\n')
+    with pytest.raises(ConfigError, match=r"collision\.tangential\.friction: missing; model = \"coulomb\""):
+        parse_config(text, "c.toml")
+    with pytest.raises(ConfigError, match=r"collision\.tangential\.friction = -0\.1: must be a number in \[0, 1e100\]"):
+        parse_config(text + "friction = -0.1\n", "c.toml")
+    with pytest.raises(ConfigError, match=r"collision\.tangential: missing key\(s\) restitution"):
+        parse_config(CONSTANT + '\n[collision.tangential]\nmodel = "constant"\n', "c.toml")
+
+
+def test_disks_take_a_ring_and_spheres_a_shell():
+    disks = ROUGH.replace("dimension = 3", "dimension = 2")
+    assert parse_config(disks, "d.toml", overrides={"particles.inertia": 1.0}).particles.inertia == 1.0
+    with pytest.raises(ConfigError, match=r"must be a number in \(0, 1\]"):
+        parse_config(disks, "d.toml", overrides={"particles.inertia": 1.01})
+    assert parse_config(ROUGH, "s.toml", overrides={"particles.inertia": 2.0 / 3.0}).particles.inertia == 2.0 / 3.0
+
+
+@pytest.mark.parametrize("key, value", [("particles.inertia", 0.4), ("initial.rotational_temperature", 1.0),
+                                        ("driving.rotational_fraction", 0.0)])
+def test_rough_keys_need_the_tangential_table(key, value):
+    text = CONSTANT + "\n[driving]\nheating_rate = 0.1\n"
+    with pytest.raises(ConfigError, match=rf"^override: {key.replace('.', chr(92) + '.')} = .*: is for rough particles"):
+        parse_config(text, "x.toml", overrides={key: value})
+    if key == "driving.rotational_fraction":
+        with pytest.raises(ConfigError, match="must be a number in"):
+            parse_config(text + "\n[collision.tangential]\nrestitution = 0.0\n", "x.toml", overrides={key: 1.5})
+
+
+def test_inertia_bounds_are_the_theorys():
+    from granulargas.io import config
+    from granulargas.theory import rough
+
+    assert config.MAX_INERTIA == rough.MAX_INERTIA and config.DEFAULT_INERTIA == rough.DEFAULT_INERTIA
+
+
+def test_rough_mixture_is_refused_in_one_line():
+    """[collision.tangential] with [[species]]: one line naming the table (rough mixtures run
+    from Python only)."""
+    text = ROUGH.replace("[particles]\ndiameter = 1.0\nmass = 1.0\n", "") + (
+        '\n[[species]]\nname = "a"\nfraction = 0.5\n\n[[species]]\nname = "b"\nfraction = 0.5\nmass = 2.0\n')
+    parse_config(text.replace("[collision.tangential]\nrestitution = 0.2\n", ""), "m.toml")  # smooth: fine
+    with pytest.raises(ConfigError) as err:
+        parse_config(text, "m.toml")
+    msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("m.toml: collision.tangential = {...}: ") and "[[species]]" in msg

@@ -32,8 +32,9 @@ def _datasets(path):
         for name, g in f["observables"].items():
             for part in ("step", "time", "value"):
                 out[f"observables/{name}/{part}"] = g[part][()]
-        if "last_collision" in f["particles/all"]:
-            out["last_collision"] = f["particles/all/last_collision/value"][()]
+        for element in ("last_collision", "angular_velocity"):
+            if element in f["particles/all"]:
+                out[element] = f[f"particles/all/{element}/value"][()]
     return out
 
 
@@ -62,11 +63,15 @@ CASES = {
     "viscoelastic-3d": {},
     "tc-model-2d": {"system.dimension": 2, "collision.model": "constant", "collision.restitution": 0.5,
                     "collision.tc_time": 1e-3},
+    "rough-coulomb-driven-3d": {"collision.tangential.model": "coulomb", "collision.tangential.restitution": 0.4,
+                                "collision.tangential.friction": 0.2, "initial.rotational_temperature": 0.3,
+                                "driving.heating_rate": 0.05, "driving.interval": 0.05,
+                                "driving.rotational_fraction": 0.4},
 }
 
 
 def _config_text(small_3d, case):
-    return small_3d if case == "viscoelastic-3d" else small_3d.replace("damping = 0.1", "")
+    return small_3d if case != "tc-model-2d" else small_3d.replace("damping = 0.1", "")
 
 
 @pytest.mark.parametrize("case", sorted(CASES))

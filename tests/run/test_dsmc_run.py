@@ -326,3 +326,29 @@ def test_sigint_in_a_real_dsmc_process(write_config, tmp_path):
     assert main(["run", str(path), "--restart", str(out), "--append", "--quiet",
                  "--set", f"run.end_time={t_s + 1.0!r}"]) == 0
     assert [s.time for s in iter_snapshots(out)][-1] == t_s + 1.0
+
+
+def test_rough_driven_dsmc_config_restarts_exactly(dsmc_config, tmp_path):
+    """Rough particles with method = "dsmc": angular velocities in every frame, the rough
+    observables, the energy balance of translation and rotation, --append bit for bit."""
+    text = DSMC_3D.replace('model = "viscoelastic"\ndamping = 0.1',
+                           'model = "constant"\nrestitution = 0.8\n\n[collision.tangential]\nmodel = "coulomb"\n'
+                           "restitution = 0.5\nfriction = 0.3").replace(
+        "[run]", "[driving]\nheating_rate = 0.05\ninterval = 0.1\nrotational_fraction = 0.5\n\n[run]")
+    path = dsmc_config(text)
+    full = run_config(load_config(path, {"output.file": str(tmp_path / "full.h5")}))
+    part = tmp_path / "part.h5"
+    run_config(load_config(path, {"run.end_time": 10.0, "output.file": str(part)}))
+    run_config(load_config(path, {"initial.from": str(part), "output.file": str(part)}), append=True)
+    _assert_same_datasets(full.output, part)
+    with h5py.File(full.output) as f, h5py.File(part) as g:
+        assert np.array_equal(f["particles/all/angular_velocity/value"][()], g["particles/all/angular_velocity/value"][()])
+        assert f["particles/all/angular_velocity/value"].shape == (5, 400, 3)
+        assert np.all(f["particles/all/inertia"][()] == 0.4)
+    obs = read_observables(full.output)
+    ke, diss, inj = obs["kinetic_energy"][2], obs["dissipated_energy"][2], obs["injected_energy"][2]
+    rot = 0.5 * 3 * 400 * obs["rotational_temperature"][2]
+    assert np.allclose(ke + rot + diss - inj, ke[0] + rot[0], rtol=1e-9)
+    assert obs["rotational_temperature"][2][0] == pytest.approx(1.0, rel=1e-12)  # the default: T0
+    assert {"cumulant_a20", "cumulant_a02", "cumulant_a11"} <= set(obs)
+    assert read_parameters(full.output)["tangential"]["friction"] == 0.3

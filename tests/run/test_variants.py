@@ -31,8 +31,12 @@ EXAMPLES = {
     "elastic_3d.toml": ["placement", "lists"],
     "hcs_dsmc_3d.toml": ["dsmc"],
     "clustering_2d_constant.toml": ["placement", "placement-large", "lists"],
+    "rough_hcs_3d.toml": ["placement", "cells-rough"],
+    "rough_driven_2d.toml": ["placement", "lists-rough", "lists-rough-driven"],
+    "rough_mpemba_hot.toml": ["placement", "cells-rough", "cells-rough-driven"],
     "mixture_hcs_3d.toml": ["dsmc-mixture"],
     "glass_steel_3d.toml": ["placement", "cells-mixture"],
+
 }
 
 
@@ -45,7 +49,9 @@ def test_example_configs_name_the_variants_they_compile(name, expected):
 def test_every_example_config_compiles_a_named_variant():
     for path in (ROOT / "configs").glob("*.toml"):
         names = [v.name for v in variants_for(load_config(path))]
-        assert any(n in ("lists", "cells", "resolved", "dsmc", "lists-mixture", "cells-mixture", "dsmc-mixture")
+        assert any(n in ("lists", "cells", "resolved", "dsmc", "lists-rough", "cells-rough", "dsmc-rough",
+                         "lists-mixture", "cells-mixture", "dsmc-mixture")
+
                    for n in names), (path.name, names)
 
 
