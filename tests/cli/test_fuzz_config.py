@@ -92,7 +92,8 @@ def check_run(mc: MutatedConfig):
         stderr = "\n".join(line for line in o.stderr.splitlines() if not line.startswith("compiling "))
         stopped_early = o.code == 130 and stderr.strip() == "interrupted: SIGINT"  # before the file existed
         if o.code == 0 or (o.code == 130 and not stopped_early):
-            outputs = [d / p for p in set(after) - set(before) if p.endswith(".h5")]
+            # the new file (output.file may have any name, "0" as well as "out.h5"; directories end in "/")
+            outputs = [d / p for p in set(after) - set(before) if not p.endswith("/")]
             assert len(outputs) == 1, (after, o.stdout)
             with h5py.File(outputs[0], "r") as f:  # a valid file: at least the first frame
                 assert f["particles/all/velocity/time"].shape[0] >= 1  # the DSMC writes no positions
