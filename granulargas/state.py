@@ -96,6 +96,7 @@ FIELDS = {f.name: f for f in PARTICLE_FIELDS}
 #: Counters of the state that an H5MD file keeps as observables of the same name (sampled
 #: at every frame): name -> dtype. ``time`` and ``events`` are the frame's time and step.
 COUNTERS = {"collisions": np.int64, "dissipated_energy": np.float64, "wall_collisions": np.int64,
+            "wall_work": np.float64,
             "injected_energy": np.float64, "kick_step": np.int64, "three_body_contacts": np.int64}
 
 
@@ -178,6 +179,8 @@ class State:
         still in contact with another (collisions that take time), all so far.
     dissipated_energy, injected_energy : float
         Kinetic energy dissipated in collisions and put in by the driving so far.
+    wall_work : float
+        Energy the thermal and vibrating walls have given the gas so far (net).
     kick_step : int or None
         Index k of the next driving step, at (k + 1/2) dt (None: the first after ``time``).
     species_collisions : int64 array (S, S) or None
@@ -208,6 +211,7 @@ class State:
     three_body_contacts: int = 0
     species_collisions: np.ndarray | None = None
     dsmc: DSMCContinuation | None = None
+    wall_work: float = 0.0
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -236,7 +240,7 @@ class State:
                               f"{('periodic',) * (d - 1) + ('wall',)}")
         else:
             set_(self, "boundary", tuple(str(x) for x in self.boundary))
-        for name in ("time", "dissipated_energy", "injected_energy"):
+        for name in ("time", "dissipated_energy", "injected_energy", "wall_work"):
             set_(self, name, float(getattr(self, name)))
         for name in ("collisions", "events", "wall_collisions", "three_body_contacts"):
             set_(self, name, int(getattr(self, name)))

@@ -66,6 +66,11 @@ SECTION_TEXT = {
                             "of the contact points becomes −β_t times itself, so β_t = −1 is smooth and "
                             "+1 perfectly rough.",
     "driving": "Optional: white-noise driving (a heated granular gas in a steady state).",
+    "gravity": "Optional: a uniform acceleration (see [Gravity and vibrating walls](gravity-and-vibrating-walls.md)).",
+    "walls": "Optional: the kind of each wall (`system.boundary` axes with `\"wall\"`); a side left out "
+             "is a hard wall at rest.",
+    "walls.<side>": "The keys of each side's table in `[walls]` (`x_low`, ..., `z_high`), e.g. "
+                    "`walls.z_low.amplitude`.",
     "species": "Optional, in place of `[particles]`: an array of tables `[[species]]`, one per species of "
                "a mixture ([Mixtures](mixtures.md)). Each key below is checked per species and named "
                "`species.<name>.<key>` in messages and overrides.",
@@ -119,7 +124,7 @@ def config_reference_markdown() -> str:
     entries = config_entries()
     lines = []
     for section in dict.fromkeys(e.section for e in entries):
-        anchor = section.replace(".", "-")
+        anchor = section.replace(".", "-").replace("<", "").replace(">", "")
         shown = f"[[{section}]]" if section == "species" else f"[{section}]"  # an array of tables
         lines += [f"## `{shown}` {{ #{anchor} }}", ""]
         if section in SECTION_TEXT:

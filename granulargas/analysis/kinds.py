@@ -18,6 +18,7 @@ from granulargas.analysis.driven import analyze_driven
 from granulargas.analysis.elastic import analyze_elastic
 from granulargas.analysis.rough import analyze_rough
 from granulargas.analysis.run import RunInfo, analyze_cooling
+from granulargas.analysis.vibrated import analyze_vibrated
 from granulargas.errors import InputFileError
 from granulargas.io.scene import MODELS
 
@@ -28,6 +29,7 @@ ANALYSES = {
     "cooling": analyze_cooling,
     "elastic": analyze_elastic,
     "driven": analyze_driven,
+    "vibrated": analyze_vibrated,
     "rough": analyze_rough,
 }
 

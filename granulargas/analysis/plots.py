@@ -17,7 +17,7 @@ from granulargas.analysis.run import A2_ERROR_METHOD
 from granulargas.theory.hcs import FIRST_SONINE
 
 __all__ = ["PLOTS", "plot_analysis", "ratio_limits", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic",
-           "plot_rough", "plot_sweep"]
+           "plot_rough", "plot_sweep", "plot_vibrated"]
 
 
 def _plt():
@@ -368,6 +368,59 @@ def plot_driven(analysis, path):
 PLOTS["driven"] = plot_driven
 
 
+def plot_vibrated(analysis, path):
+    """Figure of a :class:`granulargas.analysis.vibrated.VibratedAnalysis`: the density profile
+    (with the hydrostatic one for an elastic gas on a thermal floor), the temperature profile
+    along and across the axis, the cumulative energy put in and dissipated, and the centre of
+    mass against time."""
+    plt = _plt()
+    a = analysis
+    p = a.profile
+    ax_name = "xyz"[a.axis]
+    ok = p.counts >= 30
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5))
+    ax = axes[0, 0]
+    ax.plot(p.centres, p.density, "o", ms=3, label="measured")
+    hyd = a.hydrostatic
+    if hyd is not None:
+        ax.plot(p.centres, hyd, "k-", lw=1.2, label="hydrostatic, p = n T_w Z(n)")
+    ax.set_yscale("log")
+    ax.set_xlabel(ax_name)
+    ax.set_ylabel("number density n")
+    ax.legend(fontsize=8)
+    ax = axes[0, 1]
+    ax.plot(p.centres[ok], p.temperature[ok], "o-", ms=3, label="T")
+    ax.plot(p.centres[ok], p.t_along[ok], "^", ms=3, label=f"m<c_{ax_name}^2>")
+    ax.plot(p.centres[ok], p.t_across[ok], "v", ms=3, label="across")
+    if a.thermal_floor is not None:
+        ax.axhline(a.thermal_floor, color="k", lw=1, label="T_w")
+    bed = a.bed
+    if bed is not None:
+        ax.axhline(bed["temperature"], color="k", ls="--", lw=1, label="leading-order bed")
+    ax.set_xlabel(ax_name)
+    ax.set_ylabel("temperature")
+    ax.legend(fontsize=8)
+    ax = axes[1, 0]
+    ax.plot(a.time, a.wall_work - a.wall_work[0], label="put in by the walls")
+    ax.plot(a.time, a.dissipated - a.dissipated[0], label="dissipated")
+    ax.axvline(a.t_from, color="0.6", lw=0.8)
+    ax.set_xlabel("t")
+    ax.set_ylabel("energy (cumulative)")
+    b = a.balance
+    ax.set_title(f"steady state: dissipated / put in = {b.ratio:.4f} ± {b.ratio_error:.2g}", fontsize=9)
+    ax.legend(fontsize=8)
+    ax = axes[1, 1]
+    ax.plot(a.com_time, a.com, "o-", ms=2)
+    ax.axvline(a.t_from, color="0.6", lw=0.8)
+    ax.set_xlabel("t")
+    ax.set_ylabel(f"centre of mass {ax_name}")
+    fig.suptitle(_title(a.info, "Vibrated gas: profiles, energy balance, centre of mass"), fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def plot_rough(analysis, path):
     """T_tr(t), T_rot(t), theta(t) against the two-temperature theory, and the cumulants.
 
@@ -425,6 +478,7 @@ def plot_rough(analysis, path):
     return path
 
 
+PLOTS["vibrated"] = plot_vibrated
 PLOTS["rough"] = plot_rough
 
 

@@ -249,11 +249,11 @@ def _mean_particle_mass(radii, masses, dim) -> float:
 
 
 def run_kind(info: RunInfo) -> str:
-    """``"rough"`` (rough particles, cooling or driven: :mod:`granulargas.analysis.rough`),
-    ``"driven"`` (white-noise driving), ``"elastic"`` (energy conserved: eps = 1 or
-    damping 0), ``"cooling"``, or ``"unknown"`` (the file does not record its collision
-    model, :class:`granulargas.io.scene.Scene`)."""
-    if info.scene.rough and info.scene.model != "unknown":
+    """``"vibrated"`` (gravity, thermal or vibrating walls; rough particles too),
+    ``"rough"`` (rough particles, cooling or driven: :mod:`granulargas.analysis.rough`),
+    ``"driven"`` (white-noise driving), ``"elastic"`` (energy conserved: eps = 1 or damping
+    0), ``"cooling"``, or ``"unknown"`` (the file does not record its collision model, :class:`granulargas.io.scene.Scene`)."""
+    if info.scene.rough and info.scene.model != "unknown" and info.scene.kind != "vibrated":
         return "rough"
     return info.scene.kind
 

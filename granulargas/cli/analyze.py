@@ -246,6 +246,46 @@ def driven_report(a, rows: int = 10) -> str:
     return "\n".join(lines)
 
 
+def vibrated_report(a, rows: int = 10) -> str:
+    """Text report of a :class:`granulargas.analysis.vibrated.VibratedAnalysis`."""
+    s = a.summary()
+    lines = _header(a.info)
+    ax = "xyz"[a.axis]
+    if a.gravity is not None:
+        lines.append(f"  gravity g = {list(a.gravity)}; profiles along {ax}")
+    for name, w in sorted(a.walls.items()):
+        if w.get("kind") == "vibrating":
+            lines.append(f"  {name}: vibrating ({w['waveform']}), A = {w['amplitude']:.4g}, nu = {w['frequency']:.4g}, "
+                         f"A omega = {2 * np.pi * w['amplitude'] * w['frequency']:.4g}")
+        elif w.get("kind") == "thermal":
+            lines.append(f"  {name}: thermal, T_w = {w['temperature']:.4g}")
+    lines.append(f"  theory: {a.theory_name}")
+    lines.append(f"  steady state from t = {a.t_from:.4g}; errors from block means")
+    lines.append(f"  T = {_pm(s.get('T_steady'), s.get('T_steady_error'))}, centre of mass {ax} = "
+                 f"{_pm(s.get('centre_of_mass'), s.get('centre_of_mass_error'))}")
+    if s.get("T_wall") is not None:
+        lines.append(f"  thermal floor T_w = {s['T_wall']:.5g}{_dev(s.get('T_steady'), s['T_wall'])}")
+    if s.get("T_bed_theory") is not None:
+        lines.append(f"  leading-order bed T = {s['T_bed_theory']:.4g}{_dev(s.get('T_steady'), s['T_bed_theory'])}; "
+                     f"its small parameters: (1-e^2) N = {s['bed_dissipation']:.2g}, m<U^2>/T = "
+                     f"{s['bed_plate_speed']:.2g}, A m g/T = {s['bed_amplitude']:.2g}, floor packing "
+                     f"{s['bed_floor_packing']:.2g}")
+    lines.append(f"  energy: walls put in {_pm(s.get('power_in'), s.get('power_in_error'))} per unit time, collisions "
+                 f"dissipate {_pm(s.get('dissipation'), s.get('dissipation_error'))}; ratio "
+                 f"{_pm(s.get('balance_ratio'), s.get('balance_ratio_error'), '.4f')} (1 in a steady state)")
+    p = a.profile
+    hyd = a.hydrostatic
+    head = f"  {ax:>8} {'n':>10} {'T':>10} {'T_along':>10} {'T_across':>10} {'kurt.':>8}"
+    lines += ["", head + (f" {'n_hydro':>10}" if hyd is not None else "")]
+    filled = np.flatnonzero(p.counts >= 30)  # layers with samples enough for a temperature
+    for i in filled[np.unique(np.linspace(0, len(filled) - 1, max(rows, 2)).astype(int))] if filled.size else ():
+        k = float(np.nanmean(p.kurtosis[i]))
+        row = (f"  {p.centres[i]:8.4g} {p.density[i]:10.4g} {p.temperature[i]:10.4g} {p.t_along[i]:10.4g} "
+               f"{p.t_across[i]:10.4g} {k:8.3f}")
+        lines.append(row + (f" {hyd[i]:10.4g}" if hyd is not None else ""))
+    return "\n".join(lines)
+
+
 def rough_report(a, rows: int = 10) -> str:
     """Text report of a :class:`granulargas.analysis.rough.RoughAnalysis`."""
     from granulargas.analysis.rough import RELAXATION_COLLISIONS
@@ -285,7 +325,8 @@ def rough_report(a, rows: int = 10) -> str:
 
 
 #: kind -> text report ``f(analysis, rows) -> str``
-REPORTS = {"cooling": cooling_report, "elastic": elastic_report, "driven": driven_report, "rough": rough_report}
+REPORTS = {"cooling": cooling_report, "elastic": elastic_report, "driven": driven_report, "rough": rough_report,
+           "vibrated": vibrated_report}
 
 
 def walls_report(w: dict) -> str:
@@ -377,7 +418,7 @@ def run(args) -> int:
     except (ValueError, ArithmeticError) as exc:  # numbers no run of ours writes (a damaged file)
         raise InputFileError(f"{args.file}: cannot analyse ({exc or type(exc).__name__})") from None
     walls = None
-    if a.info.walls:
+    if a.info.walls and a.kind != "vibrated":  # (a vibrated gas: its own profiles)
         from granulargas.analysis.walls import wall_summary
 
         t_from = getattr(a, "t_equilibrated", getattr(a, "t_relaxed", float(a.time[0])))

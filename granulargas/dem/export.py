@@ -55,6 +55,10 @@ def export_lammps(config, directory, *, contact_fraction: float | None = 0.01, s
     if config.run.method == "dsmc":
         raise ConfigError(f'{config.source}: run.method = "dsmc": a DSMC run has no positions; LAMMPS export '
                           'writes a spatial run (export the config with run.method = "edmd")')
+    for section in ("gravity", "walls"):
+        if getattr(config, section) is not None:
+            raise ConfigError(f"{config.source}: [{section}]: the LAMMPS export writes flat hard walls and no field "
+                              f"(export the config without [{section}])")
     if c.model == "constant":
         raise ConfigError(
             f"{config.source}: collision.model = \"constant\": LAMMPS export needs the viscoelastic "

@@ -2,12 +2,13 @@
 
 Public API (contract in ARCHITECTURE.md)::
 
-    from granulargas.engine import Simulation, CollisionRule, TangentialRule, WhiteNoise
+    from granulargas.engine import Simulation, CollisionRule, TangentialRule, WhiteNoise, Wall, Walls
 """
 
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.rules import CollisionRule
 from granulargas.engine.simulation import Simulation
 from granulargas.engine.tangential import TangentialRule
+from granulargas.engine.walls import Wall, Walls
 
-__all__ = ["Simulation", "CollisionRule", "TangentialRule", "WhiteNoise"]
+__all__ = ["Simulation", "CollisionRule", "TangentialRule", "WhiteNoise", "Wall", "Walls"]

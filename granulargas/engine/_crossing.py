@@ -47,7 +47,8 @@ import math
 import numpy as np
 
 from granulargas._numba import inlined, kernel
-from granulargas.engine._geometry import min_image, pair_delay
+from granulargas.engine._flight import face_delay, pair_delay
+from granulargas.engine._geometry import min_image
 from granulargas.engine._prefetch import prefetch
 
 #: cells are at least (1 + MARGIN) times the largest contact distance wide
@@ -109,15 +110,31 @@ def face_gap(x, v, c, width, n, period):
 
 
 @inlined
-def predict_crossing(i, t, rec, grid, space):
+def predict_crossing(i, t, rec, grid, space, flight):
     """Earliest cell crossing of particle i (streamed to t): (time, face 2 a + side).
 
     The axis whose face comes first has the least gap / speed; the times are
     compared as gap_a |v_b| < gap_b |v_a| and one division gives the delay
     (inf if the particle crosses no face). The axis is chosen without a branch
-    (weights, as in :func:`face_gap`).
+    (weights, as in :func:`face_gap`). Under gravity (``flight`` not None) each axis's
+    first crossing is the root of a quadratic
+    (:func:`granulargas.engine._flight.face_delay`), and the earliest is kept.
     """
     cell = grid.cell
+    if flight is not None:
+        best = math.inf
+        face = np.int64(0)
+        for a in range(space.dims):
+            c = cell[i, a]
+            n = space.ncell[a]
+            per = space.period[a]
+            width = grid.width[a]
+            s, side = face_delay(min_image(rec[i, a] - c * width, per), rec[i, 3 + a], flight[a], width,
+                                 per < math.inf or c > 0, per < math.inf or c < n - 1)
+            if s < best:
+                best = s
+                face = 2 * a + side
+        return t + best, face
     gap, speed, side = face_gap(rec[i, 0], rec[i, 3], cell[i, 0], grid.width[0], space.ncell[0],
                                 space.period[0])
     face = side
@@ -147,7 +164,7 @@ def _neighbour(c, o, n, period):
 
 
 @inlined
-def _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period):
+def _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period, flight):
     """Second pass of the cell scans: the earliest collision, before ``before``, of the
     particle at (xi, yi, zi) moving with (vx, vy, vz), radius ri, at time t, with the
     particles of the cells whose first particles are ``first[1:k]`` (each cell's chain
@@ -157,7 +174,7 @@ def _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, p
     for q in range(1, k):
         j = first[q]
         while j >= 0:
-            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
+            tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period, flight)
             better = tc < best
             best = tc if better else best
             p = j if better else p
@@ -166,7 +183,7 @@ def _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, p
 
 
 @kernel(python=False)
-def scan_cells(i, t, before, rec, head, row_of, first, ncell, period, x0, x1, y0, y1, z0, z1):
+def scan_cells(i, t, before, rec, head, row_of, first, ncell, period, x0, x1, y0, y1, z0, z1, flight):
     """Earliest collision of particle i (streamed to t) with the particles of the cells at
     offsets [x0, x1] x [y0, y1] x [z0, z1] from its cell, before ``before``: (time,
     partner slot) or (``before``, -1). It takes ``head``, ``row_of`` (= ``cell``) and
@@ -212,7 +229,7 @@ def scan_cells(i, t, before, rec, head, row_of, first, ncell, period, x0, x1, y0
                 j = head[kx + row]
                 first[k] = j
                 k += 1 if j >= 0 else 0
-    return _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period)
+    return _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period, flight)
 
 
 @inlined
@@ -225,7 +242,7 @@ def _interior(i, grid, space):
 
 
 @inlined
-def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
+def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0, flight):
     """:func:`scan_cells` over cells of flat index c0 + u s1 + w s2 + v (w, u in 0..2,
     v in 0..n0-1, in this order) -- the cells around an interior cell, without wraps; the
     same two passes. (The coordinate differences keep their nearest-image tests: a particle
@@ -250,11 +267,11 @@ def scan_block(i, t, before, rec, grid, space, c0, s1, s2, n0):
                 j = head[b + v]
                 first[k] = j
                 k += 1 if j >= 0 else 0
-    return _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period)
+    return _scan_listed(first, k, t, before, xi, yi, zi, vx, vy, vz, ri, rec, row_of, period, flight)
 
 
 @inlined
-def predict_pair_cells(i, t, before, rec, count, grid, space):
+def predict_pair_cells(i, t, before, rec, count, grid, space, flight):
     """Earliest collision of particle i (streamed to t) before ``before``: (time, partner
     slot) or (``before``, -1).
 
@@ -270,11 +287,12 @@ def predict_pair_cells(i, t, before, rec, count, grid, space):
         if _interior(i, grid, space):
             nx = space.ncell[0]
             sz = nx * space.ncell[1]
-            pt, pj = scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz, 3)
+            pt, pj = scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz, 3,
+                                flight)
         else:
             zr = 1 if space.ncell[2] >= 3 else 0
             pt, pj = scan_cells(i, t, math.inf, rec, grid.head, grid.cell, grid.fresh, space.ncell, space.period,
-                                -1, 1, -1, 1, -zr, zr)
+                                -1, 1, -1, 1, -zr, zr, flight)
         grid.pair_t[i] = pt
         grid.cell[i, PAIR_J] = pj
         grid.cell[i, PAIR_TAG] = count[pj] if pj >= 0 else 0
@@ -284,7 +302,7 @@ def predict_pair_cells(i, t, before, rec, count, grid, space):
 
 
 @inlined
-def scan_new_layer(i, t, face, rec, count, grid, space):
+def scan_new_layer(i, t, face, rec, count, grid, space, flight):
     """After i crossed ``face`` into its present cell: keep the better of the stored pair
     and the particles of the layer of cells that became adjacent, and mark the stored
     pair current (``grid.fresh``); if the stored partner has collided since, do
@@ -302,7 +320,7 @@ def scan_new_layer(i, t, face, rec, count, grid, space):
         s1 = nx if a == 0 else 1
         s2 = nx if a == 2 else sz
         pt, pn = scan_block(i, t, grid.pair_t[i], rec, grid, space, grid.cell[i, FLAT] + o * sa - s1 - s2,
-                            s1, s2, 1)
+                            s1, s2, 1, flight)
     else:
         zr = 1 if space.ncell[2] >= 3 else 0
         x0 = o if a == 0 else -1
@@ -312,7 +330,7 @@ def scan_new_layer(i, t, face, rec, count, grid, space):
         z0 = o if a == 2 else -zr
         z1 = o if a == 2 else zr
         pt, pn = scan_cells(i, t, grid.pair_t[i], rec, grid.head, grid.cell, grid.fresh, space.ncell, space.period,
-                            x0, x1, y0, y1, z0, z1)
+                            x0, x1, y0, y1, z0, z1, flight)
     if pn >= 0:
         grid.pair_t[i] = pt
         grid.cell[i, PAIR_J] = pn

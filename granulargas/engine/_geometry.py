@@ -1,6 +1,8 @@
 """Compiled geometry of free flight between events (numba leaf module).
 
-Particles move on straight lines between events. Internally every system is
+The geometry of straight flights; the flight itself (straight or under gravity) and the
+pair prediction with a partner streamed on its flight are
+:mod:`granulargas.engine._flight`. Internally every system is
 three-dimensional: a 2D system has z = 0, v_z = 0 and one cell layer, so the
 same kernels (one compiled signature) serve disks and spheres. Each axis is
 periodic (period L: minimum image, wrap) or bounded by flat hard walls at 0 and
@@ -72,18 +74,6 @@ def collision_delay(dx, dy, dz, ux, uy, uz, sigma):
     s = gap / (den if hit else 1.0)
     s = s if gap > 0.0 else 0.0
     return s if hit else math.inf
-
-
-@inlined
-def pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period):
-    """Time from t until particle i (centre (xi, yi, zi) at t, velocity v, radius ri)
-    touches particle j, streamed from its own clock: (1) with the record of j
-    (``rec[j]``: position at its clock ``rec[j, 6]``, velocity, radius ``rec[j, 7]``)."""
-    dtj = t - rec[j, 6]
-    return collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj), period[0]),
-                           min_image(yi - (rec[j, 1] + rec[j, 4] * dtj), period[1]),
-                           min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), period[2]),
-                           vx - rec[j, 3], vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
 
 
 @inlined

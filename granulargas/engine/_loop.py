@@ -103,11 +103,21 @@ from granulargas.engine._crossing import (
     scan_new_layer,
 )
 from granulargas.engine._drive import kick_velocities
-from granulargas.engine._geometry import collision_delay, exit_delay, min_image, pair_delay, wall_delay
+from granulargas.engine._flight import expiry_delay, pair_delay, partner_at, stream
+from granulargas.engine._geometry import collision_delay, min_image, wall_delay
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._resolved import resolved_pair
 from granulargas.engine._species import count_pair, pair_law, wall_law
 from granulargas.engine._spin import kick_spins, rough_pair, rough_wall
+from granulargas.engine._walls import (
+    RECHECK,
+    THERMAL,
+    VIBRATING,
+    moving_wall_collision,
+    predict_walls,
+    thermal_velocity,
+    wall_motion,
+)
 from granulargas.engine._probe import (
     COLLIDE,
     PEEK,
@@ -141,34 +151,19 @@ STALE = -4
 CROSS = -5
 
 
-@inlined
-def stream(i, t, rec, img, period):
-    """Move particle i on its straight line to time t, wrapping on periodic axes."""
-    dt = t - rec[i, 6]
-    for a in range(3):
-        x = rec[i, a] + rec[i, 3 + a] * dt
-        if x >= period[a]:
-            x -= period[a]
-            img[i, a] += 1
-        elif x < 0.0:
-            x += period[a]
-            img[i, a] -= 1
-        rec[i, a] = x
-    rec[i, 6] = t
-
-
 # --------------------------------------------------------------------- predict
 @inlined
-def predict_expiry(i, t, rec, centre, period, half_shell):
-    """Time at which particle i (streamed to t) is ``half_shell`` from its list centre."""
-    return t + exit_delay(min_image(rec[i, 0] - centre[i, 0], period[0]),
-                          min_image(rec[i, 1] - centre[i, 1], period[1]),
-                          min_image(rec[i, 2] - centre[i, 2], period[2]),
-                          rec[i, 3], rec[i, 4], rec[i, 5], half_shell)
+def predict_expiry(i, t, rec, centre, period, half_shell, flight):
+    """Time at which particle i (streamed to t) is ``half_shell`` from its list centre (under
+    gravity a lower bound of it: :func:`granulargas.engine._flight.expiry_delay`)."""
+    return t + expiry_delay(min_image(rec[i, 0] - centre[i, 0], period[0]),
+                            min_image(rec[i, 1] - centre[i, 1], period[1]),
+                            min_image(rec[i, 2] - centre[i, 2], period[2]),
+                            rec[i, 3], rec[i, 4], rec[i, 5], half_shell, flight)
 
 
 @inlined
-def predict_pair(i, t, before, rec, nbl, nbn, period):
+def predict_pair(i, t, before, rec, nbl, nbn, period, flight):
     """Earliest collision of particle i (streamed to t) with its neighbours before ``before``.
 
     Returns (time, partner slot), or (``before``, -1) if there is none. Branch-free
@@ -185,7 +180,7 @@ def predict_pair(i, t, before, rec, nbl, nbn, period):
     p = -1
     for k in range(nbn[i]):
         j = nbl[i, k]
-        tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period)
+        tc = t + pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period, flight)
         better = tc < best
         best = tc if better else best
         p = j if better else p
@@ -193,7 +188,7 @@ def predict_pair(i, t, before, rec, nbl, nbn, period):
 
 
 @kernel(python=False)
-def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts):
+def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts, flight):
     """:func:`predict_pair` for a particle whose contact is under way (resolved rule,
     :mod:`granulargas.engine._resolved`).
 
@@ -218,17 +213,17 @@ def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts):
     p = -1
     for k in range(nbn[i]):
         j = nbl[i, k]
-        dtj = t - rec[j, 6]
+        xj, yj, zj, wx, wy, wz = partner_at(j, t - rec[j, 6], rec, flight)
         end = until[i] if j == skip else -math.inf
         if partner[j] == i and until[j] > end:
             end = until[j]
         h = end - t if end > t else 0.0
-        ux = vx - rec[j, 3]
-        uy = vy - rec[j, 4]
-        uz = vz - rec[j, 5]
-        s = collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj) + ux * h, period[0]),
-                            min_image(yi - (rec[j, 1] + rec[j, 4] * dtj) + uy * h, period[1]),
-                            min_image(zi - (rec[j, 2] + rec[j, 5] * dtj) + uz * h, period[2]),
+        ux = vx - wx
+        uy = vy - wy
+        uz = vz - wz
+        s = collision_delay(min_image(xi - xj + ux * h, period[0]),
+                            min_image(yi - yj + uy * h, period[1]),
+                            min_image(zi - zj + uz * h, period[2]),
                             ux, uy, uz, ri + rec[j, 7])
         tc = t + h + s
         better = tc < best
@@ -243,7 +238,7 @@ def in_contact(contacts, i, t):
     without any of the resolved rule's code)."""
 
 
-def predict_pair_contact(i, t, before, rec, lists, period, contacts):
+def predict_pair_contact(i, t, before, rec, lists, period, contacts, flight):
     """:func:`predict_pair_except` (``contacts`` None: never called, returns (before, -1))."""
 
 
@@ -259,11 +254,11 @@ def _in_contact(contacts, i, t):
 
 
 @overload(predict_pair_contact)
-def _predict_pair_contact(i, t, before, rec, lists, period, contacts):
+def _predict_pair_contact(i, t, before, rec, lists, period, contacts, flight):
     if isinstance(contacts, types.NoneType):
-        return lambda i, t, before, rec, lists, period, contacts: (before, np.int64(-1))
-    return lambda i, t, before, rec, lists, period, contacts: predict_pair_except(
-        i, t, before, rec, lists.nbl, lists.nbn, period, contacts)
+        return lambda i, t, before, rec, lists, period, contacts, flight: (before, np.int64(-1))
+    return lambda i, t, before, rec, lists, period, contacts, flight: predict_pair_except(
+        i, t, before, rec, lists.nbl, lists.nbn, period, contacts, flight)
 
 
 @overload(collide_resolved)
@@ -310,11 +305,16 @@ def _kick_rough(rec, mass, ident, dims, spins, seed, step):
 
 
 @inlined
-def predict_wall(i, t, rec, space):
+def predict_wall(i, t, before, rec, space, flight, wallkinds):
     """Earliest wall collision of particle i (streamed to t): (time, wall index 2 a + side).
 
-    (inf, 0) without wall axes.
+    (inf, 0) without wall axes. With gravity (``flight``) or wall kinds other than hard
+    walls at rest (``wallkinds``) :func:`granulargas.engine._walls.predict_walls`, which
+    may stop looking at ``before`` (i's earliest other event, after which it is predicted
+    again) and tags a re-check with :data:`~granulargas.engine._walls.RECHECK`.
     """
+    if flight is not None or wallkinds is not None:
+        return predict_walls(i, t, before, rec, space, flight, wallkinds)
     best = math.inf
     wall = 0
     axes = space.wall_axes
@@ -340,10 +340,10 @@ def mode_flags(cells):
 
 
 @inlined
-def settle_event(i, t, best, p, tag, rec, events, space):
+def settle_event(i, t, best, p, tag, rec, events, space, flight, wallkinds):
     """The earlier of i's predicted event (time ``best``, partner or kind ``p``, ``tag``) and
     its next wall impact into i's event slot; returns that event's time."""
-    tw, wall = predict_wall(i, t, rec, space)
+    tw, wall = predict_wall(i, t, best, rec, space, flight, wallkinds)
     if tw < best:
         best = tw
         p = WALL
@@ -354,7 +354,7 @@ def settle_event(i, t, best, p, tag, rec, events, space):
 
 
 @kernel(python=False)
-def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts):
+def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight, wallkinds):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
 
     ``lists`` is the neighbour lists (``onlists`` = 1, ``oncells`` = None) or the cell
@@ -365,70 +365,76 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
 
     ``contacts`` (resolved rule; None otherwise): while i's contact is under way
     (t < ``contacts.until[i]``; the end of a contact of i with j is never before j's)
-    its contact partners are left out (:func:`predict_pair_except`)."""
+    its contact partners are left out (:func:`predict_pair_except`).
+
+    ``flight`` (None: straight; gravity: the (3,) acceleration) and ``wallkinds`` (None:
+    hard walls at rest; else a :class:`~granulargas.engine._state.WallSpec`): numba removes
+    their branches for None, as for the mode flags."""
     best = math.inf
     kind = np.int64(EXPIRY)
     tag = np.int64(0)
     p = np.int64(-1)
     if onlists is not None:
-        best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
+        best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell, flight)
     if oncells is not None:
-        best, face = predict_crossing(i, t, rec, lists, space)
+        best, face = predict_crossing(i, t, rec, lists, space, flight)
         kind = np.int64(CROSS)
         tag = np.int64(face)
     if in_contact(contacts, i, t):
-        best, p = predict_pair_contact(i, t, best, rec, lists, space.period, contacts)
+        best, p = predict_pair_contact(i, t, best, rec, lists, space.period, contacts, flight)
     else:
         if onlists is not None:
-            best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
+            best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period, flight)
         if oncells is not None:
-            best, p = predict_pair_cells(i, t, best, rec, count, lists, space)
+            best, p = predict_pair_cells(i, t, best, rec, count, lists, space, flight)
     if p >= 0:
         tag = np.int64(count[p])
     else:
         p = kind
-    return settle_event(i, t, best, p, tag, rec, events, space)
+    return settle_event(i, t, best, p, tag, rec, events, space, flight, wallkinds)
 
 
 @inlined
-def predict_listed(i, t, rec, count, events, lists, space, half_shell, contacts):
+def predict_listed(i, t, rec, count, events, lists, space, half_shell, contacts, flight, wallkinds):
     """:func:`predict` in the neighbour-list mode, inlined into the loop's two hot sites
     (the particle of the event and its collision partner; ``predict`` itself is a call)."""
-    best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell)
+    best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell, flight)
     tag = np.int64(0)
     if in_contact(contacts, i, t):
-        best, p = predict_pair_contact(i, t, best, rec, lists, space.period, contacts)
+        best, p = predict_pair_contact(i, t, best, rec, lists, space.period, contacts, flight)
     else:
-        best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period)
+        best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period, flight)
     if p >= 0:
         tag = np.int64(count[p])
     else:
         p = np.int64(EXPIRY)
-    return settle_event(i, t, best, p, tag, rec, events, space)
+    return settle_event(i, t, best, p, tag, rec, events, space, flight, wallkinds)
 
 
 @inlined_ir
-def predict_cells(i, t, rec, count, events, grid, space):
+def predict_cells(i, t, rec, count, events, grid, space, flight, wallkinds):
     """:func:`predict` in the cell-crossing mode (no contacts there), for the loop to inline
     at its two hot sites, the event's own particle and a collision partner: the crossing,
     the best pair (the stored one right after a crossing of i, else the scan of the cells
     around i), the walls. (Inlined at the partner too it costs ~0.4 s of first compile and
     saves 1-4 % of the run time at packing 0.05-0.1.)"""
-    best, face = predict_crossing(i, t, rec, grid, space)
+    best, face = predict_crossing(i, t, rec, grid, space, flight)
     tag = np.int64(face)
     p = np.int64(CROSS)
-    best, pj = predict_pair_cells(i, t, best, rec, count, grid, space)
+    best, pj = predict_pair_cells(i, t, best, rec, count, grid, space, flight)
     if pj >= 0:
         p = np.int64(pj)
         tag = np.int64(count[p])
-    return settle_event(i, t, best, p, tag, rec, events, space)
+    return settle_event(i, t, best, p, tag, rec, events, space, flight, wallkinds)
 
 
 @kernel
-def predict_all(t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, times):
+def predict_all(t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight, wallkinds,
+                times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
     for i in range(rec.shape[0]):
-        times[i] = predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts)
+        times[i] = predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight,
+                           wallkinds)
 
 
 # --------------------------------------------------------------------- execute
@@ -457,8 +463,10 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     rec = p.rec
     period = prm.space.period
     rule = prm.rule
-    stream(i, te, rec, p.img, period)
-    stream(j, te, rec, p.img, period)
+    flight = prm.flight
+    wallkinds = prm.wallkinds
+    stream(i, te, rec, p.img, period, flight)
+    stream(j, te, rec, p.img, period, flight)
     dx = min_image(rec[i, 0] - rec[j, 0], period[0])
     dy = min_image(rec[i, 1] - rec[j, 1], period[1])
     dz = min_image(rec[i, 2] - rec[j, 2], period[2])
@@ -482,7 +490,8 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
         mi = p.mass[i]
         mj = p.mass[j]
         lastcoll = p.lastcoll
-        if rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time):
+        if (rule.tc_time > 0.0 and (te - lastcoll[i] < rule.tc_time or te - lastcoll[j] < rule.tc_time)
+                or -un < rule.elastic_below):
             eps = 1.0
         else:
             r_eff = rec[i, 7] * rec[j, 7] / (rec[i, 7] + rec[j, 7])
@@ -515,13 +524,14 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
     if onlists is not None:
-        tj = predict_listed(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
+        tj = predict_listed(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, flight, wallkinds)
     if oncells is not None:
-        tj = predict_cells(j, te, rec, p.count, ev, lists, prm.space)
+        tj = predict_cells(j, te, rec, p.count, ev, lists, prm.space, flight, wallkinds)
     if not cal_update_ring(j, tj, cal):
         return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
-        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
+        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts,
+                     flight, wallkinds)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
         c.events += 1
         c.err_i = i
@@ -534,7 +544,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
 def execute_expiry(i, te, p, lists, cells, c, prm):
     """List expiry of i at te: a new list centre and neighbour list (OVERFLOW/CELL_OVERFLOW
     if a list or a cell is full: nothing changed, the driver enlarges and calls again)."""
-    stream(i, te, p.rec, p.img, prm.space.period)
+    stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
     st = rebuild_list(i, p.rec, lists, cells, prm.space, prm.rmax, prm.shell)
     if st != 0:
         c.err_i = i
@@ -550,28 +560,31 @@ def execute_crossing(i, face, te, p, grid, c, prm):
     (:func:`granulargas.engine._crossing.cross`) and its best pair updated with the
     layer of cells that became adjacent (:func:`~granulargas.engine._crossing.scan_new_layer`);
     the loop's prediction of i then uses it."""
-    stream(i, te, p.rec, p.img, prm.space.period)
+    stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
     cross(i, face, grid, prm.space)
-    scan_new_layer(i, te, face, p.rec, p.count, grid, prm.space)
+    scan_new_layer(i, te, face, p.rec, p.count, grid, prm.space, prm.flight)
     c.crossings += 1
     return DONE
 
 
 @kernel(python=False)
-def execute_wall(i, wall, te, p, c, walls, prm, spins, species):
+def execute_wall(i, wall, te, p, c, walls, prm, flight, wallkinds, spins, species):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
     m_eff = m_i (rough particles: :func:`granulargas.engine._spin.rough_wall`, except the TC
-    model's elastic collisions; a mixture: the normal law of i's species). Returns DONE or
-    TABLE_RANGE."""
+    model's elastic collisions; a mixture: the normal law of i's species; hard walls at rest;
+    other kinds: :func:`execute_wall_kind`, smooth particles only). Returns DONE, TABLE_RANGE
+    or COLLAPSE."""
     rec = p.rec
     rule = prm.rule
-    stream(i, te, rec, p.img, prm.space.period)
+    stream(i, te, rec, p.img, prm.space.period, flight)
+    if wallkinds is not None:
+        return execute_wall_kind(i, wall, te, p, c, walls, prm, wallkinds, species)
     a = wall >> 1
     side = wall & 1
     vn = rec[i, 3 + a]
     if (vn < 0.0) if side == 0 else (vn > 0.0):  # moving into the wall
         mi = p.mass[i]
-        if rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time:
+        if rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time or abs(vn) < rule.elastic_below:
             eps = 1.0
         else:
             eps_wall, k_wall = wall_law(rule.wall_eps, rule.prefactor, species, i)
@@ -602,6 +615,71 @@ def execute_wall(i, wall, te, p, c, walls, prm, spins, species):
 
 
 @kernel(python=False)
+def execute_wall_kind(i, wall, te, p, c, walls, prm, spec, species):
+    """Collision of i (streamed to te) with wall ``wall`` of kind ``spec.kind[a, side]``
+    (:mod:`granulargas.engine._walls`): hard (at rest), thermal (outgoing velocity drawn
+    from the wall's Maxwellian flux) or vibrating (the rule at the normal speed relative to
+    the wall, the wall's velocity at te; a mixture: the law of i's species). The energy a
+    thermal or vibrating wall gives the
+    gas is added to ``walls.work``. A re-check event (tag bit ``RECHECK``) changes nothing."""
+    if wall & RECHECK:
+        walls.rechecks[0] += 1
+        return DONE
+    rec = p.rec
+    rule = prm.rule
+    a = wall >> 1
+    side = wall & 1
+    kind = spec.kind[a, side]
+    vn = rec[i, 3 + a]
+    mi = p.mass[i]
+    if kind == THERMAL:
+        if not ((vn < 0.0) if side == 0 else (vn > 0.0)):
+            return DONE
+        out, t1, t2 = thermal_velocity(spec.seed, c.wall_collisions, math.sqrt(spec.temperature[a, side] / mi))
+        e_old = rec[i, 3] * rec[i, 3] + rec[i, 4] * rec[i, 4] + rec[i, 5] * rec[i, 5]
+        rec[i, 3 + a] = out if side == 0 else -out
+        m = 0
+        for b in range(prm.space.dims):
+            if b != a:
+                rec[i, 3 + b] = t1 if m == 0 else t2
+                m += 1
+        e_new = rec[i, 3] * rec[i, 3] + rec[i, 4] * rec[i, 4] + rec[i, 5] * rec[i, 5]
+        walls.work[a, side] += 0.5 * mi * (e_new - e_old)
+        walls.impulse[a, side] += mi * (abs(vn) + out)
+        c.sum_mv2 += mi * (e_new - e_old)
+    else:
+        _, wv, _ = wall_motion(spec, a, side, te)
+        u = vn - wv
+        if (u >= 0.0) if side == 0 else (u <= 0.0):  # not moving into the wall
+            return DONE
+        g = abs(u)
+        if rule.tc_time > 0.0 and te - p.lastcoll[i] < rule.tc_time or g < rule.elastic_below:
+            eps = 1.0
+        else:
+            eps_wall, k_wall = wall_law(rule.wall_eps, rule.prefactor, species, i)
+            eps = restitution(rule.kind, eps_wall, k_wall, rule.inv_h, rule.coeffs, g, rec[i, 7], mi)
+            if eps < 0.0:
+                c.err_i = i
+                c.err_j = -1
+                return TABLE_RANGE
+        v_new, loss, work, impulse = moving_wall_collision(vn, wv, eps, mi, side)
+        rec[i, 3 + a] = v_new
+        c.dissipated += loss
+        c.sum_mv2 += mi * (v_new * v_new - vn * vn)
+        walls.impulse[a, side] += impulse
+        if kind == VIBRATING:
+            walls.work[a, side] += work
+    p.count[i] += 1
+    c.wall_collisions += 1
+    _collapse_watch(i, te, p, prm)
+    if p.rapid[i] >= prm.collapse_count:
+        c.err_i = i
+        c.err_j = -1
+        return COLLAPSE
+    return DONE
+
+
+@kernel(python=False)
 def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins):
     """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1; rough
     particles' spins too, :func:`granulargas.engine._spin.kick_spins`); every event predicted
@@ -609,7 +687,7 @@ def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins
     rec = p.rec
     n = rec.shape[0]
     for i in range(n):
-        stream(i, t, rec, p.img, prm.space.period)
+        stream(i, t, rec, p.img, prm.space.period, prm.flight)
     c.injected += kick_velocities(rec, 3, p.mass, p.ident, prm.space.dims, prm.kick_seed,
                                   c.kick_step, prm.kick_scale)
     if spins is not None:
@@ -620,7 +698,8 @@ def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins
     c.sum_mv2 = s
     c.kick_step += 1
     c.kicks += 1
-    predict_all(t, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts, cal.qt)
+    predict_all(t, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts, prm.flight,
+                prm.wallkinds, cal.qt)
     return DONE if cal_build(t, cal) else CALENDAR
 
 
@@ -813,25 +892,27 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if status != DONE:
                 break
         elif j == WALL:
-            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, spins, species)
+            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, prm.flight, prm.wallkinds, spins, species)
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:
-                    ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts)
+                    ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
+                                 contacts, prm.flight, prm.wallkinds)
                     if not cal_update(i, ti, cal):
                         status = CALENDAR
                     c.events += 1
                 break
         else:
             # ---- stale event: the partner changed course; just re-predict
-            stream(i, te, rec, p.img, prm.space.period)
+            stream(i, te, rec, p.img, prm.space.period, prm.flight)
             c.stale += 1
             clock = tick(probe, P_STALE, clock)
         # ---- re-predict the particle of the event
         if onlists is not None:
-            ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts)
+            ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, prm.flight,
+                                prm.wallkinds)
         if oncells is not None:
-            ti = predict_cells(i, te, rec, p.count, ev, lists, prm.space)
+            ti = predict_cells(i, te, rec, p.count, ev, lists, prm.space, prm.flight, prm.wallkinds)
         clock = tick(probe, PREDICT, clock)
         if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
             status = CALENDAR
@@ -890,18 +971,25 @@ def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisi
 
 
 @kernel
-def synchronised(rec, img, period, t, out_r, out_img):
-    """Positions and images of all particles streamed to time t (no side effect).
+def synchronised(rec, img, period, t, flight, out_r, out_img, out_v):
+    """Positions, images and velocities of all particles streamed to time t on their flight
+    (no side effect).
 
     Positions land in [0, L) on periodic axes: one wrap suffices because no
     particle is more than shell/2 from its list centre, which lies in the box
     (cell-crossing mode: no particle is beyond its cell by more than round-off).
-    Wall axes (period inf) are not wrapped.
+    Wall axes (period inf) are not wrapped. Straight flights keep the velocities.
     """
     for i in range(rec.shape[0]):
         dt = t - rec[i, 6]
         for a in range(3):
-            x = rec[i, a] + rec[i, 3 + a] * dt
+            if flight is None:
+                x = rec[i, a] + rec[i, 3 + a] * dt
+                out_v[i, a] = rec[i, 3 + a]
+            else:
+                w = rec[i, 3 + a] + flight[a] * dt
+                x = rec[i, a] + 0.5 * (rec[i, 3 + a] + w) * dt
+                out_v[i, a] = w
             k = img[i, a]
             if x >= period[a]:
                 x -= period[a]

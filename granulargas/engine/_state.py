@@ -57,7 +57,10 @@ Record layout
 * ``calendar`` :class:`Calendar` -- see :mod:`granulargas.engine._calendar`.
 * ``counters`` (1,) :data:`COUNTERS` record.
 * ``walls`` :class:`Walls` -- ``impulse`` (3, 2) f8: normal momentum delivered to
-  the lower / upper wall of each axis since the last reset.
+  the lower / upper wall of each axis since the last reset; ``work`` (3, 2) f8: energy
+  the thermal and vibrating walls have given the gas (cumulative, net); ``rechecks``
+  (1,) i8: wall events that were re-checks of a vibrating wall's contact search
+  (:mod:`granulargas.engine._walls`).
 * ``contacts`` :class:`Contacts` -- collisions that take time
   (:mod:`granulargas.engine._resolved`): ``until`` f8, the time at which the
   particle's last contact ends (-inf: none), ``partner`` i4 the slot of that
@@ -90,7 +93,7 @@ Lists = namedtuple("Lists", ["centre", "nbl", "nbn", "scratch", "stencil", "mark
 Cells = namedtuple("Cells", ["ids", "n"])
 Grid = namedtuple("Grid", ["head", "cell", "width", "pair_t", "fresh"])
 Calendar = namedtuple("Calendar", ["qt", "chunks", "where", "small", "buckets", "state"])
-Walls = namedtuple("Walls", ["impulse"])
+Walls = namedtuple("Walls", ["impulse", "work", "rechecks"])
 Contacts = namedtuple("Contacts", ["until", "partner", "work", "out"])
 Spins = namedtuple("Spins", ["w", "kappa", "model", "beta", "mu", "wall_beta", "wall_mu", "kick_scale"])
 Species = namedtuple("Species", ["of", "count", "eps", "prefactor", "wall_eps", "wall_prefactor", "weight",
@@ -104,10 +107,11 @@ Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calenda
 #: restitution table (``inv_h``, ``coeffs``), the sphere-wall ``wall_eps``
 #: (constant rule), and for collisions that take time ``resolved`` (1: on), the
 #: compression prefactor q and the oblique-contact table (``ob_inv_hs``,
-#: ``ob_inv_hd``, ``ob_coeffs``; :mod:`granulargas.contact.oblique_lookup`).
+#: ``ob_inv_hd``, ``ob_coeffs``; :mod:`granulargas.contact.oblique_lookup`);
+#: ``elastic_below``: collisions at a normal speed below it are elastic (0: never).
 RuleParams = namedtuple("RuleParams", ["kind", "eps", "tc_time", "prefactor", "inv_h", "coeffs",
                                        "wall_eps", "resolved", "compression", "ob_inv_hs", "ob_inv_hd",
-                                       "ob_coeffs"])
+                                       "ob_coeffs", "elastic_below"])
 #: Geometry: ``box`` (3,) side lengths (the cell grid spans [0, L)); ``period`` (3,)
 #: the period of each axis (L when periodic, inf on a wall axis, so that the
 #: minimum image and the wrap leave wall axes alone); ``ncell`` (3,) cells per
@@ -117,9 +121,21 @@ Space = namedtuple("Space", ["box", "period", "ncell", "wall_axes", "dims"])
 #: (how far a particle may move from its list centre, with a round-off margin),
 #: ``rmax`` (largest radius), ``collapse_dt`` and ``collapse_count`` (inelastic-
 #: collapse watch), and the white-noise driving: ``kick_interval`` (inf: none),
-#: ``kick_scale`` (velocity-kick standard deviation for unit mass), ``kick_seed``.
+#: ``kick_scale`` (velocity-kick standard deviation for unit mass), ``kick_seed``;
+#: the flight, ``flight`` (None: straight; else the (3,) gravity vector,
+#: :mod:`granulargas.engine._flight`), and the wall kinds, ``wallkinds`` (None: hard
+#: walls at rest; else a :class:`WallSpec`). The kernels take the last two as arguments
+#: of their own, so that numba removes their branches when they are None.
 Params = namedtuple("Params", ["rule", "space", "shell", "half_shell", "rmax", "collapse_dt",
-                               "collapse_count", "kick_interval", "kick_scale", "kick_seed"])
+                               "collapse_count", "kick_interval", "kick_scale", "kick_seed", "flight",
+                               "wallkinds"])
+#: Wall kinds and motions (:mod:`granulargas.engine._walls`), each (3, 2) [axis, side]:
+#: ``kind`` i8 (HARD, THERMAL, VIBRATING), ``waveform`` i8 (SINE, TRIANGLE, BIPARABOLIC),
+#: ``amplitude``, ``frequency`` (cycles per unit time) and ``phase`` (in cycles, phi / 2 pi)
+#: of a vibrating wall, ``temperature`` of a thermal wall; ``seed`` (uint64) of the thermal
+#: walls' counter-based draws.
+WallSpec = namedtuple("WallSpec", ["kind", "waveform", "amplitude", "frequency", "phase", "temperature",
+                                   "seed"])
 
 #: Mutable scalars of a run. ``time`` of the last event; ``dissipated`` energy
 #: (cumulative); ``virial`` sum of r_ij . Delta p_ij and ``kin_int`` integral of
@@ -146,7 +162,7 @@ CALENDAR_STATE = np.dtype([
 
 def rule_params(kind: int, eps: float = 1.0, tc_time: float = -1.0, prefactor: float = 0.0,
                 inv_h: float = 1.0, coeffs=None, wall_eps: float | None = None, oblique=None,
-                compression: float = 0.0) -> RuleParams:
+                compression: float = 0.0, elastic_below: float = 0.0) -> RuleParams:
     """A :class:`RuleParams` with the dtypes the kernels are compiled for (``oblique``: an
     :class:`~granulargas.contact.oblique_grid.ObliqueTable` for collisions that take time)."""
     coeffs = np.zeros((1, 4)) if coeffs is None else np.ascontiguousarray(coeffs, dtype=np.float64)
@@ -157,7 +173,7 @@ def rule_params(kind: int, eps: float = 1.0, tc_time: float = -1.0, prefactor: f
         ob = np.ascontiguousarray(oblique.coeffs, dtype=np.float64)
     return RuleParams(int(kind), float(eps), float(tc_time), float(prefactor), float(inv_h), coeffs,
                       float(eps if wall_eps is None else wall_eps), resolved, float(compression),
-                      inv_hs, inv_hd, ob)
+                      inv_hs, inv_hd, ob, float(elastic_below))
 
 
 def contacts(n: int, until=None, partner=None) -> Contacts:
@@ -196,11 +212,40 @@ def space(box3, period3, ncell, wall_axes, dims) -> Space:
 
 def params(rule: RuleParams, spc: Space, shell: float, rmax: float, collapse_dt: float,
            collapse_count: int, kick_interval: float = math.inf, kick_scale: float = 0.0,
-           kick_seed: int = 0) -> Params:
-    """A :class:`Params` with the dtypes the kernels are compiled for."""
+           kick_seed: int = 0, gravity=None, wallkinds: WallSpec | None = None) -> Params:
+    """A :class:`Params` with the dtypes the kernels are compiled for (``gravity``: None or a
+    (3,) vector, zero-padded from a 2D one)."""
+    flight = None
+    if gravity is not None:
+        flight = np.zeros(3)
+        g = np.asarray(gravity, dtype=np.float64)
+        flight[: g.shape[0]] = g
     return Params(rule, spc, float(shell), 0.5 * float(shell) * (1.0 - 1e-9), float(rmax),
                   float(collapse_dt), int(collapse_count), float(kick_interval), float(kick_scale),
-                  np.uint64(kick_seed))
+                  np.uint64(kick_seed), flight, wallkinds)
+
+
+def walls(impulse=None, work=None, rechecks: int = 0) -> Walls:
+    """A :class:`Walls` record (zeros unless given)."""
+    imp = np.zeros((3, 2)) if impulse is None else np.array(impulse, dtype=np.float64)
+    wk = np.zeros((3, 2)) if work is None else np.array(work, dtype=np.float64)
+    return Walls(imp, wk, np.array([rechecks], dtype=np.int64))
+
+
+def wall_spec(kind=None, waveform=None, amplitude=None, frequency=None, phase=None, temperature=None,
+              seed: int = 0) -> WallSpec:
+    """A :class:`WallSpec` with the dtypes the kernels are compiled for; each argument (3, 2)
+    or None (hard walls at rest, zeros); ``phase`` in radians."""
+
+    def table(x, dtype):
+        out = np.zeros((3, 2), dtype=dtype)
+        if x is not None:
+            out[:] = np.asarray(x, dtype=dtype)
+        return out
+
+    return WallSpec(table(kind, np.int64), table(waveform, np.int64), table(amplitude, np.float64),
+                    table(frequency, np.float64), table(phase, np.float64) / (2.0 * math.pi),
+                    table(temperature, np.float64), np.uint64(seed))
 
 
 def event_rows(n: int):

@@ -7,9 +7,10 @@ distance below R_i + R_j + shell listed both ways) -- or, with cell crossings,
 every particle in the cell of its position (up to round-off) and listed once,
 in that cell's linked list, cells at least 2 R_max wide; no two particles
 overlapping beyond round-off (except a pair whose contact is under way with a
-resolved rule: its extended outgoing lines overlap); no particle overlapping a wall beyond round-off,
-none with a nonzero image count on a wall axis; each wall event scheduled for
-a particle moving into that wall.
+resolved rule: its extended outgoing lines overlap); no particle overlapping a wall beyond round-off
+(a vibrating wall at its position at the current time), none with a nonzero image count on a wall
+axis; each wall event scheduled for a particle moving into that wall (straight flights; under
+gravity a particle moving away from a floor comes back). Particles are streamed on their flight.
 """
 
 from __future__ import annotations
@@ -38,7 +39,9 @@ def check(sim, overlap_tol: float = 1e-9) -> list[str]:
     if not cal_check(e.calendar):
         problems.append("event calendar broken")
     rec = e.particles.rec
-    r = rec[:, :3] + rec[:, 3:6] * (t - rec[:, 6])[:, None]
+    dt = (t - rec[:, 6])[:, None]
+    flight = sim._flight()
+    r = rec[:, :3] + rec[:, 3:6] * dt + (0.0 if flight is None else 0.5 * flight * dt * dt)
     if sim.neighbours == "cells":
         problems += _check_grid(sim, e.lists, r)
     else:
@@ -58,14 +61,19 @@ def check(sim, overlap_tol: float = 1e-9) -> list[str]:
             problems.append(f"overlap of {i} with {bad[:5]}")
     for a in sim._space.wall_axes:
         a = int(a)
-        gap = np.minimum(r[:, a] - rad, sim._space.box[a] - rad - r[:, a])
+        box = sim._space.box[a]
+        lo, hi = 0.0, box
+        if sim.walls is not None:
+            lo = float(sim.walls.side(a, 0).position(box, 0, t))
+            hi = float(sim.walls.side(a, 1).position(box, 1, t))
+        gap = np.minimum(r[:, a] - rad - lo, hi - rad - r[:, a])
         bad = np.flatnonzero(gap < -overlap_tol * rad)
         if len(bad):
             problems.append(f"overlap with a wall of axis {a}: particles {bad[:5].tolist()}")
         if np.any(e.particles.img[:, a] != 0):
             problems.append(f"nonzero image count on wall axis {a}")
     partner, tag = e.events.partner, e.events.tag
-    for i in np.flatnonzero(partner == -2):
+    for i in np.flatnonzero(partner == -2) if flight is None else ():
         a, side = int(tag[i]) >> 1, int(tag[i]) & 1
         v = rec[i, 3 + a]
         if not (v < 0 if side == 0 else v > 0):

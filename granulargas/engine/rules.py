@@ -8,6 +8,12 @@ collisions follow the same rule with R_eff = R_i and m_eff = m_i (a flat,
 infinitely heavy wall of the same material); a constant-eps rule may give the
 walls their own ``wall_restitution``.
 
+A restitution floor, ``elastic_below`` = v (the ElasticV of DynamO, Bannerman, Sargant &
+Lue 2011), makes every collision (pair or wall) whose normal relative speed is below v
+elastic: a grain coming to rest on a floor under gravity, or a cluster on a shaken plate,
+then bounces on at about that speed instead of colliding ever faster (the inelastic
+collapse of a bouncing ball, a Zeno trap that no event-driven loop can pass).
+
 A viscoelastic rule with ``duration="resolved"`` makes collisions take time:
 the pair's outcome (outgoing velocity, contact duration, where the pair leaves
 the contact) comes from the oblique-contact table and the pair jumps onto its
@@ -70,6 +76,9 @@ class CollisionRule:
     oblique : object
         Resolved rule: the oblique-contact table
         (:class:`granulargas.contact.oblique_grid.ObliqueTable`) of the same contact end.
+    elastic_below : float or None
+        Restitution floor: a collision whose normal relative speed is below it is
+        elastic (constant and instantaneous viscoelastic rules). None: off.
     pairs : PairTable or None
         One law per pair of species (a mixture); ``restitution``, ``wall_restitution`` and
         ``prefactor`` then hold those of the first species' own pair, (0, 0).
@@ -84,6 +93,7 @@ class CollisionRule:
     duration: str = "instantaneous"
     compression: float = 0.0
     oblique: Any = None
+    elastic_below: float | None = None
     pairs: PairTable | None = None
 
     @classmethod
@@ -98,15 +108,15 @@ class CollisionRule:
 
     @classmethod
     def constant(cls, restitution, tc_time: float | None = None,
-                 wall_restitution=None) -> "CollisionRule":
-        """Constant coefficient of restitution 0 < eps <= 1, optionally with the TC model
-        and a separate constant eps for sphere-wall collisions.
+                 wall_restitution=None, elastic_below: float | None = None) -> "CollisionRule":
+        """Constant coefficient of restitution 0 < eps <= 1, optionally with the TC model,
+        a separate constant eps for sphere-wall collisions and a restitution floor.
 
         A mixture: ``restitution`` a symmetric (S, S) table eps_ij, ``wall_restitution``
         one number or one per species (default eps_ii)."""
         if np.ndim(restitution) == 2:
             table = PairTable.constant(restitution, wall_restitution)
-            rule = cls.constant(table.restitution[0][0], tc_time, table.wall_restitution[0])
+            rule = cls.constant(table.restitution[0][0], tc_time, table.wall_restitution[0], elastic_below)
             return replace(rule, pairs=table)
         if np.ndim(wall_restitution) == 1:
             raise ConfigError("wall_restitution: one value per species needs a table of restitutions per pair")
@@ -123,12 +133,12 @@ class CollisionRule:
             if not tc_time > 0.0:
                 raise ConfigError(f"tc_time = {tc_time}: must be > 0 (or None to switch the TC model off)")
         return cls("constant", restitution=restitution, tc_time=tc_time,
-                   wall_restitution=wall_restitution)
+                   wall_restitution=wall_restitution, elastic_below=_floor(elastic_below))
 
     @classmethod
     def viscoelastic(cls, prefactor: float, table: Any, tc_time: float | None = None,
                      duration: str = "instantaneous", compression: float | None = None,
-                     oblique: Any = None) -> "CollisionRule":
+                     oblique: Any = None, elastic_below: float | None = None) -> "CollisionRule":
         """Viscoelastic eps(beta) from a restitution table, beta = k (R_eff g_n / m_eff^2)^(1/5).
 
         ``duration="resolved"``: collisions take time (module docstring); needs
@@ -140,7 +150,7 @@ class CollisionRule:
             if duration != "instantaneous":
                 raise ConfigError('duration = "resolved" takes one material: a table of prefactors per pair '
                                   "of species needs instantaneous collisions")
-            rule = cls.viscoelastic(pairs.prefactor[0][0], table, tc_time)
+            rule = cls.viscoelastic(pairs.prefactor[0][0], table, tc_time, elastic_below=elastic_below)
             return replace(rule, pairs=pairs)
         prefactor = float(prefactor)
         if not prefactor >= 0.0:
@@ -153,9 +163,12 @@ class CollisionRule:
             if compression is not None or oblique is not None:
                 raise ConfigError('compression and oblique are used only with duration = "resolved"')
             return cls("viscoelastic", prefactor=prefactor, table=table,
-                       tc_time=None if tc_time is None else float(tc_time))
+                       tc_time=None if tc_time is None else float(tc_time), elastic_below=_floor(elastic_below))
         if tc_time is not None:
             raise ConfigError('tc_time: the TC model is not used with duration = "resolved"')
+        if elastic_below is not None:
+            raise ConfigError('elastic_below: collisions that take time (duration = "resolved") have no '
+                              'restitution to set to 1')
         compression = float("nan") if compression is None else float(compression)
         if not (compression > 0.0 and compression < float("inf")):
             raise ConfigError(f'duration = "resolved" needs the compression prefactor q > 0 (the contact '
@@ -185,13 +198,25 @@ class CollisionRule:
         kind = {"elastic": ELASTIC, "constant": CONSTANT, "viscoelastic": VISCOELASTIC}[self.kind]
         tc = -1.0 if self.tc_time is None else float(self.tc_time)
         eps = self.restitution if self.kind == "constant" else 1.0
+        floor = 0.0 if self.elastic_below is None else float(self.elastic_below)
         if self.kind == "viscoelastic":
             return rule_params(kind, eps, tc, self.prefactor, float(self.table.inv_h),
-                               self.table.coeffs, oblique=self.oblique, compression=self.compression)
-        return rule_params(kind, eps, tc, self.prefactor, wall_eps=self.wall_restitution)
+                               self.table.coeffs, oblique=self.oblique, compression=self.compression,
+                               elastic_below=floor)
+        return rule_params(kind, eps, tc, self.prefactor, wall_eps=self.wall_restitution, elastic_below=floor)
 
     def kernel_arguments(self):
         """(kind code, eps, tc_time or -1, prefactor, inv_h, coeffs): the first six fields of
         :meth:`compiled`, for kernels that take them as plain arguments (the DSMC)."""
         r = self.compiled()
         return r.kind, r.eps, r.tc_time, r.prefactor, r.inv_h, r.coeffs
+
+
+def _floor(elastic_below):
+    """The restitution floor as a float > 0, or None."""
+    if elastic_below is None:
+        return None
+    v = float(elastic_below)
+    if not (v > 0.0 and v < float("inf")):
+        raise ConfigError(f"elastic_below = {elastic_below}: must be a speed > 0 (or None for no floor)")
+    return v

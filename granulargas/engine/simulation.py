@@ -31,6 +31,7 @@ from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.pairs import pair_count_matrix, species_of_state
 from granulargas.engine.rules import CollisionRule
+from granulargas.engine.walls import Walls
 from granulargas.engine.tangential import (
     TangentialRule,
     public_spins,
@@ -211,6 +212,15 @@ class Simulation:
         Remove the centre-of-mass velocity that round-off accumulates on the
         periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
         e.g. a mean flow given on purpose.
+    gravity : sequence of d floats, optional
+        A uniform acceleration g (on wall and periodic axes alike; a periodic axis
+        falls freely): particles fly on parabolas between events
+        (:mod:`granulargas.engine._flight`).
+    walls : Walls, optional
+        The kind of each side of the wall axes (:class:`granulargas.engine.walls.Walls`:
+        hard, thermal or vibrating; a side not given is a hard wall at rest). A vibrating
+        wall rests its amplitude inside the box; every sphere must start clear of every
+        wall's position at the state's time.
     tangential : TangentialRule, optional
         Rough particles (:class:`granulargas.engine.TangentialRule`): the particles spin, with
         the state's ``angular_velocities`` (default 0) and ``inertia`` kappa = I / (m R^2)
@@ -238,7 +248,8 @@ class Simulation:
 
     def __init__(self, state: State, rule: CollisionRule, *, driving: WhiteNoise | None = None,
                  neighbours: str = "lists", shell: float | None = None, collapse_count: int = 100,
-                 remove_drift: bool = True, tangential: TangentialRule | None = None):
+                 remove_drift: bool = True, gravity=None, walls: Walls | None = None,
+                 tangential: TangentialRule | None = None):
         if not isinstance(state, State):
             raise TypeError("state must be a granulargas.state.State")
         if state.positions is None:
@@ -269,16 +280,23 @@ class Simulation:
         img = state.array("images")
         if np.any(img[:, wall] != 0):
             raise ConfigError("images: must be 0 on wall axes")
+        #: the uniform acceleration (d,) as a tuple, or None
+        self.gravity = _gravity(gravity, d)
+        #: the wall kinds (None: hard walls at rest)
+        self.walls = _walls(walls, self.boundary, bx, 2.0 * float(rad.max()))
         for a in np.flatnonzero(wall):
-            low = pos[:, a] - rad
-            high = bx[a] - rad - pos[:, a]
+            lo = 0.0 if self.walls is None else float(self.walls.side(a, 0).position(bx[a], 0, state.time))
+            hi = bx[a] if self.walls is None else float(self.walls.side(a, 1).position(bx[a], 1, state.time))
+            low = pos[:, a] - rad - lo
+            high = hi - rad - pos[:, a]
             tol = 1e-9 * rad
             bad = np.flatnonzero((low < -tol) | (high < -tol))
             if len(bad):
                 k = int(bad[0])
                 raise ConfigError(f"positions: particle {k} at {'xyz'[a]} = {pos[k, a]:.6g} overlaps a "
-                                  f"wall (radius {rad[k]:.6g}, walls at 0 and {bx[a]:.6g}); every "
-                                  f"sphere must lie within [R, L - R] on a wall axis")
+                                  f"wall (radius {rad[k]:.6g}, walls at {lo:.6g} and {hi:.6g} at t = "
+                                  f"{state.time:.6g}); every sphere must lie within [R, L - R] on a wall "
+                                  f"axis, clear of a vibrating wall's position")
         shift = np.floor(pos / bx).astype(np.int64)
         shift[:, wall] = 0
         pos -= shift * bx
@@ -306,6 +324,9 @@ class Simulation:
         if driving is not None and driving.rotational_fraction > 0.0 and tangential is None:
             raise ConfigError(f"driving: rotational_fraction = {driving.rotational_fraction}: smooth particles "
                               "have no spins to drive (give a tangential rule)")
+        if tangential is not None and self.walls is not None and self.walls.moving:
+            raise ConfigError("tangential: rough particles take hard walls at rest only (thermal and vibrating "
+                              "walls act on smooth particles)")
         self.tangential = tangential
         self._spins, self._kappa = spins_of(state) if tangential is not None else (None, None)
         # a mixture: the species of every particle index the rule's pair table
@@ -326,6 +347,7 @@ class Simulation:
         self._collisions = state.collisions
         self._events = state.events
         self._wall_collisions = state.wall_collisions
+        self._wall_work = state.wall_work
         self._dissipated = state.dissipated_energy
         self._injected = state.injected_energy
         kick_step = state.kick_step
@@ -489,7 +511,8 @@ class Simulation:
                                    np.where(cp >= 0, slot[np.maximum(cp, 0)], -1).astype(np.int32)
                                    ) if self.rule.resolved else None
         _loop.predict_all(self._time, rec, particles.count, events, lists, *_loop.mode_flags(cells), spc,
-                          0.5 * self.shell * (1.0 - 1e-9), contacts, calendar.qt)
+                          0.5 * self.shell * (1.0 - 1e-9), contacts, self._flight(), self._wallkinds(),
+                          calendar.qt)
         counters = np.zeros(1, dtype=_state.COUNTERS)
         c = counters[0]
         with np.errstate(over="ignore", under="ignore"):
@@ -505,7 +528,7 @@ class Simulation:
         c["kick_step"] = self._kick_step
         c["three_body"] = self._three_body
         c["err_i"] = c["err_j"] = -1
-        walls = _state.Walls(impulse=self._wall_impulse.copy())
+        walls = _state.walls(impulse=self._wall_impulse)  # work: since this build (added to _wall_work)
         tg = self.tangential  # rough particles; None: the loop compiles without spins
         spins = None if tg is None else _state.spins(
             self._spins[order], self._kappa[order], tg.code, tg.restitution, tg.friction, tg.wall_beta, tg.wall_mu,
@@ -564,7 +587,21 @@ class Simulation:
             kick_interval=drv.interval, kick_scale=kick_scale(drv.translational_rate, drv.interval, self.n),
             kick_seed=drv.seed)
         return _state.params(self.rule.compiled(), self._space, self.shell, float(self._radii.max()),
-                             1e-10 * scale, self.collapse_count, **kick)
+                             1e-10 * scale, self.collapse_count, **kick, gravity=self._flight(),
+                             wallkinds=self._wallkinds())
+
+    def _flight(self):
+        """The flight the kernels take: None (straight) or the (3,) gravity vector."""
+        if self.gravity is None:
+            return None
+        g = np.zeros(3)
+        g[: self.dimension] = self.gravity
+        return g
+
+    def _wallkinds(self):
+        """The wall kinds the kernels take: None for hard walls at rest, else the compiled
+        :class:`~granulargas.engine._state.WallSpec`."""
+        return self.walls.compiled() if self.walls is not None and self.walls.moving else None
 
     # -------------------------------------------------------------------- run
     def run(self, until: float, max_collisions: int | None = None, progress=None) -> "Simulation":
@@ -656,7 +693,8 @@ class Simulation:
     def _remove_drift(self) -> bool:
         """Subtract the centre-of-mass velocity on periodic axes once it exceeds
         ``DRIFT_LIMIT`` of the thermal speed (see :meth:`run`); True if it did."""
-        axes = [a for a in range(self.dimension) if self.boundary[a] == "periodic"]
+        axes = [a for a in range(self.dimension) if self.boundary[a] == "periodic"
+                and (self.gravity is None or self.gravity[a] == 0.0)]  # a falling axis is no drift
         if not self.remove_drift or not axes:
             return False
         v, m = self._vm()
@@ -714,7 +752,14 @@ class Simulation:
         i, j = int(c["err_i"]), int(c["err_j"])
         ids = [int(self._order[k]) for k in (i, j) if k >= 0]
         where = f"at t = {float(c['time']):.12g} after {int(c['collisions'])} collisions (particles {ids})"
+        zeno = (f"inelastic collapse {where}: ever faster collisions (a grain coming to rest on a wall, or a "
+                f"cluster on a shaken plate, bounces infinitely often in a finite time); set a restitution floor "
+                f"(collision.elastic_below: collisions below that normal speed are elastic; "
+                f"CollisionRule.constant(eps, elastic_below=v)) or the TC model (collision.tc_time)")
+        trap = self.gravity is not None or "wall" in self.boundary
         if status == _loop.COLLAPSE:
+            if trap:
+                raise InelasticCollapseError(zeno, where=where)
             if self.rule.kind == "constant":
                 raise InelasticCollapseError(
                     f"inelastic collapse {where}: the collision rate diverges; use the TC model "
@@ -723,6 +768,9 @@ class Simulation:
         if status == _loop.TABLE_RANGE:
             raise TableRangeError(f"impact beyond the restitution table {where}: build the table "
                                   f"with a larger beta_max")
+        if status == _loop.WATCHDOG and trap and i >= 0 and self._engine.particles.lastcoll[i] == float(c["time"]):
+            # a particle that keeps colliding at one instant of the clock: bounces faster than it resolves
+            raise InelasticCollapseError(zeno, where=where)
         if status == _loop.WATCHDOG:
             raise SimulationError(f"event-queue watchdog {where}: an event in the past or an endless "
                                   f"run of zero-time events")
@@ -735,12 +783,9 @@ class Simulation:
         """Stream all particles to ``time`` and wrap; the next run rebuilds the queue."""
         if self._built:
             e = self._engine
-            self._positions, self._images = self._synchronised()
+            self._positions, self._images, self._velocities = self._synchronised()
             n, d = self._positions.shape
             inv = self._order
-            vel = np.empty((n, d))
-            vel[inv] = e.particles.rec[:, 3 : 3 + d]
-            self._velocities = vel
             lc = np.empty(n)
             lc[inv] = e.particles.lastcoll
             self._last_collision = lc
@@ -751,6 +796,7 @@ class Simulation:
             self._injected = float(c["injected"])
             self._collisions, self._events = int(c["collisions"]), int(c["events"])
             self._wall_collisions = int(c["wall_collisions"])
+            self._wall_work += float(np.sum(e.walls.work))
             self._kick_step = int(c["kick_step"])
             self._three_body = int(c["three_body"])
             self._wall_impulse = e.walls.impulse.copy()
@@ -774,12 +820,15 @@ class Simulation:
         n, d = self._positions.shape
         r = np.empty((n, 3))
         img = np.empty((n, 3), dtype=np.int32)
-        _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, r, img)
+        v = np.empty((n, 3))
+        _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, self._flight(), r, img, v)
         pos = np.empty((n, d))
         pos[self._order] = r[:, :d]
         im = np.empty((n, d), dtype=np.int64)
         im[self._order] = img[:, :d]
-        return pos, im
+        vel = np.empty((n, d))
+        vel[self._order] = v[:, :d]
+        return pos, im, vel
 
     # ----------------------------------------------------------- public state
     @property
@@ -846,13 +895,16 @@ class Simulation:
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
-        pos, img = self._synchronised() if self._built else (self._positions, self._images)
+        pos, img = self._synchronised()[:2] if self._built else (self._positions, self._images)
         return pos + img * self._box
 
     @property
     def velocities(self) -> np.ndarray:
+        """Velocities (N, d) at ``time`` (a copy; under gravity each streamed from its clock)."""
         if not self._built:
             return self._velocities.copy()
+        if self._flight() is not None:
+            return self._synchronised()[2]
         out = np.empty_like(self._velocities)
         out[self._order] = self._engine.particles.rec[:, 3 : 3 + self.dimension]
         return out
@@ -931,7 +983,7 @@ class Simulation:
         continues bit for bit where :meth:`synchronise` would. ``contact_until`` and
         ``contact_partner`` are None unless collisions take time, ``kick_step`` without driving;
         the per-particle fields the engine does not use are those it was given."""
-        pos, img = self._synchronised() if self._built else (self._positions.copy(), self._images.copy())
+        pos, img = self._synchronised()[:2] if self._built else (self._positions.copy(), self._images.copy())
         resolved = self.rule.resolved
         return State(
             positions=pos, velocities=self.velocities, radii=self.radii, masses=self.masses, box=self.box,
@@ -940,6 +992,7 @@ class Simulation:
             contact_partner=self.contact_partner if resolved else None,
             time=self.time, collisions=self.collisions, events=self.events,
             dissipated_energy=self.dissipated_energy, wall_collisions=self.wall_collisions,
+            wall_work=self.wall_work,
             injected_energy=self.injected_energy, kick_step=None if self.driving is None else self.kick_step,
             three_body_contacts=self.three_body_contacts, species_collisions=self.species_collisions,
             **({} if self.tangential is None else {"angular_velocities": self.angular_velocities,
@@ -949,8 +1002,31 @@ class Simulation:
     # ------------------------------------------------------------ observables
     def _vm(self):
         if self._built:
+            if self._flight() is not None:  # velocities at time (the order of masses matches)
+                return self._synchronised()[2], self._masses
             return self._engine.particles.rec[:, 3 : 3 + self.dimension], self._engine.particles.mass
         return self._velocities, self._masses
+
+    @property
+    def potential_energy(self) -> float:
+        """Potential energy in the uniform field, -sum m g . r (unwrapped positions; 0 without
+        gravity)."""
+        if self.gravity is None:
+            return 0.0
+        r = self.unwrapped_positions
+        return float(-np.sum(self._masses * (r @ np.asarray(self.gravity))))
+
+    @property
+    def wall_work(self) -> float:
+        """Energy the thermal and vibrating walls have given the gas so far (net, cumulative)."""
+        if self._built:
+            return self._wall_work + float(np.sum(self._engine.walls.work))
+        return self._wall_work
+
+    @property
+    def wall_rechecks(self) -> int:
+        """Re-check events of the vibrating walls' contact search in the current build."""
+        return int(self._engine.walls.rechecks[0]) if self._built else 0
 
     @property
     def kinetic_energy(self) -> float:
@@ -994,8 +1070,15 @@ class Simulation:
         (kinetic plus collisional virial; c is the peculiar velocity). With walls
         the sphere-wall forces are not included: this is then the volume average of
         the trace of the kinetic and collisional stress, and
-        :meth:`wall_pressure_window` is the pressure on the walls.
+        :meth:`wall_pressure_window` is the pressure on the walls. Under gravity NaN (the
+        kinetic integral is not kept for velocities that change between events).
         """
+        if self.gravity is not None:
+            self._window_start = self.time
+            if self._built:
+                self._counters["virial"] = self._counters["kin_int"] = 0.0
+            self._virial = self._kin_int = 0.0
+            return float("nan")
         if self._built:
             c = self._counters
             kin, vir = float(c["kin_int"]), float(c["virial"])
@@ -1041,6 +1124,10 @@ class Simulation:
 
     def __repr__(self):
         walls = "" if "wall" not in self.boundary else f", boundary={self.boundary}"
+        if self.walls is not None and self.walls.moving:
+            walls += ", walls=" + ", ".join(f"{'xyz'[a]}_{('low', 'high')[s]}: {w.kind}" for a, s, w in self.walls.given())
+        if self.gravity is not None:
+            walls += f", gravity={list(self.gravity)}"
         return (f"Simulation(N={self.n}, d={self.dimension}, packing={self.packing_fraction:.4g}, "
                 f"rule={self.rule.kind}{walls}, time={self.time:.6g}, collisions={self.collisions})")
 
@@ -1060,3 +1147,38 @@ def _boundary(boundary, d):
         if x not in BOUNDARIES:
             raise ConfigError(f"boundary = {list(b)}: {x!r} is not one of {', '.join(BOUNDARIES)}")
     return b
+
+
+def _gravity(gravity, d):
+    """The acceleration as a tuple of d finite floats, or None (ConfigError otherwise)."""
+    if gravity is None:
+        return None
+    g = np.asarray(gravity, dtype=np.float64).ravel()
+    if g.shape != (d,) or not np.all(np.isfinite(g)):
+        raise ConfigError(f"gravity = {np.asarray(gravity).tolist()}: give {d} finite components (one per axis)")
+    return tuple(float(x) for x in g)
+
+
+def _walls(walls, boundary, box, dmax):
+    """The wall kinds, checked against the boundary and the box (None: hard walls at rest)."""
+    if walls is None:
+        return None
+    if not isinstance(walls, Walls):
+        raise TypeError("walls must be a granulargas.engine.walls.Walls or None")
+    for a, side, w in walls.given():
+        name = "xyz"[a] + ("_low" if side == 0 else "_high")
+        if a >= len(boundary):
+            raise ConfigError(f"walls: {name}: a {len(boundary)}D system has no {'xyz'[a]} axis")
+        if boundary[a] != "wall":
+            raise ConfigError(f"walls: {name} is a {w.kind} wall on the {'xyz'[a]} axis, which is "
+                              f"\"{boundary[a]}\": a wall of any kind needs a \"wall\" axis")
+    for a in range(len(boundary)):
+        if boundary[a] != "wall":
+            continue
+        room = float(box[a]) - walls.side(a, 0).reach - walls.side(a, 1).reach
+        if not room > dmax:
+            raise ConfigError(f"walls: the {'xyz'[a]} axis is {float(box[a]):.6g} long and its walls reach "
+                              f"{walls.side(a, 0).reach:.6g} and {walls.side(a, 1).reach:.6g} into it (twice "
+                              f"their amplitudes): at their closest they leave {room:.6g}, no room for a "
+                              f"particle of diameter {dmax:.6g}")
+    return walls

@@ -650,7 +650,7 @@ MIN_WALL_AXIS_DIAMETERS = 4.15
 
 
 def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, masses=None,
-                 aspect=None, sweeps=None, rng=None, boundary=None) -> State:
+                 aspect=None, sweeps=None, rng=None, boundary=None, margins=None) -> State:
     """A random homogeneous initial state: box, positions, velocities (in this order from one generator).
 
     Parameters
@@ -682,6 +682,11 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
         [R_max, L - R_max]); the density next to the walls relaxes to its steady
         profile within a few collision times. A wall axis must be at least
         ``MIN_WALL_AXIS_DIAMETERS`` largest diameters long.
+    margins : array (d, 2), optional
+        Room kept free at the lower and upper wall of each wall axis besides R_max (e.g.
+        the sweep 2A of a vibrating wall, :attr:`granulargas.engine.walls.Wall.reach`):
+        the positions are placed on L - 2 R_max - margins there, which must still be at
+        least ``MIN_WALL_AXIS_DIAMETERS`` largest diameters less 2 R_max.
     """
     if dimension not in (2, 3):
         raise ConfigError(f"dimension = {dimension}: allowed values are 2 and 3")
@@ -700,15 +705,19 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
     box = box_for_packing(radii, packing, dimension, aspect)
     placement = box.copy()
     rmax = float(radii.max())
+    margins = np.zeros((dimension, 2)) if margins is None else np.asarray(margins, dtype=np.float64)
     for a in walls:
-        if box[a] < MIN_WALL_AXIS_DIAMETERS * 2.0 * rmax:
-            raise ConfigError(f"wall axis {'xyz'[a]}: length {box[a]:.4g} is too short for the particles: "
+        free = box[a] - margins[a].sum()
+        if free < MIN_WALL_AXIS_DIAMETERS * 2.0 * rmax:
+            room = "" if not margins[a].any() else f" less {margins[a].sum():.4g} kept clear of the walls"
+            raise ConfigError(f"wall axis {'xyz'[a]}: length {box[a]:.4g}{room} is too short for the particles: "
                               f"it must be >= {MIN_WALL_AXIS_DIAMETERS:g} largest diameters "
                               f"(= {MIN_WALL_AXIS_DIAMETERS * 2.0 * rmax:.4g}); use more particles or a "
                               f"lower packing fraction")
-        placement[a] -= 2.0 * rmax
+        placement[a] = free - 2.0 * rmax
     pos = random_positions(radii, placement, sweeps=sweeps, rng=rng)
-    pos[:, walls] += rmax
+    for a in walls:
+        pos[:, a] += rmax + margins[a, 0]
     vel = maxwell_velocities(masses, dimension, temperature, rng=rng)
     bnd = None if boundary is None else tuple(boundary)
     return State(pos, vel, radii, masses, box, boundary=bnd)

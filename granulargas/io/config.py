@@ -2,8 +2,8 @@
 
 A config file has the sections ``[system]``, ``[particles]``, ``[initial]``,
 ``[collision]`` (with the optional sub-table ``[collision.material]``),
-``[driving]`` (optional), ``[run]`` and ``[output]``, and for a mixture an array of tables
-``[[species]]`` in place of ``[particles]``; :func:`load_config` reads it with :mod:`tomllib`, applies
+``[driving]``, ``[gravity]`` and ``[walls]`` (optional), ``[run]`` and ``[output]``, and for a
+mixture an array of tables ``[[species]]`` in place of ``[particles]``; :func:`load_config` reads it with :mod:`tomllib`, applies
 optional dotted-key overrides, and returns a :class:`RunConfig`.
 
 The schema
@@ -69,6 +69,12 @@ CONTACT_ENDS = ("overlap", "force")
 DURATIONS = ("instantaneous", "resolved")
 BOUNDARIES = ("periodic", "wall")
 DRIVING_MODELS = ("white_noise",)
+#: ``[walls]``: the sides of the wall axes, the kinds of wall and the waveforms of a vibrating one
+WALL_SIDES = ("x_low", "x_high", "y_low", "y_high", "z_low", "z_high")
+WALL_KINDS = ("hard", "thermal", "vibrating")
+WAVEFORMS = ("sine", "triangle", "biparabolic")
+#: largest |g| component (reduced): g t^2 and the speeds g t stay finite for times up to TIME_MAX**0.5
+GRAVITY_MAX = 1e50
 #: ``[collision.tangential] model``: a constant tangential restitution, or Walton's Coulomb model
 TANGENTIAL_MODELS = ("constant", "coulomb")
 #: ``particles.inertia`` kappa = 4 I / (m sigma^2): uniform sphere 2/5, uniform disk 1/2 (also
@@ -221,7 +227,8 @@ class CollisionConfig:
     sphere-wall collisions (default: ``restitution``); elastic runs have elastic
     walls, viscoelastic runs the sphere-plane contact of the same material.
     ``duration``: "instantaneous" collisions, or "resolved" (viscoelastic with
-    ``[collision.material]``): collisions that take time.
+    ``[collision.material]``): collisions that take time. ``elastic_below``: collisions at a
+    normal speed below it are elastic (None: never).
     A mixture (``[[species]]``): ``restitution`` and ``damping`` may be tables
     ``{"a-b": value}`` with one entry per pair of species (keys in the species' order,
     "a-b" with a at or before b; :meth:`pair_table`), ``wall_restitution`` a table
@@ -235,6 +242,7 @@ class CollisionConfig:
     tc_time: float | None = None
     wall_restitution: float | dict | None = None
     duration: str = "instantaneous"
+    elastic_below: float | None = None
     tangential: TangentialConfig | None = None
 
     @property
@@ -293,6 +301,53 @@ class DrivingConfig:
 
 
 @dataclass(frozen=True)
+class GravityConfig:
+    """``[gravity]`` (optional): a uniform acceleration ``acceleration`` (one component per
+    axis), periodic axes or walls alike; particles fly on parabolas between events."""
+
+    acceleration: tuple = (0.0, 0.0, -1.0)
+
+    @property
+    def vector(self) -> tuple:
+        return tuple(float(x) for x in self.acceleration)
+
+
+@dataclass(frozen=True)
+class WallConfig:
+    """One side of a wall axis in ``[walls]``: ``kind`` "hard" (at rest, the run's restitution),
+    "thermal" (diffuse at ``temperature``) or "vibrating" (``amplitude``, ``frequency``,
+    ``waveform``, ``phase`` in radians; it rests ``amplitude`` inside the box)."""
+
+    kind: str = "hard"
+    amplitude: float | None = None
+    frequency: float | None = None
+    waveform: str = "sine"
+    phase: float = 0.0
+    temperature: float | None = None
+
+
+@dataclass(frozen=True)
+class WallsConfig:
+    """``[walls]`` (optional): the kind of each side of the wall axes (a side left out is hard)."""
+
+    x_low: WallConfig | None = None
+    x_high: WallConfig | None = None
+    y_low: WallConfig | None = None
+    y_high: WallConfig | None = None
+    z_low: WallConfig | None = None
+    z_high: WallConfig | None = None
+
+    def side(self, axis: int, side: int) -> WallConfig:
+        """The wall of an axis and side (0 lower, 1 upper); a hard one if not given."""
+        return getattr(self, WALL_SIDES[2 * axis + side]) or WallConfig()
+
+    @property
+    def moving(self) -> bool:
+        """Whether any side is thermal or vibrating (not all hard walls at rest)."""
+        return any(getattr(self, s) is not None and getattr(self, s).kind != "hard" for s in WALL_SIDES)
+
+
+@dataclass(frozen=True)
 class RunSection:
     """``[run]``: stop at ``end_time`` or after ``collisions_per_particle``,
     whichever comes first (at least one is required). Collisions per particle
@@ -337,6 +392,8 @@ class RunConfig:
     source: str = "<config>"
     text: str = ""
     driving: DrivingConfig | None = None
+    gravity: GravityConfig | None = None
+    walls: WallsConfig | None = None
     species: tuple = ()
 
     @property
@@ -395,6 +452,9 @@ class Key:
         The dataclass field (default: ``key``).
     required_in_table : bool
         A key of a sub-table that must be given whenever the table is.
+    template : bool
+        A key of each of several tables (section ``"walls.<side>"``: every side's table),
+        checked once for each table given, under its real name (``walls.z_low.amplitude``).
     per_species : bool
         A key of each ``[[species]]`` table (section ``"species"``), checked once for each
         species under its name (``species.glass.diameter``).
@@ -417,6 +477,7 @@ class Key:
     run_check: str = ""
     field: str | None = None
     required_in_table: bool = False
+    template: bool = False
     per_species: bool = False
 
     @property
@@ -437,6 +498,10 @@ class Key:
         if self.type == "list of strings":
             n = f"{dimension} " if dimension is not None else ""
             return f"a list of {n}strings (one per axis), each one of " + ", ".join(f'"{c}"' for c in self.choices)
+        if self.type == "list of numbers":
+            n = f"{dimension} " if dimension is not None else ""
+            return f"a list of {n}numbers (one per axis), " + _range_phrase("each", self.low, self.high,
+                                                                           self.low_open, self.high_open)
         if self.choices is not None:
             if all(isinstance(c, str) for c in self.choices):
                 return "one of " + ", ".join(f'"{c}"' for c in self.choices)
@@ -587,6 +652,13 @@ SCHEMA: tuple[Key, ...] = (
         "`restitution`). Elastic runs have elastic walls; viscoelastic runs the sphere–plane contact "
         "of the same material. A mixture may give one per species, `{ glass = 0.9, steel = 0.7 }` "
         "(a species left out: its own pair's ε).", low=0.0, low_open=True, high=1.0),
+    Key("collision", "elastic_below", "number",
+        '`model = "constant"` or `"viscoelastic"`: a collision (pair or wall) whose normal relative speed '
+        "is below this is elastic (the restitution floor of DynamO's ElasticV, Bannerman, Sargant & Lue "
+        "2011). It keeps a grain coming to rest on a floor under gravity, or a cluster on a shaken plate, "
+        "out of an endless run of ever-smaller bounces (inelastic collapse): such a grain bounces on at "
+        "about this speed. Leave the key out for none.",
+        unit="reduced speed", low=0.0, low_open=True, high=SCALE_RANGE[1], reason=_SPEED),
     Key("collision", "material", "table",
         "Instead of `damping`: the viscoelastic contact from material constants "
         "(`[collision.material]`, below)."),
@@ -684,6 +756,42 @@ SCHEMA: tuple[Key, ...] = (
         "Time between kicks; observables are sampled half-way between kicks.",
         default_text="0.02 of the cooling time of the theoretical steady state", unit="reduced time",
         low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
+    # [gravity]
+    Key("gravity", "acceleration", "list of numbers",
+        "Uniform acceleration g, one component per axis (x, y, z), on wall and periodic axes alike (a "
+        "periodic axis falls freely); particles fly on parabolas between events. A gas at temperature T "
+        "fills a height of about T / (m |g|) above a floor.",
+        default_text="required in `[gravity]`", unit="reference diameter per reduced time²",
+        low=-GRAVITY_MAX, high=GRAVITY_MAX, reason="g t² and the speeds g t stay finite in float64"),
+    # [walls]
+    *(Key("walls", side, "table",
+          f"The {'lower' if side.endswith('low') else 'upper'} wall of the {side[0]} axis (a \"wall\" entry "
+          "of `system.boundary`): an inline table of the keys of `[walls.<side>]` below, e.g. "
+          '`{ kind = "vibrating", amplitude = 0.1, frequency = 2.0 }`.',
+          default_text='a hard wall at rest') for side in WALL_SIDES),
+    # [walls.<side>]
+    Key("walls.<side>", "kind", "string",
+        '`"hard"`: at rest, the run\'s restitution (`wall_restitution`); `"thermal"`: at rest, diffuse: '
+        "the outgoing velocity drawn from the flux of a Maxwellian at `temperature`; `\"vibrating\"`: "
+        "infinitely heavy, moving along its normal as `amplitude` × waveform(2π `frequency` t + `phase`) "
+        "about a rest position `amplitude` inside the box, the run's restitution at the speed relative to "
+        "the wall.", default="hard", choices=WALL_KINDS, template=True),
+    Key("walls.<side>", "amplitude", "number", '`kind = "vibrating"`: the amplitude A (required).',
+        unit="reference diameter", low=0.0, low_open=True, high=LENGTH_RANGE[1], reason=_LENGTH, template=True,
+        run_check="the walls of an axis leave room at their closest: L - 2 A_low - 2 A_high above the box's "
+                  "smallest side for the cell grid"),
+    Key("walls.<side>", "frequency", "number", '`kind = "vibrating"`: the frequency ν = ω / 2π (required).',
+        unit="per reduced time", low=0.0, low_open=True, high=1e50, reason="ν t stays finite in float64",
+        template=True),
+    Key("walls.<side>", "waveform", "string",
+        '`kind = "vibrating"`: `"sine"`; `"triangle"` (the symmetric sawtooth: constant speed (2/π) A ω, '
+        'turning at ±A); `"biparabolic"` (parabolic arcs through the sine\'s zeros and extremes, '
+        "acceleration ∓(8/π²) A ω² on each half cycle).", default="sine", choices=WAVEFORMS, template=True),
+    Key("walls.<side>", "phase", "number", '`kind = "vibrating"`: the phase φ at t = 0.', default=0.0,
+        unit="radians", low=-1e6, high=1e6, reason="its fraction of a cycle keeps 1e-10 in float64",
+        template=True),
+    Key("walls.<side>", "temperature", "number", '`kind = "thermal"`: the wall temperature T_w (required).',
+        unit="T0", low=SCALE_RANGE[0], high=SCALE_RANGE[1], reason=_SPEED, template=True),
     Key("driving", "rotational_fraction", "number",
         "Rough particles (`[collision.tangential]`): the fraction of the driving's power that goes to "
         "the spins as random angular-velocity kicks (the splitting thermostat of Megías & Santos 2022); "
@@ -742,9 +850,11 @@ SECTION_CLASSES = {
     "system": SystemConfig, "particles": ParticlesConfig, "initial": InitialConfig,
     "collision": CollisionConfig, "collision.material": MaterialConfig,
     "collision.tangential": TangentialConfig, "driving": DrivingConfig,
-    "run": RunSection, "output": OutputConfig, "species": SpeciesConfig,
+    "gravity": GravityConfig, "walls": WallsConfig, "walls.<side>": WallConfig, "run": RunSection,
+    "output": OutputConfig, "species": SpeciesConfig,
 }
-SECTIONS = ("system", "particles", "initial", "collision", "driving", "run", "output", "species")
+SECTIONS = ("system", "particles", "initial", "collision", "driving", "gravity", "walls", "run", "output",
+            "species")
 #: the array of tables of a mixture, one table per species
 ARRAY_SECTIONS = ("species",)
 #: the material constants a species may give (``[[species]]``) or take from ``[collision.material]``
@@ -752,7 +862,9 @@ MATERIAL_CONSTANTS = ("young_modulus", "poisson_ratio", "dissipation_time")
 #: characters of a species name
 _NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 #: sections that may be left out as a whole (absent: None in RunConfig)
-OPTIONAL_SECTIONS = ("driving",)
+OPTIONAL_SECTIONS = ("driving", "gravity", "walls")
+#: the tables of ``[walls]``: each side's keys are the template keys of ``walls.<side>``
+SIDE_TABLES = {f"walls.{side}": "walls.<side>" for side in WALL_SIDES}
 #: keys whose value is a sub-table with its own section in SCHEMA
 SUBTABLES = {"collision.material": "collision.material", "collision.tangential": "collision.tangential"}
 #: keys that take a number or an inline table of sub-keys (dotted in SCHEMA)
@@ -869,6 +981,10 @@ def _check_type(key: Key, v: Any, values: Values, dimension: int):
         if not isinstance(v, list) or not all(isinstance(b, str) for b in v):
             values.fail(d, f"must be {key.range_text(dimension)}")
         return tuple(v)
+    if key.type == "list of numbers":
+        if not isinstance(v, list) or not all(isinstance(b, (int, float)) and not isinstance(b, bool) for b in v):
+            values.fail(d, f"must be {key.range_text(dimension)}")
+        return tuple(float(b) for b in v)
     raise AssertionError(key.type)
 
 
@@ -884,6 +1000,14 @@ def _check_range(key: Key, v: Any, values: Values, dimension: int):
         bad = [b for b in v if b not in key.choices]
         if bad:
             values.fail(d, f'"{bad[0]}" is not one of {allowed}')
+        return
+    if key.type == "list of numbers":
+        axes = "x, y, z" if dimension == 3 else "x, y"
+        if len(v) != dimension:
+            values.fail(d, f"{len(v)} entries for a {dimension}D system: give one per axis ({axes})")
+        for x in v:
+            if not (math.isfinite(x) and key.low <= x <= key.high):
+                values.fail(d, f"must be {key.range_text(dimension)} ({key.reason})")
         return
     if key.choices is not None:
         ok = v in key.choices
@@ -1048,9 +1172,75 @@ def _check_driving_needs_heating_rate(v: Values):
         v.fail("driving.heating_rate", "missing; [driving] needs heating_rate >= 0 (dT/dt of the driving alone)")
 
 
+def _check_gravity_needs_acceleration(v: Values):
+    if v.section_given("gravity") and not v.has("gravity.acceleration"):
+        v.fail("gravity.acceleration", "missing; [gravity] needs acceleration = [gx, gy(, gz)], one entry per axis")
+
+
+def _check_walls_on_wall_axes(v: Values):
+    boundary = v.get("system.boundary") or ("periodic",) * v.get("system.dimension")
+    for side in WALL_SIDES:
+        table = f"walls.{side}"
+        if not v.has(table):
+            continue
+        a = "xyz".index(side[0])
+        if a >= v.get("system.dimension"):
+            v.fail(table, f"a {v.get('system.dimension')}D system has no {side[0]} axis", _Shown("{...}"))
+        if boundary[a] != "wall":
+            v.fail(table, f'the {side[0]} axis is "{boundary[a]}" (system.boundary = '
+                          f'[{", ".join(chr(34) + b + chr(34) for b in boundary)}]): a wall of any kind needs a '
+                          '"wall" axis', _Shown("{...}"))
+
+
+#: the keys each wall kind takes besides ``kind`` (required first, then optional)
+_WALL_KEYS = {"hard": ((), ()), "thermal": (("temperature",), ()),
+              "vibrating": (("amplitude", "frequency"), ("waveform", "phase"))}
+
+
+def _check_wall_kind_keys(v: Values):
+    for side in WALL_SIDES:
+        table = f"walls.{side}"
+        if not v.has(table):
+            continue
+        kind = v.get(f"{table}.kind")
+        required, optional = _WALL_KEYS[kind]
+        for key in required:
+            if not v.has(f"{table}.{key}"):
+                v.fail(f"{table}.{key}", f'missing; kind = "{kind}" needs {" and ".join(required)}')
+        for key in ("amplitude", "frequency", "waveform", "phase", "temperature"):
+            if v.has(f"{table}.{key}") and key not in required + optional:
+                users = [k for k, (r, o) in _WALL_KEYS.items() if key in r + o]
+                v.fail(f"{table}.{key}", f'is only used with kind = "{users[0]}" (kind = "{kind}")')
+
+
+def _check_elastic_below(v: Values):
+    if v.has("collision.elastic_below") and v.get("collision.duration") == "resolved":
+        v.fail("collision.elastic_below", 'collisions that take time (duration = "resolved") have no '
+                                          "restitution to set to 1")
+
+
+def _check_species_scene(v: Values):
+    if not v.species:
+        return
+    if v.section_given("gravity"):
+        raise ConfigError(f"{v.source}: [gravity]: not available with [[species]] (a mixture runs without gravity; "
+                          "gravity takes one kind of particle, [particles])")
+    for side in WALL_SIDES:
+        if v.has(f"walls.{side}") and v.get(f"walls.{side}.kind") != "hard":
+            v.fail(f"walls.{side}", f'kind = "{v.get(f"walls.{side}.kind")}" is not available with [[species]] (a '
+                                    'mixture takes hard walls at rest only)', _Shown("{...}"))
+
+
 def _check_dsmc_supported(v: Values):
     if v.get("run.method") != "dsmc":
         return
+    for section in ("gravity", "walls"):
+        if v.section_given(section):
+            raise ConfigError(f"{v.source}: [{section}]: needs positions: method = \"dsmc\" simulates a "
+                              f"homogeneous gas (use method = \"edmd\")")
+    if v.has("collision.elastic_below"):
+        v.fail("collision.elastic_below", 'guards against the inelastic collapse of a spatial gas: not '
+                                          'available with method = "dsmc"')
     boundary = v.get("system.boundary")
     if boundary is not None and "wall" in boundary:
         v.fail("system.boundary", 'walls need positions: method = "dsmc" simulates a homogeneous gas '
@@ -1093,6 +1283,13 @@ def _check_tangential(v: Values):
     if v.species:
         v.fail("collision.tangential", "a config takes rough particles of one kind, not a mixture ([[species]]): "
                                        "rough mixtures run from Python (docs/rough.md)", _Shown("{...}"))
+    if v.section_given("gravity"):
+        raise ConfigError(f"{v.source}: [gravity]: not available with rough particles ([collision.tangential]) in "
+                          "a config: rough grains under gravity run from Python (docs/gravity-and-vibrating-walls.md)")
+    for side in WALL_SIDES:
+        if v.has(f"walls.{side}") and v.get(f"walls.{side}.kind") != "hard":
+            v.fail(f"walls.{side}", f'kind = "{v.get(f"walls.{side}.kind")}" is not available with rough particles '
+                                    "([collision.tangential]): they take hard walls at rest only", _Shown("{...}"))
 # ------------------------------------------------------------------ [[species]]
 
 
@@ -1335,13 +1532,22 @@ RULES: tuple[Rule, ...] = (
     Rule('`wall_restitution` is used only with walls (a `"wall"` entry in `boundary`).',
          _check_wall_restitution_needs_walls),
     Rule("`[driving]` needs `heating_rate`.", _check_driving_needs_heating_rate),
-    Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls and no `tc_time`.',
-         _check_dsmc_supported),
+    _only_with("collision.elastic_below", ("constant", "viscoelastic")),
+    Rule('`elastic_below` is not used with `duration = "resolved"`.', _check_elastic_below),
+    Rule("`[[species]]` (a mixture) takes no `[gravity]` and only hard walls in `[walls]`.", _check_species_scene),
+    Rule("`[gravity]` needs `acceleration`.", _check_gravity_needs_acceleration),
+    Rule('A side of `[walls]` belongs to an axis of the system whose `boundary` entry is `"wall"` (a '
+         "vibrating or thermal wall on a periodic axis is refused).", _check_walls_on_wall_axes),
+    Rule('A vibrating wall needs `amplitude` and `frequency` (and may take `waveform`, `phase`), a thermal '
+         "one `temperature`; a key of another kind is refused.", _check_wall_kind_keys),
+    Rule('`method = "dsmc"` (homogeneous, no positions) takes no walls, no `[gravity]`, no `[walls]`, no '
+         "`tc_time` and no `elastic_below`.", _check_dsmc_supported),
     Rule("`inertia`, `rotational_temperature` and `rotational_fraction` are for rough particles: they need "
          "`[collision.tangential]`.", _check_rough_keys_need_tangential),
     Rule('`[collision.tangential]`: `model = "coulomb"` needs `friction`; `friction` and `wall_friction` '
          'are only used with `"coulomb"`, `wall_restitution` and `wall_friction` only with walls; rough '
-         'particles need `duration = "instantaneous"` and one kind of particle (no `[[species]]`).',
+         'particles need `duration = "instantaneous"` and one kind of particle (no `[[species]]`), and take no '
+         '`[gravity]` and only hard walls in `[walls]`.',
          _check_tangential),
 )
 
@@ -1416,11 +1622,11 @@ def _nearest_key(parts: list[str]) -> str | None:
     if not close:
         return None
     section = close[0]
-    in_section = [k.dotted[len(section) + 1:] for k in SCHEMA if k.section.split(".")[0] == section]
+    in_section = [k.dotted[len(section) + 1:] for k in SCHEMA if k.section.split(".")[0] == section and not k.template]
     key = difflib.get_close_matches(".".join(parts[1:]), in_section, n=1, cutoff=0.6)
     if key:
         return f"{section}.{key[0]}"
-    by_name = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA}
+    by_name = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA if not k.template}  # not walls.<side>.*
     name = difflib.get_close_matches(parts[-1], list(by_name), n=1, cutoff=0.75)
     return by_name[name[0]] if name else section
 
@@ -1472,7 +1678,7 @@ def _species_override(data: dict, parts: list, dotted: str, value) -> dict:
 
 def _check_structure(data: dict, values: Values):
     """Unknown sections and keys (with the nearest valid name), non-table sections."""
-    all_keys = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA}
+    all_keys = {k.dotted.split(".")[-1]: k.dotted for k in SCHEMA if not k.template}
     for name, table in data.items():
         if name in ARRAY_SECTIONS and name in SECTIONS:
             _check_species_structure(table, values)
@@ -1503,6 +1709,14 @@ def _check_table(section: str, table: Any, values: Values, all_keys: dict):
             if not isinstance(value, dict):
                 values.fail(dotted, "must be a table", value)
             _check_table(SUBTABLES[dotted], value, values, all_keys)
+        elif dotted in SIDE_TABLES:
+            if not isinstance(value, dict):
+                values.fail(dotted, 'must be a table, e.g. { kind = "vibrating", amplitude = 0.1, frequency = 2.0 }',
+                            value)
+            subs = _section_keys(SIDE_TABLES[dotted])
+            for sub, subvalue in value.items():
+                if sub not in subs:
+                    values.fail(f"{dotted}.{sub}", f"unknown key{_suggest(sub, subs)}", subvalue)
         elif dotted in INLINE_TABLES and isinstance(value, dict):
             subs = INLINE_TABLES[dotted]
             for sub, subvalue in value.items():
@@ -1527,7 +1741,7 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
     values.sections = set(data)
     dimension = 3
     for key in SCHEMA:
-        if key.per_species:
+        if key.template or key.per_species:
             continue
         dotted = key.dotted
         present, raw = _lookup(data, key)
@@ -1563,10 +1777,33 @@ def build_config(data: dict, *, source: str = "<config>", text: str = "", overri
         if dotted == "system.dimension":
             dimension = v
         values.value[dotted] = v
+    _check_side_tables(values, dimension)
     _check_species_keys(data.get("species"), values, dimension)
     for rule in RULES:
         rule.check(values)
     return _assemble(values, source, text)
+
+
+def _check_side_tables(values: Values, dimension: int):
+    """The keys of each ``[walls]`` side table given, as ``walls.<side>.<key>``: type and range
+    by the template keys of ``walls.<side>`` (absent keys take their defaults)."""
+    from dataclasses import replace
+
+    for table in SIDE_TABLES:
+        if table not in values.given:
+            continue
+        raw = values.raw[table]
+        for template in (k for k in SCHEMA if k.template):
+            key = replace(template, section="walls", key=f"{table.split('.')[1]}.{template.key}", template=False)
+            dotted = key.dotted
+            if template.key not in raw:
+                values.value[dotted] = key.default
+                continue
+            values.raw[dotted] = raw[template.key]
+            values.given.add(dotted)
+            v = _check_type(key, raw[template.key], values, dimension)
+            _check_range(key, v, values, dimension)
+            values.value[dotted] = v
 
 
 def _assemble(values: Values, source: str, text: str) -> RunConfig:
@@ -1598,13 +1835,25 @@ def _assemble(values: Values, source: str, text: str) -> RunConfig:
 
     def section(name):
         kwargs = {k.attribute: v[k.dotted] for k in SCHEMA if k.section == name and k.dotted not in SUBTABLES}
+        if name == "gravity" and kwargs.get("acceleration") is None:
+            kwargs.pop("acceleration")
         if name == "collision":
             kwargs["material"] = material
             kwargs["tangential"] = tangential
         return SECTION_CLASSES[name](**kwargs)
 
-    parts = {s: section(s) if s not in OPTIONAL_SECTIONS or s in values.sections else None
-             for s in SECTIONS if s not in ARRAY_SECTIONS}
+    def walls():
+        sides = {}
+        for side in WALL_SIDES:
+            if f"walls.{side}" in values.given:
+                kind = v[f"walls.{side}.kind"]
+                used = ("kind",) + _WALL_KEYS[kind][0] + _WALL_KEYS[kind][1]
+                sides[side] = WallConfig(**{k.key: v[f"walls.{side}.{k.key}"] if k.key in used else None
+                                            for k in SCHEMA if k.template})
+        return WallsConfig(**sides)
+
+    parts = {s: (walls() if s == "walls" else section(s)) if s not in OPTIONAL_SECTIONS or s in values.sections
+             else None for s in SECTIONS if s not in ARRAY_SECTIONS}
     for name in values.species:
         if v[f"species.{name}.material_density"] is not None:  # the reduced mass of the material route
             v[f"species.{name}.mass"] = (v[f"species.{name}.material_density"] / v["collision.material.density"]
@@ -1652,6 +1901,14 @@ def dump_toml(config: RunConfig) -> str:
         if obj is None:
             continue
         lines.append(f"\n[{name}]")
+        if name == "walls":
+            for side in WALL_SIDES:
+                wall = getattr(obj, side)
+                if wall is not None:
+                    subs = ", ".join(f"{k.key} = {_toml_value(getattr(wall, k.key))}" for k in SCHEMA
+                                     if k.template and getattr(wall, k.key) is not None)
+                    lines.append(f"{side} = {{ {subs} }}")
+            continue
         for key in SCHEMA:
             if key.section != name or key.dotted in SUBTABLES or key.dotted.startswith(tuple(f"{t}." for t in INLINE_TABLES)):
                 continue
@@ -1662,7 +1919,9 @@ def dump_toml(config: RunConfig) -> str:
                 lines.append(f"{key.key} = {{ {subs} }}")
                 continue
             value = getattr(obj, key.attribute)
-            if isinstance(value, tuple):
+            if isinstance(value, tuple) and key.type == "list of numbers":
+                lines.append(f"{key.key} = [{', '.join(_toml_value(float(x)) for x in value)}]")
+            elif isinstance(value, tuple):
                 lines.append(f"{key.key} = [{', '.join(_toml_value(x) for x in value)}]")
             elif isinstance(value, dict):
                 entries = ", ".join(f"{quote(k)} = {_toml_value(x)}" for k, x in value.items())

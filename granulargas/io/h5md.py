@@ -28,6 +28,10 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         temperature, kinetic_energy, collisions, dissipated_energy, events,
         momentum (d,), pressure:        step (S,), time (S,) shared, value (S, ...)
         wall_collisions, wall_pressure  (runs with walls)
+        potential_energy                (runs with gravity: -sum m g . r, unwrapped positions)
+        wall_work, wall_impulse (d, 2)  (runs with thermal or vibrating walls, or gravity and walls: energy
+                                        the walls gave the gas, cumulative; normal momentum delivered to
+                                        the lower / upper wall of each axis over the interval ending at time)
         injected_energy, kick_step      (driven runs: energy put in, index of the next kick)
         three_body_contacts             (collisions that take time: collisions of a particle still
                                         in contact with another one, cumulative)
@@ -112,6 +116,9 @@ DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_p
 #: observables of runs with walls / with driving (written only by such runs)
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
+GRAVITY_OBSERVABLES = ("potential_energy",)
+#: observables of runs with thermal or vibrating walls, or with gravity and walls
+WALL_KIND_OBSERVABLES = ("wall_work", "wall_impulse")
 RESOLVED_OBSERVABLES = ("three_body_contacts",)
 #: observables of runs of rough particles (those that store angular velocities)
 ROUGH_OBSERVABLES = ("rotational_temperature", "cumulant_a20", "cumulant_a02", "cumulant_a11")
@@ -206,12 +213,15 @@ class H5MDWriter:
     overwrite : bool
     driven : bool
         Also the driving's observables (``injected_energy``, ``kick_step``).
+    gravity, wall_kinds : bool
+        A run under gravity (``potential_energy``) / with thermal or vibrating walls
+        (``wall_work``, ``wall_impulse``; with gravity and walls too).
     species : int
         A mixture of that many species: also :data:`SPECIES_OBSERVABLES` (0: none).
     """
 
     def __init__(self, path, state: State, *, fields=(), parameters=None, overwrite=False, author=None,
-                 driven=False, species: int = 0):
+                 driven=False, gravity=False, wall_kinds=False, species: int = 0):
         self.path = Path(path)
         self.d, self.n = state.dimension, state.n
         self.positions = state.positions is not None
@@ -226,6 +236,8 @@ class H5MDWriter:
         self.boundary = state.boundary
         extra = ((WALL_OBSERVABLES if "wall" in self.boundary else ()) + (DRIVING_OBSERVABLES if driven else ())
                  + (RESOLVED_OBSERVABLES if "contact_partner" in self.fields else ())
+                 + (GRAVITY_OBSERVABLES if gravity else ())
+                 + (WALL_KIND_OBSERVABLES if wall_kinds or (gravity and "wall" in self.boundary) else ())
                  + (ROUGH_OBSERVABLES if "angular_velocities" in self.fields else ())
                  + (SPECIES_OBSERVABLES if species else ()))
         self.species = int(species)
@@ -369,7 +381,7 @@ class H5MDWriter:
         self._obs = {}
         step = time = None
         for name in names:
-            shape = (d,) if name == "momentum" else ()
+            shape = (d,) if name == "momentum" else (d, 2) if name == "wall_impulse" else ()
             if name in SPECIES_OBSERVABLES:
                 shape = (self.species,) * (2 if name == "species_collisions" else 1)
             dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
@@ -402,7 +414,13 @@ class H5MDWriter:
                                ("cumulant_a11", "<c^2 w^2>/(<c^2><w^2>) - 1")):
                 obs[name].attrs["description"] = (
                     f"{what} (c weighted by m, w by I: granulargas.observables.rough_moments)")
-        for name, text in _SPECIES_DESCRIPTIONS.items():
+        described = {
+            "potential_energy": "potential energy -sum m g . r in the uniform field (unwrapped positions)",
+            "wall_work": "energy the thermal and vibrating walls have given the gas (cumulative, net)",
+            "wall_impulse": "normal momentum delivered to the lower / upper wall of each axis over the sampling "
+                            "interval ending at time (d, 2); NaN at the first sample",
+            **_SPECIES_DESCRIPTIONS}
+        for name, text in described.items():
             if name in obs:
                 obs[name].attrs["description"] = text
         if "wall_pressure" in obs:

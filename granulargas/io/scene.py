@@ -15,8 +15,9 @@ A scene is a handful of orthogonal fields:
 * ``model``: the collision law, ``"elastic"``, ``"constant"``, ``"viscoelastic"``, or
   ``"unknown"`` (a file that does not record it);
 * ``kind``: how the energy goes, ``"cooling"`` (dissipative, no driving), ``"driven"``
-  (white-noise driving), ``"elastic"`` (conserved) or ``"unknown"``;
-* ``walls``, ``resolved`` (collisions that take time), ``polydisperse``, ``tc_model``
+  (white-noise driving), ``"vibrated"`` (gravity, or thermal or vibrating walls: the walls
+  put energy in, or the gas settles on a floor), ``"elastic"`` (conserved) or ``"unknown"``;
+* ``walls``, ``gravity``, ``resolved`` (collisions that take time), ``polydisperse``, ``tc_model``
   (the TC model's elastic collisions), ``material`` (the material route: the contact
   stiffness and so the contact time is known), ``rough`` (rough particles: spins and a
   tangential law; two temperatures), ``mixture`` (species, ``[[species]]``: the temperature
@@ -41,7 +42,7 @@ __all__ = ["Scene", "Statement", "STATEMENTS", "MODELS", "KINDS"]
 #: collision models the theory knows
 MODELS = ("elastic", "constant", "viscoelastic")
 #: how a run's energy goes
-KINDS = ("cooling", "driven", "elastic", "unknown")
+KINDS = ("cooling", "driven", "vibrated", "elastic", "unknown")
 
 
 @dataclass(frozen=True)
@@ -53,6 +54,7 @@ class Scene:
     model: str = "elastic"
     kind: str = "elastic"
     walls: bool = False
+    gravity: bool = False
     resolved: bool = False
     polydisperse: bool = False
     tc_model: bool = False
@@ -74,15 +76,17 @@ class Scene:
         """The scene of a :class:`granulargas.io.config.RunConfig`."""
         s, c, p = config.system, config.collision, config.particles
         driving = config.driving
+        gravity = config.gravity is not None and any(config.gravity.vector)
+        vibrated = gravity or (config.walls is not None and config.walls.moving)
         # a mixture's tables per pair: it cools if any pair does
         eps = min(c.restitution.values()) if isinstance(c.restitution, dict) else c.restitution
         damping = max(c.damping.values()) if isinstance(c.damping, dict) else c.damping
         mixture = bool(getattr(config, "species", ()))
         return cls(
             method=config.run.method, dimension=s.dimension, model=c.model,
-            kind=_kind(c.model, eps, damping if c.material is None else 1.0,
-                       driving is not None and driving.heating_rate > 0.0),
-            walls="wall" in s.boundary, resolved=c.duration == "resolved",
+            kind="vibrated" if vibrated else _kind(c.model, eps, damping if c.material is None else 1.0,
+                                                    driving is not None and driving.heating_rate > 0.0),
+            walls="wall" in s.boundary, gravity=gravity, resolved=c.duration == "resolved",
             polydisperse=bool(not mixture and p.polydisperse and p.diameter_max > p.diameter_min),
             tc_model=c.tc_time is not None,
             material=c.material is not None, mixture=mixture,
@@ -102,6 +106,11 @@ class Scene:
         drv = parameters.get("driving")
         driven = isinstance(drv, dict) and _float(drv.get("heating_rate"), 0.0) > 0.0
         material = isinstance(parameters.get("units_si"), dict)
+        grav = parameters.get("gravity")
+        gravity = isinstance(grav, dict) and bool(np.any(np.asarray(grav.get("acceleration", 1.0), float) != 0.0))
+        walls = parameters.get("walls")
+        moving = isinstance(walls, dict) and any(isinstance(w, dict) and w.get("kind") in ("thermal", "vibrating")
+                                                  for w in walls.values())
         mixture = isinstance(parameters.get("species"), dict)
         poly = False
         for values in (radii, masses):
@@ -109,8 +118,10 @@ class Scene:
                 poly = True
         return cls(
             method=str(parameters.get("method", "edmd")), dimension=int(dimension), model=model,
-            kind=_kind(model, _float(coll.get("restitution"), None), _float(coll.get("prefactor"), None), driven),
-            walls="wall" in tuple(boundary), resolved=bool(contacts) or coll.get("duration") == "resolved",
+            kind="vibrated" if (gravity or moving) and model != "unknown" else
+            _kind(model, _float(coll.get("restitution"), None), _float(coll.get("prefactor"), None), driven),
+            walls="wall" in tuple(boundary), gravity=gravity,
+            resolved=bool(contacts) or coll.get("duration") == "resolved",
             polydisperse=poly, tc_model=_float(coll.get("tc_time"), None) is not None, material=material,
             mixture=mixture, rough=isinstance(parameters.get("tangential"), dict),
         )
@@ -130,7 +141,8 @@ class Scene:
         if self.kind not in ("elastic", "unknown"):
             parts.append(self.kind)
         parts.append(law)
-        parts += [name for name, on in (("walls", self.walls), ("collisions that take time", self.resolved),
+        parts += [name for name, on in (("walls", self.walls), ("gravity", self.gravity),
+                                        ("collisions that take time", self.resolved),
                                         ("polydisperse", self.polydisperse), ("TC model", self.tc_model),
                                         ("material route", self.material), ("mixture", self.mixture),
                                         ("rough particles", self.rough)) if on]
@@ -190,7 +202,7 @@ STATEMENTS = {
         lambda s: _cools(s) and s.model in ("constant", "viscoelastic") and not s.rough and not s.mixture),
     "rough": Statement(
         "two temperatures (translation, rotation) by the Maxwellian energy balances, and how far smooth "
-        "particles would take T_tr(t)", lambda s: s.rough and not s.mixture),
+        "particles would take T_tr(t)", lambda s: s.rough and not s.mixture and s.kind != "vibrated"),
     "instability": Statement(
         "box length against the shear-instability length L_c: clusters and shear modes in space",
         lambda s: s.space and _cools(s)),
@@ -201,9 +213,12 @@ STATEMENTS = {
         "inelastic collapse of a constant eps without the TC model (dense regions in space)",
         lambda s: s.space and s.model == "constant" and not s.tc_model and s.kind in ("cooling", "driven")),
     "pressure": Statement(
-        "the pressure (collisional virial) and Z = P/(nT)", lambda s: s.space),
+        "the pressure (collisional virial) and Z = P/(nT)", lambda s: s.space and not s.gravity),
     "wall_pressure": Statement(
-        "the wall pressure and the density profile across the walls", lambda s: s.walls),
+        "the wall pressure and the density profile across the walls", lambda s: s.walls and s.kind != "vibrated"),
+    "vibrated_scene": Statement(
+        "the scene of gravity and thermal or vibrating walls: Gamma, the leading-order bed, the energy balance, "
+        "the profiles along gravity", lambda s: s.kind == "vibrated"),
     "contact_time": Statement(
         "t_c / t_free of the contacts (material route) or tc_time / t_free (TC model)",
         lambda s: (s.model == "viscoelastic" and s.material) or s.tc_model),

@@ -91,6 +91,7 @@ from granulargas.io.scene import Scene
 from granulargas.run import validity as V
 from granulargas.run.prepare import (DELTA_MAX, OBLIQUE_BETA_MAX, mean_particle, mean_restitution, mixture_of_config,
                                      oblique_bounds, reduced_compression, reduced_prefactor)
+from granulargas.run import vibrated as vibrated_scene
 from granulargas.theory.driven import RELAXATION_TIMES
 from granulargas.theory import rough as rough_theory
 from granulargas.theory.gas import cooling_curve
@@ -250,6 +251,8 @@ def choose_method(config, instability_length: float = math.inf, duration: str | 
     "resolved" or "dem" rule DSMC out."""
     s, c = config.system, config.collision
     eta = s.packing_fraction
+    if getattr(config, "gravity", None) is not None:
+        return "edmd", "gravity needs positions (DSMC simulates a homogeneous gas)"
     if "wall" in s.boundary:
         return "edmd", "walls need positions (DSMC simulates a homogeneous gas)"
     if c.tc_time is not None:
@@ -345,6 +348,10 @@ class Advice:
     validity: tuple = ()
     species: tuple = ()
     notes: tuple = ()
+    #: a vibrated scene's lines (:func:`granulargas.run.vibrated.scene_lines`), in place of the cooling advice
+    vibrated: tuple = ()
+    #: a vibrated scene's numbers (:func:`granulargas.run.vibrated.scene`), for JSON
+    vibrated_numbers: dict = field(default_factory=dict)
     #: rough particles: the largest relative change of T_tr(t) over the run if the particles
     #: were smooth (beta_t = -1; :func:`granulargas.theory.rough.smooth_deviation`), and whether
     #: that is within the tolerance
@@ -370,7 +377,8 @@ class Advice:
 
     def lines(self) -> list[str]:
         sc = self.scene
-        out = [self._run_line()] + list(self.species)
+        # a vibrated scene has no free cooling to predict: its own numbers instead
+        out = (list(self.vibrated) if sc.kind == "vibrated" else [self._run_line()]) + list(self.species)
         if self.rough_deviation is not None:
             verdict = "a smooth model will do" if self.smooth_ok else "keep the rough particles"
             out.append(f"rough        smooth particles (beta_t = -1) would move T_tr(t) by up to "
@@ -453,6 +461,7 @@ class Advice:
             "duration": self.duration,
             "notes": list(self.notes),
             "validity": list(self.validity),
+            "vibrated": self.vibrated_numbers or None,
         }
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
 
@@ -560,7 +569,13 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     t_end = rv.t_end
     adv = Advice(gas.model, tolerance, t_end, rv.T_end / T0, scene=scene, T0=T0, box=V.box_length(config),
                  spread=rv.spread)
-    adv.validity = tuple(ln for ln in rv.lines()[1:]
+    if scene.kind == "vibrated":  # the scene's lines lead; the checks after them
+        adv.vibrated = tuple(rv.vibrated)
+        adv.vibrated_numbers = vibrated_scene.scene(config)
+        checks = [ln for ln in rv.lines() if ln not in rv.vibrated]
+    else:
+        checks = rv.lines()[1:]
+    adv.validity = tuple(ln for ln in checks
                          if not ln.startswith("validity     beta") and ln != f"warning: {rv.instability_warning}")
     notes = []
     if scene.kind == "driven":

@@ -42,12 +42,12 @@ from granulargas.contact import material, oblique_table, restitution_table
 from granulargas.contact.oblique import DELTA_MAX, compression_prefactor
 from granulargas.contact.oblique_grid import BETA_MAX as OBLIQUE_BETA_MAX
 from granulargas import theory
-from granulargas.engine import CollisionRule, TangentialRule, WhiteNoise
+from granulargas.engine import CollisionRule, TangentialRule, Wall, Walls, WhiteNoise
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
 from granulargas.initial import box_for_packing, maxwell_spins, random_state
 from granulargas.initial.lattice_gas import MIN_WALL_AXIS_DIAMETERS, RANDOM_PLACEMENT_MAX, maxwell_velocities
-from granulargas.io.config import TABLE_BETA_MAX, RunConfig
+from granulargas.io.config import TABLE_BETA_MAX, WALL_SIDES, RunConfig
 from granulargas.io.h5md import has_positions, open_run, read_state
 from granulargas.run.resources import check_dsmc_memory, check_memory
 from granulargas.state import State
@@ -72,6 +72,9 @@ class Setup:
     driving: object = None
     #: the restart file the state was read from (None: a fresh state)
     source: str | None = None
+    #: the uniform acceleration (tuple) or None; the wall kinds (engine.walls.Walls) or None
+    gravity: tuple | None = None
+    walls: object = None
     #: rough particles: the tangential rule (None: smooth)
     tangential: object = None
 
@@ -153,9 +156,14 @@ def fresh_state(config: RunConfig) -> State:
                 f"{MIN_WALL_AXIS_DIAMETERS:g} largest diameters (= {MIN_WALL_AXIS_DIAMETERS * dmax:.4g}); "
                 "use more particles or a higher packing_fraction"
             )
+    walls = make_walls(config)
+    margins = None
+    if walls is not None:  # keep the sweep of the vibrating walls clear
+        margins = np.array([[walls.side(a, 0).reach, walls.side(a, 1).reach] for a in range(s.dimension)])
+        check_wall_room(config, walls, box, dmax)
     try:
         state = random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
-                             radii=radii, masses=masses, rng=rng, boundary=s.boundary)
+                             radii=radii, masses=masses, rng=rng, boundary=s.boundary, margins=margins)
         return state if not config.species else state.replace(species=species_indices(config))
     except ConfigError as exc:
         limit = RANDOM_PLACEMENT_MAX[s.dimension]
@@ -388,6 +396,34 @@ def driven_energy_bound(config: RunConfig, prefactor: float, state: State) -> fl
     return 2.0 * max(e0, 0.5 * s.dimension * len(state.masses) * t_ss)
 
 
+def scene_energy_bound(config: RunConfig, state: State) -> float:
+    """Total kinetic energy the restitution table of a run under gravity or with thermal or
+    vibrating walls must cover: twice the initial energy plus, per particle, the largest
+    potential drop across the box along a wall axis (m |g_a| L_a), the speed gravity adds
+    on a periodic axis by ``run.end_time`` (|g_a| t), ten times the fastest vibrating wall
+    and ten thermal speeds of the hottest thermal wall (kinetic energies m v^2 / 2 of those
+    speeds). No bound is rigorous for walls that put energy in; a run that goes beyond stops
+    with a TableRangeError."""
+    s = config.system
+    m = state.masses
+    e0 = 0.5 * float((m[:, None] * state.velocities**2).sum())
+    speed2 = 0.0
+    if config.gravity is not None:
+        for a, g in enumerate(config.gravity.vector):
+            if s.boundary[a] == "wall":
+                speed2 += 2.0 * abs(g) * float(state.box[a])
+            elif config.run.end_time is not None:
+                speed2 += (abs(g) * config.run.end_time) ** 2
+    walls = make_walls(config)
+    if walls is not None:
+        for a, side, w in walls.given():
+            if w.kind == "vibrating":
+                speed2 = max(speed2, (10.0 * w.max_speed) ** 2)
+            elif w.kind == "thermal":
+                speed2 = max(speed2, 100.0 * w.temperature / float(m.min()))
+    return 2.0 * (e0 + 0.5 * float(m.sum()) * speed2)
+
+
 def make_rule(config: RunConfig, state: State):
     """(rule, name, prefactor, table, warnings, parameters) for the config."""
     c = config.collision
@@ -396,22 +432,28 @@ def make_rule(config: RunConfig, state: State):
     if c.model == "elastic":
         return CollisionRule.elastic(len(config.species) if mixture else None), "elastic", None, None, [], params
     if c.model == "constant":
-        params.update(restitution=c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution)
+        params.update(restitution=c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution,
+                      elastic_below=c.elastic_below)
         if mixture:
             eps = pair_restitutions(config)
             walls = c.species_values(c.wall_restitution, config.species_names, np.diagonal(eps))
             params.update(restitution=mean_restitution(config), restitution_pairs=eps,
                           wall_restitution=np.array(walls))
-            rule = CollisionRule.constant(eps, tc_time=c.tc_time, wall_restitution=walls)
+            rule = CollisionRule.constant(eps, tc_time=c.tc_time, wall_restitution=walls,
+                                          elastic_below=c.elastic_below)
         else:
-            rule = CollisionRule.constant(c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution)
+            rule = CollisionRule.constant(c.restitution, tc_time=c.tc_time, wall_restitution=c.wall_restitution,
+                                          elastic_below=c.elastic_below)
         return rule, "constant", None, None, [], params
     k = reduced_prefactor(config)
     pairs = pair_prefactors(config) if mixture else None
     # the bounds of a mixture with its largest pair prefactor (rigorous: beta grows with k)
     k_bound = float(pairs.max()) if mixture else k
     driven = config.driving is not None and config.driving.heating_rate > 0.0
-    bmax = beta_bound(k_bound, state, driven_energy_bound(config, k_bound, state) if driven else None)
+    energy = driven_energy_bound(config, k_bound, state) if driven else None
+    if config.gravity is not None or (config.walls is not None and config.walls.moving):
+        energy = max(energy or 0.0, scene_energy_bound(config, state))
+    bmax = beta_bound(k_bound, state, energy)
     if not bmax <= TABLE_BETA_MAX:
         key = ("collision.material" if c.material is not None else "collision.damping" if isinstance(c.damping, dict)
                else f"collision.damping = {c.damping:g}")
@@ -447,8 +489,9 @@ def make_rule(config: RunConfig, state: State):
         rule = CollisionRule.viscoelastic(prefactor=k, table=table, duration="resolved", compression=q,
                                           oblique=oblique)
         return rule, "viscoelastic", k, table, warns, params
-    return (CollisionRule.viscoelastic(prefactor=pairs if mixture else k, table=table), "viscoelastic", k, table,
-            warns, params)
+    params.update(elastic_below=c.elastic_below)
+    return (CollisionRule.viscoelastic(prefactor=pairs if mixture else k, table=table, elastic_below=c.elastic_below),
+            "viscoelastic", k, table, warns, params)
 
 
 def make_driving(config: RunConfig, prefactor: float | None, state: State):
@@ -528,6 +571,60 @@ def make_tangential(config: RunConfig):
     return rule, {**rule.parameters(), "inertia": config.particles.inertia}
 
 
+def make_walls(config: RunConfig):
+    """The config's ``[walls]`` as :class:`granulargas.engine.walls.Walls` (None without the
+    section); the thermal walls' draws are seeded with ``system.seed``."""
+    if config.walls is None:
+        return None
+    sides = {}
+    for a in range(config.system.dimension):
+        for side in (0, 1):
+            name = "xyz"[a] + ("_low", "_high")[side]
+            w = getattr(config.walls, name)
+            if w is None:
+                continue
+            if w.kind == "vibrating":
+                sides[name] = Wall.vibrating(w.amplitude, w.frequency, w.waveform, w.phase)
+            elif w.kind == "thermal":
+                sides[name] = Wall.thermal(w.temperature)
+            else:
+                sides[name] = Wall.hard()
+    return Walls(**sides, seed=config.system.seed)
+
+
+def check_wall_room(config: RunConfig, walls, box, dmax: float) -> None:
+    """The vibrating walls of each axis leave room for a particle at their closest (twice
+    their amplitudes less than the axis, by more than the largest diameter); one line
+    naming the amplitude key otherwise."""
+    for a in range(config.system.dimension):
+        lo, hi = walls.side(a, 0), walls.side(a, 1)
+        room = float(box[a]) - lo.reach - hi.reach
+        if config.system.boundary[a] == "wall" and not room > dmax:
+            name = "xyz"[a] + ("_low" if lo.reach >= hi.reach else "_high")
+            amp = getattr(config.walls, name).amplitude
+            raise ConfigError(f"{config.source}: walls.{name}.amplitude = {amp:g}: the walls of the {'xyz'[a]} "
+                              f"axis (length {float(box[a]):.4g}) reach {lo.reach:.4g} and {hi.reach:.4g} into the "
+                              f"box (twice their amplitudes) and leave {room:.4g} at their closest, no room for a "
+                              f"particle of diameter {dmax:.4g}")
+
+
+def make_scene(config: RunConfig, state: State):
+    """(gravity, walls, parameters) of the config's ``[gravity]`` and ``[walls]``: the
+    acceleration as a tuple (None without the section or for a zero vector), the wall kinds
+    (:func:`make_walls`, checked against the state's box) and the ``parameters/`` record."""
+    g = config.gravity.vector if config.gravity is not None else None
+    if g is not None and not any(g):
+        g = None
+    walls = make_walls(config)
+    params = {}
+    if g is not None:
+        params["gravity"] = {"acceleration": np.array(g)}
+    if walls is not None:
+        check_wall_room(config, walls, state.box, 2.0 * float(state.radii.max()))
+        params["walls"] = {name: {"kind": w.kind, "amplitude": w.amplitude, "frequency": w.frequency,
+                                  "waveform": w.waveform, "phase": w.phase, "temperature": w.temperature}
+                           for name, w in ((n, getattr(walls, n)) for n in WALL_SIDES) if w is not None}
+    return g, walls, params
 def species_parameters(config: RunConfig) -> dict:
     """The species of a mixture for the H5MD ``parameters/species`` group: names (in index order),
     counts, diameters, masses, number fractions, and the material constants each species uses."""
@@ -601,6 +698,7 @@ def prepare(config: RunConfig) -> Setup:
     source = str(Path(config.initial.from_file)) if config.initial.from_file else None
     rule, name, k, table, warns, rule_params = make_rule(config, state)
     driving, driving_params = make_driving(config, k, state)
+    gravity, walls, scene_params = make_scene(config, state)
     tangential, tangential_params = make_tangential(config)
     s = config.system
     vol = particle_volume(2.0 * state.radii, s.dimension).sum()
@@ -622,6 +720,7 @@ def prepare(config: RunConfig) -> Setup:
     }
     if driving_params is not None:
         parameters["driving"] = driving_params
+    parameters.update(scene_params)
     if config.run.method == "dsmc":
         parameters["dsmc"] = {
             "chi": float(theory.contact_value(parameters["packing_fraction"], s.dimension)),
@@ -647,4 +746,4 @@ def prepare(config: RunConfig) -> Setup:
                                  "collisions": state.collisions}
     if tangential_params is not None:
         parameters["tangential"] = tangential_params
-    return Setup(rule, name, state, k, table, parameters, warns, driving, source, tangential)
+    return Setup(rule, name, state, k, table, parameters, warns, driving, source, gravity, walls, tangential)

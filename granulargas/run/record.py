@@ -36,6 +36,7 @@ import numpy as np
 
 from granulargas import __version__, theory
 from granulargas.dsmc import DSMC
+from granulargas.engine.walls import SIDES as WALL_SIDES
 from granulargas.io.h5md import H5MDWriter
 from granulargas.observables import sonine_coefficients, species_moments
 from granulargas.run.rough import rotational_observables
@@ -138,6 +139,12 @@ def run_parameters(sim) -> dict:
         out["dsmc"] = {"chi": float(sim.chi), "number_density": float(radii.shape[0] / float(sim.volume))}
         if sim.chi_pairs is not None:
             out["dsmc"]["chi_pairs"] = np.asarray(sim.chi_pairs)
+    if getattr(sim, "gravity", None) is not None:
+        out["gravity"] = {"acceleration": np.array(sim.gravity)}
+    if getattr(sim, "walls", None) is not None:
+        out["walls"] = {name: {"kind": w.kind, "amplitude": w.amplitude, "frequency": w.frequency,
+                               "waveform": w.waveform, "phase": w.phase, "temperature": w.temperature}
+                        for name, w in ((n, getattr(sim.walls, n)) for n in WALL_SIDES) if w is not None}
     if sim.rule.species:
         out["species"] = species_parameters(sim, d)
     return out
@@ -187,8 +194,16 @@ def observables(sim, pressure: bool) -> dict:
         "sonine_a2": float(a2),
         "sonine_a3": float(a3),
     }
+    gravity = getattr(sim, "gravity", None)
+    walls = getattr(sim, "walls", None)
+    if gravity is not None:
+        out["potential_energy"] = float(sim.potential_energy)
     if "wall" in sim.boundary:
         out["wall_collisions"] = int(sim.wall_collisions)
+        if (walls is not None and walls.moving) or gravity is not None:  # a vibrated scene
+            out["wall_work"] = float(sim.wall_work)
+            # the momentum per wall over the interval (read before the wall pressure resets it)
+            out["wall_impulse"] = sim.wall_impulse() if pressure else np.full((sim.dimension, 2), math.nan)
         out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
     if sim.driving is not None:
         out["injected_energy"] = float(sim.injected_energy)
@@ -232,8 +247,10 @@ class RunWriter:
         self.sim = sim
         self.dsmc = _is_dsmc(sim)
         params = {**run_parameters(sim), **(parameters or {})}
+        walls = getattr(sim, "walls", None)
         self.writer = H5MDWriter(path, _state(sim), fields=_fields(sim), parameters=params, overwrite=overwrite,
-                                 driven=sim.driving is not None, species=sim.rule.species)
+                                 driven=sim.driving is not None, gravity=getattr(sim, "gravity", None) is not None,
+                                 wall_kinds=walls is not None and walls.moving, species=sim.rule.species)
         self.path = self.writer.path
         self._last_sample = None
         try:

@@ -293,11 +293,16 @@ def check_same_physics(config: RunConfig, path: Path) -> None:
     if old is None:
         raise InputFileError(f"{path}: parameters/config is missing or not a valid config; --append needs the "
                              "file's config")
-    if (config.driving is None) != (old.driving is None):
-        given = "has no [driving]" if config.driving is None else "has [driving]"
-        raise ConfigError(f"{config.source}: {given}, but the file {path} was run "
-                          f"{'with' if old.driving is not None else 'without'} it; --append continues the same "
-                          "physics (write a new file with --output instead)")
+    for name in ("driving", "gravity", "walls"):
+        if (getattr(config, name) is None) != (getattr(old, name) is None):
+            given = f"has no [{name}]" if getattr(config, name) is None else f"has [{name}]"
+            raise ConfigError(f"{config.source}: {given}, but the file {path} was run "
+                              f"{'with' if getattr(old, name) is not None else 'without'} it; --append continues the "
+                              "same physics (write a new file with --output instead)")
+    for name in ("gravity", "walls"):
+        if getattr(config, name) != getattr(old, name):
+            raise ConfigError(f"{config.source}: [{name}] differs from the one the file {path} was run with; --append "
+                              "continues the same physics (write a new file with --output instead)")
     for section in _SAME_PHYSICS:
         new_s, old_s = getattr(config, section), getattr(old, section)
         for f in fields(new_s):
@@ -331,6 +336,14 @@ def collapse_message(config: RunConfig, where: str) -> str:
     (the TC model's ``collision.tc_time``, with a value that changed T(t) by 0.03 % in the
     collapse demonstration of docs/choosing-a-model.md, or the viscoelastic model)."""
     tc = TC_TIME_FRACTION * mean_free_time(config)
+    if config.gravity is not None or config.system.walls:
+        speed = ELASTIC_BELOW_FRACTION * math.sqrt(config.initial.temperature / config.particles.mass) \
+            if config.particles.mass else ELASTIC_BELOW_FRACTION
+        return (f"inelastic collapse {where}: ever faster collisions (a grain coming to rest on a wall, or a "
+                f"cluster on a shaken plate, bounces infinitely often in a finite time); set collision.elastic_below "
+                f"in {config.source} (collisions below that normal speed are elastic, e.g. elastic_below = "
+                f"{speed:.2g}: {ELASTIC_BELOW_FRACTION:g} of the initial thermal speed) or collision.tc_time "
+                f"(the TC model)")
     return (f"inelastic collapse {where}: the collision rate diverges; set collision.tc_time in {config.source} "
             f"(the TC model, e.g. tc_time = {tc:.2g}: {TC_TIME_FRACTION:.0e} of the initial mean free time) "
             f"or use collision.model = \"viscoelastic\"")
@@ -338,6 +351,8 @@ def collapse_message(config: RunConfig, where: str) -> str:
 
 #: tc_time the collapse error proposes, in mean free times at the initial temperature
 TC_TIME_FRACTION = 1e-6
+#: elastic_below the collapse error of a scene with walls or gravity proposes, in initial thermal speeds
+ELASTIC_BELOW_FRACTION = 1e-3
 
 
 def run_config(config: RunConfig, *, overwrite: bool = False, quiet: bool = True, progress=None,
@@ -515,7 +530,7 @@ def _build_simulation(config: RunConfig, setup, st, what):
         sim = make_dsmc(config, setup)
     else:
         sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
-                         tangential=setup.tangential)
+                         gravity=setup.gravity, walls=setup.walls, tangential=setup.tangential)
         what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     sim.run(until=sim.time)
     return sim
@@ -530,7 +545,8 @@ def _open_writer(config: RunConfig, setup, st, sim, path, append: bool, overwrit
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None, species=setup.rule.species)
+                            driven=sim.driving is not None, gravity=setup.gravity is not None,
+                            wall_kinds=setup.walls is not None and setup.walls.moving, species=setup.rule.species)
     try:
         if stop is not None:
             stop.arm()

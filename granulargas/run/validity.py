@@ -91,12 +91,13 @@ from granulargas import theory
 from granulargas.contact import restitution_table
 from granulargas.contact.material import damping_from_prefactor, effective_modulus, rho_from_material
 from granulargas.errors import ConfigError
-from granulargas.io.config import TABLE_BETA_MAX
+from granulargas.io.config import TABLE_BETA_MAX, RunConfig
 from granulargas.io.scene import Scene
 from granulargas.theory import rough as rough_theory
 from granulargas.theory.moments import speed_quadrature
 from granulargas.run.prepare import (mean_particle, mean_restitution, mixture_of_config, pair_weights, reduced_prefactor,
                                      species_fractions)
+from granulargas.run.vibrated import scene_lines
 from granulargas.theory.gas import (  # noqa: F401  (re-exported: what the checks predict with)
     THERMAL_QUANTILES,
     CoolingCurve,
@@ -306,6 +307,9 @@ class RunValidity:
     T_steady: float = math.nan
     instability_warning: str | None = None
     T_stable: float = math.nan
+    #: a vibrated scene's lines (gravity, thermal or vibrating walls: :mod:`granulargas.run.vibrated`),
+    #: in place of the homogeneous gas's temperature range
+    vibrated: list = field(default_factory=list)
 
     @property
     def driven(self) -> bool:
@@ -318,6 +322,11 @@ class RunValidity:
 
     def lines(self) -> list[str]:
         """Report lines for the run summary (numbers, then warnings and errors)."""
+        if self.vibrated:
+            out = [x for x in self.vibrated if not x.startswith("warning: ")]
+            out += [f"warning: {w}" for w in self.warnings]
+            out += [f"error: {e}" for e in self.errors]
+            return out
         theory_name = "two-temperature theory" if self.scene.rough else "Enskog theory"
         if self.driven and math.isfinite(self.T_steady):
             at = f"at t = {self.t_end:.4g}; " if math.isfinite(self.t_end) else ""
@@ -493,6 +502,16 @@ def check_run(config) -> RunValidity:
         return rv
     if scene.kind == "driven":
         return _check_driven(config, gas, scene)
+    if scene.kind == "vibrated" and isinstance(config, RunConfig):
+        # the walls put energy in (or, under gravity alone, the gas comes to rest on the floor): no
+        # cooling curve to predict; the scene's numbers instead
+        lines = scene_lines(config)
+        rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, math.nan, scene=scene,
+                         vibrated=lines)
+        rv.tc_ratio = contact_time_ratio(gas)
+        _warn_contact(rv, gas, None)
+        rv.warnings += [x[len("warning: "):] for x in lines if x.startswith("warning: ")]
+        return rv
     src = gas.source
     spread = curve = None
     if gas.model == "viscoelastic" and gas.pair_constant > 0:

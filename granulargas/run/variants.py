@@ -44,6 +44,13 @@ _MATERIAL = {
     "collision.duration": "resolved", "system.packing_fraction": 0.1, "collision.damping": None,
 }
 _DRIVEN = {"driving.model": "white_noise", "driving.heating_rate": 0.005}
+#: a floor under gravity; a vibrating wall without and with gravity (the loops of the flight and of the
+#: wall kinds)
+_GRAVITY = {"system.boundary": ["periodic", "periodic", "wall"], "gravity.acceleration": [0.0, 0.0, -0.1],
+            "collision.elastic_below": 1e-3}
+_WALLS = {"system.boundary": ["periodic", "periodic", "wall"], "collision.elastic_below": 1e-3,
+          "walls.z_low.kind": "vibrating", "walls.z_low.amplitude": 0.05, "walls.z_low.frequency": 1.0}
+_GRAVITY_WALLS = {**_GRAVITY, **_WALLS}
 _DSMC = {"run.method": "dsmc", "system.particles": 256}
 #: rough particles (spins and a tangential restitution): a loop of their own
 _ROUGH = {"collision.tangential.restitution": 0.0}
@@ -57,16 +64,27 @@ def _placement(config: RunConfig) -> bool:
     return config.run.method == "edmd" and not config.initial.from_file
 
 
-def _engine(mode: str, resolved: bool = False, driven: bool = False,
-            rough: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
+def scene_kind(config: RunConfig) -> str | None:
+    """The engine's flight and wall kinds: "gravity-walls" (gravity, thermal or vibrating
+    walls), "walls" (thermal or vibrating walls), "gravity" (hard walls at rest) or None."""
+    walls = config.walls is not None and config.walls.moving
+    gravity = config.gravity is not None and any(config.gravity.vector)
+    if walls:
+        return "gravity-walls" if gravity else "walls"
+    return "gravity" if gravity else None
+
+
+def _engine(mode: str, resolved: bool = False, driven: bool = False, rough: bool = False, mixture: bool = False,
+            scene: str | None = None) -> Callable[[RunConfig, str], bool]:
     """Runs of the event-driven engine in neighbour mode ``mode`` (with collisions that take
     time: ``resolved``; ``driven``: the driven ones only; ``rough``: rough particles;
-    ``mixture``: those with species)."""
+    ``mixture``: those with species; ``scene``: their :func:`scene_kind`)."""
     def uses(config: RunConfig, neighbours: str) -> bool:
         return (config.run.method == "edmd" and neighbours == mode
                 and (config.collision.duration == "resolved") == resolved
                 and config.collision.rough == rough
-                and (config.driving is not None or not driven) and bool(config.species) == mixture)
+                and (config.driving is not None or not driven) and bool(config.species) == mixture
+                and scene_kind(config) == scene)
     return uses
 
 
@@ -126,6 +144,20 @@ VARIANTS = (
             _engine("lists", driven=True), after=("lists",)),
     Variant("cells-driven", "its driving step", {"run.neighbours": "cells", **_DRIVEN},
             _engine("cells", driven=True), after=("cells",)),
+    Variant("lists-gravity", "the neighbour-list engine under gravity", {"run.neighbours": "lists", **_GRAVITY},
+            _engine("lists", scene="gravity"), after=("lists",)),
+    Variant("cells-gravity", "the cell-crossing engine under gravity", {"run.neighbours": "cells", **_GRAVITY},
+            _engine("cells", scene="gravity"), after=("cells",)),
+    Variant("lists-walls", "the neighbour-list engine with thermal or vibrating walls",
+            {"run.neighbours": "lists", **_WALLS}, _engine("lists", scene="walls"), after=("lists",)),
+    Variant("cells-walls", "the cell-crossing engine with thermal or vibrating walls",
+            {"run.neighbours": "cells", **_WALLS}, _engine("cells", scene="walls"), after=("cells",)),
+    Variant("lists-gravity-walls", "the neighbour-list engine under gravity with thermal or vibrating walls",
+            {"run.neighbours": "lists", **_GRAVITY_WALLS}, _engine("lists", scene="gravity-walls"),
+            after=("lists-gravity", "lists-walls")),
+    Variant("cells-gravity-walls", "the cell-crossing engine under gravity with thermal or vibrating walls",
+            {"run.neighbours": "cells", **_GRAVITY_WALLS}, _engine("cells", scene="gravity-walls"),
+            after=("cells-gravity", "cells-walls")),
     Variant("resolved", "the engine of collisions that take time", {"run.neighbours": "lists", **_MATERIAL},
             _engine("lists", resolved=True), after=("placement", "lists")),
     Variant("resolved-driven", "its driving step", {"run.neighbours": "lists", **_MATERIAL, **_DRIVEN},

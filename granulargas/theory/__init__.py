@@ -14,6 +14,8 @@ import theory; theory.haff_tau0(...)``):
   a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there);
 * :mod:`~granulargas.theory.driven` -- the white-noise driven steady state
   (temperature, a2, kick interval; viscoelastic: effective restitution);
+* :mod:`~granulargas.theory.vibrated` -- gases under gravity and on vibrating walls:
+  hydrostatic and barometric profiles, the bouncing ball, the dilute vibrofluidized bed;
 * :mod:`~granulargas.theory.rough` -- rough grains: the two-temperature (translation,
   rotation) Maxwellian theory, free cooling, driven steady states, the Mpemba crossing
   (import it from there: ``from granulargas.theory import rough``);
@@ -22,9 +24,10 @@ import theory; theory.haff_tau0(...)``):
   (Garzó & Dufty 1999), contact values of a mixture (import it from there).
 """
 
-from granulargas.theory import driven, enskog, gas, mixture, rough, viscoelastic  # noqa: F401
+from granulargas.theory import driven, enskog, gas, mixture, rough, vibrated, viscoelastic  # noqa: F401
 from granulargas.theory.driven import *  # noqa: F401,F403
 from granulargas.theory.enskog import *  # noqa: F401,F403
+from granulargas.theory.vibrated import *  # noqa: F401,F403
 from granulargas.theory.viscoelastic import *  # noqa: F401,F403
 
-__all__ = enskog.__all__ + viscoelastic.__all__ + driven.__all__
+__all__ = enskog.__all__ + viscoelastic.__all__ + driven.__all__ + vibrated.__all__

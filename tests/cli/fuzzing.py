@@ -64,6 +64,16 @@ BASES = {
         "run": {"collisions_per_particle": 1.0},
         "output": {"file": "out.h5"},
     },
+    "vibrated-2d": {
+        "system": {"dimension": 2, "particles": 64, "packing_fraction": 0.05, "seed": 6,
+                   "boundary": ["periodic", "wall"]},
+        "collision": {"model": "constant", "restitution": 0.9, "elastic_below": 0.001},
+        "gravity": {"acceleration": [0.0, -1.0]},
+        "walls": {"y_low": {"kind": "vibrating", "amplitude": 0.1, "frequency": 1.5, "waveform": "sine"},
+                  "y_high": {"kind": "thermal", "temperature": 1.0}},
+        "run": {"end_time": 1.0},
+        "output": dict(_OUTPUT),
+    },
     "rough-2d": {
         "system": {"dimension": 2, "particles": 64, "packing_fraction": 0.1, "seed": 6},
         "particles": {"inertia": 0.5},
@@ -490,7 +500,7 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
 
 #: what names a key or a file in a one-line error: a dotted key of a known section, a [section], a
 #: file name, or the key of a ``--set`` override as given (``override: sytem.particle = 0: ...``)
-KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|run|output|species)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]"
+KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|gravity|walls|run|output|species)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]"
                     r"|\.(toml|h5|png|gsd)\b|^error: override: [^ ]+ = ")
 
 

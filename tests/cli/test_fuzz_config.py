@@ -92,8 +92,8 @@ def check_run(mc: MutatedConfig):
         stderr = "\n".join(line for line in o.stderr.splitlines() if not line.startswith("compiling "))
         stopped_early = o.code == 130 and stderr.strip() == "interrupted: SIGINT"  # before the file existed
         if o.code == 0 or (o.code == 130 and not stopped_early):
-            # the new file (output.file may have any name, "0" as well as "out.h5"; directories end in "/")
-            outputs = [d / p for p in set(after) - set(before) if not p.endswith("/")]
+            # the run's one new file (its name is the config's, which need not end in .h5)
+            outputs = [d / p for p in set(after) - set(before)]
             assert len(outputs) == 1, (after, o.stdout)
             with h5py.File(outputs[0], "r") as f:  # a valid file: at least the first frame
                 assert f["particles/all/velocity/time"].shape[0] >= 1  # the DSMC writes no positions
@@ -110,6 +110,28 @@ ISSUE_CASES = {
     "packing 1e-300": (case("constant-3d", ("system.packing_fraction", 1e-300)), (2,)),
     "particles 1e11": (case("constant-3d", ("system.particles", 100000000000)), (2,)),
 }
+
+
+# a vibrated scene's bad input: one line naming the key, exit 2, nothing written
+SCENE_CASES = {
+    "walls meet": (case("vibrated-2d", ("walls.y_low.amplitude", 9.0), ("walls.y_high", {"kind": "vibrating",
+                                                                                       "amplitude": 9.0,
+                                                                                       "frequency": 1.0})),
+                   "walls.y_low.amplitude = 9"),
+    "no room": (case("vibrated-2d", ("walls.y_low.amplitude", 17.5)), "walls.y_low.amplitude = 17.5"),
+    "frequency 0": (case("vibrated-2d", ("walls.y_low.frequency", 0.0)), "walls.y_low.frequency = 0"),
+    "frequency < 0": (case("vibrated-2d", ("walls.y_low.frequency!", -2.0)), "walls.y_low.frequency = -2"),
+    "vibrating on a periodic axis": (case("vibrated-2d", ("system.boundary", ["wall", "periodic"])), "walls.y_low"),
+    "gravity axes": (case("vibrated-2d", ("gravity.acceleration", [0.0, -1.0, 0.0])), "gravity.acceleration"),
+    "dsmc": (case("vibrated-2d", ("run.method", "dsmc")), "[gravity]"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SCENE_CASES))
+def test_scene_bad_input_gives_one_line_and_writes_nothing(name):
+    mc, key = SCENE_CASES[name]
+    o, d, after = _run_command(mc, ["run", "c.toml", "--quiet"], output_made=False)
+    assert o.code == 2 and key in o.stderr and o.stderr.count("\n") == 1, o.stderr
 
 
 @pytest.mark.parametrize("name", sorted(ISSUE_CASES))

@@ -39,6 +39,65 @@ def kick_normals(seed, step, ident):
     return _drive.kick_normals(seed, step, ident)
 
 
+# ---- the flight and the wall kinds (granulargas.engine._flight, _walls)
+from granulargas.engine import _flight, _walls  # noqa: E402
+
+
+@jit
+def descend_root(h, u, a):
+    return _flight.descend_root(h, u, a)
+
+
+@jit
+def expiry_delay(dx, dy, dz, vx, vy, vz, radius, flight):
+    return _flight.expiry_delay(dx, dy, dz, vx, vy, vz, radius, flight)
+
+
+@jit
+def face_delay(rel, v, g, width, lower, upper):
+    return _flight.face_delay(rel, v, g, width, lower, upper)
+
+
+@jit
+def plane_delay(x, v, g, radius, low, high):
+    return _flight.plane_delay(x, v, g, radius, low, high)
+
+
+@jit
+def stream(i, t, rec, img, period, flight):
+    _flight.stream(i, t, rec, img, period, flight)
+
+
+@jit
+def pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period, flight):
+    return _flight.pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period, flight)
+
+
+@jit
+def contact_delay(x, v, g, radius, rest, side, t, horizon, spec, a):
+    return _walls.contact_delay(x, v, g, radius, rest, side, t, horizon, spec, a)
+
+
+@jit
+def wall_motion(spec, a, side, t):
+    return _walls.wall_motion(spec, a, side, t)
+
+
+@jit
+def thermal_velocity(seed, k, scale):
+    return _walls.thermal_velocity(seed, k, scale)
+
+
+@jit
+def wall_uniforms(seed, k):
+    return _walls.wall_uniforms(seed, k)
+
+
+@jit
+def moving_wall_collision(vn, wv, eps, mi, side):
+    return _walls.moving_wall_collision(vn, wv, eps, mi, side)
+
+
 @jit
 def rough_pair(vi, vj, wi, wj, n, mi, mj, ki, kj, ri, rj, eps, model, beta, mu):
     """One rough pair collision on 3-vectors (v, w, the unit normal n from j to i), in place,

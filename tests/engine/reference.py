@@ -6,6 +6,13 @@ and over every particle and every wall (flat walls at 0 and L on the axes
 listed in ``walls``) of the time to touch it. Used to check the engine's
 event sequence on small systems.
 
+Gravity and wall kinds (:func:`run_scene`): all particles fly on parabolas together (the
+pair times are those of the straight relative motion); a wall at rest is touched at the
+smallest root of the textbook quadratic at which the gap closes (``numpy.roots``), a
+vibrating wall at the first sign change of the gap sampled densely and refined by
+bisection (no bound, no safe steps: a method independent of the engine's); a thermal wall
+draws the outgoing velocity from a pure-Python SplitMix64 of the same counters.
+
 Rough particles (spins ``w``, moments of inertia ``I = kappa m R^2``): the collision is
 computed as a rigid-body impulse problem, independently of the engine's algebra
 (:func:`rough_impulse`): the change of the contact-point relative velocity is linear in the
@@ -331,3 +338,193 @@ def run_reference(pos, vel, radii, masses, box, ncoll, eps=1.0, walls=(), wall_e
     if rough is not None:
         return out, pos, vel, spin
     return out, pos, vel
+
+
+# ------------------------------------------------------------------ gravity and wall kinds
+_MASK = (1 << 64) - 1
+_GAMMA = 0x9E3779B97F4A7C15
+_SALT = 0x5851F42D4C957F2D
+
+
+def _mix64(z):
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
+    return z ^ (z >> 31)
+
+
+def wall_uniforms(seed, k):
+    """Four uniforms in (0, 1] of the k-th wall collision (pure-Python SplitMix64)."""
+    key = _mix64(int(seed) ^ _SALT)
+    return tuple(1.0 - (_mix64((key + (((k << 2) | r) * _GAMMA)) & _MASK) >> 11) * 2.0**-53 for r in range(4))
+
+
+def wave(waveform, tau, amp, nu, phase):
+    """Displacement of a vibrating wall at time tau (phase in radians)."""
+    th = 2.0 * np.pi * nu * np.asarray(tau, dtype=float) + phase
+    if waveform == "sine":
+        return amp * np.sin(th)
+    if waveform == "triangle":
+        return amp * (2.0 / np.pi) * np.arcsin(np.sin(th))
+    u = np.mod(th / (2.0 * np.pi), 1.0)
+    return amp * 16.0 * np.where(u < 0.5, u * (0.5 - u), -(u - 0.5) * (1.0 - u))
+
+
+def wall_velocity(waveform, tau, amp, nu, phase):
+    """W'(tau): the derivative of :func:`wave`, written out."""
+    om = 2.0 * np.pi * nu
+    th = om * np.asarray(tau, dtype=float) + phase
+    if waveform == "sine":
+        return amp * om * np.cos(th)
+    u = np.mod(th / (2.0 * np.pi), 1.0)
+    if waveform == "triangle":
+        return np.where((u >= 0.25) & (u < 0.75), -4.0 * amp * nu, 4.0 * amp * nu)
+    return amp * nu * np.where(u < 0.5, 8.0 - 32.0 * u, -(8.0 - 32.0 * (u - 0.5)))
+
+
+def wall_position(kinds, box, a, side, t):
+    """Position of wall (a, side) at time t: a vibrating wall rests A inside the box."""
+    w = kinds.get((a, side), {"kind": "hard"})
+    base = 0.0 if side == 0 else box[a]
+    if w["kind"] != "vibrating":
+        return base
+    amp = w["amplitude"]
+    rest = base + amp if side == 0 else base - amp
+    return rest + float(wave(w["waveform"], t, amp, w["frequency"], w.get("phase", 0.0)))
+
+
+def _static_contact(h, u, a):
+    """Smallest s >= 0 with h + u s + a s^2/2 = 0 where the gap closes (textbook roots)."""
+    if h <= 0.0:
+        if u < 0 or (u == 0 and a < 0):
+            return 0.0
+    roots = np.roots([0.5 * a, u, h]) if a != 0 else (np.array([-h / u]) if u != 0 else np.array([]))
+    best = np.inf
+    for r in np.atleast_1d(roots):
+        if abs(r.imag) > 1e-12 * max(1.0, abs(r.real)):
+            continue
+        r = r.real
+        if r >= -1e-14 and u + a * r <= 1e-12 and r < best:
+            best = max(r, 0.0)
+    return best
+
+
+def _vibrating_contact(x, v, g, radius, box, a, side, t, w, horizon, samples=4000):
+    """First sign change of the gap to a vibrating wall in (0, horizon], by dense sampling
+    (``samples`` per plate period, at least 2000 in all) and bisection; inf if none."""
+    amp, nu, wf, ph = w["amplitude"], w["frequency"], w["waveform"], w.get("phase", 0.0)
+
+    def gap(s):
+        z = x + v * s + 0.5 * g * s * s
+        if side == 0:
+            return z - radius - (amp + wave(wf, t + s, amp, nu, ph))
+        return (box[a] - amp + wave(wf, t + s, amp, nu, ph)) - radius - z
+
+    if not np.isfinite(horizon):
+        horizon = 50.0 / nu
+    n = int(max(2000, samples * horizon * nu)) + 1
+    s = np.linspace(0.0, horizon, n)
+    y = gap(s)
+    bad = np.flatnonzero(y <= 0.0)
+    if len(bad) == 0:
+        return np.inf
+    k = bad[0]
+    if k == 0:
+        u = v - wall_velocity(wf, t, amp, nu, ph)
+        return 0.0 if (u < 0 if side == 0 else u > 0) else np.inf
+    lo, hi = s[k - 1], s[k]
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        if gap(mid) > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return hi
+
+
+def next_wall_event(pos, vel, radii, box, walls, t, gravity, kinds, horizon):
+    """(delay, i, axis, side) of the next sphere-wall contact of any kind, from time t."""
+    best = (np.inf, -1, -1, -1)
+    for a in walls:
+        ga = 0.0 if gravity is None else gravity[a]
+        for i in range(len(pos)):
+            for side in (0, 1):
+                w = kinds.get((a, side), {"kind": "hard"})
+                lim = min(best[0], horizon)
+                if w["kind"] == "vibrating":
+                    s = _vibrating_contact(pos[i, a], vel[i, a], ga, radii[i], box, a, side, t, w, lim)
+                elif side == 0:
+                    s = _static_contact(pos[i, a] - radii[i], vel[i, a], ga)
+                else:
+                    s = _static_contact(box[a] - radii[i] - pos[i, a], -vel[i, a], -ga)
+                if s < best[0]:
+                    best = (float(s), i, a, side)
+    return best
+
+
+def run_scene(pos, vel, radii, masses, box, nevents, *, walls=(), gravity=None, kinds=None, eps=1.0,
+              wall_eps=None, elastic_below=0.0, seed=0, t0=0.0, wall_count=0, species=None):
+    """Event sequence under gravity with walls of any kind, global clock: [(time, i, j)] with
+    j >= 0 for a pair (i < j) and j = -1 - (2 axis + side) for a wall; returns (events, pos,
+    vel, wall_work). ``kinds``: {(axis, side): {"kind": "hard" | "thermal" | "vibrating",
+    "amplitude", "frequency", "waveform", "phase" (radians), "temperature"}}; ``seed`` and
+    ``wall_count`` (the wall collisions so far) key the thermal draws. ``species``: a mixture
+    (``eps`` a table (S, S), ``wall_eps`` one per species, as in :func:`run_reference`)."""
+    pos = np.array(pos, dtype=float)
+    vel = np.array(vel, dtype=float)
+    d = pos.shape[1]
+    g = None if gravity is None else np.asarray(gravity, dtype=float)
+    kinds = kinds or {}
+    if wall_eps is None:
+        wall_eps = eps if species is None else np.diagonal(np.asarray(eps))
+    t = t0
+    out = []
+    work = 0.0
+    for _ in range(nevents):
+        tp, i, j = next_collision(pos, vel, radii, box, walls)
+        tw, k, a, side = next_wall_event(pos, vel, radii, box, walls, t, g, kinds, tp)
+        dt = min(tp, tw)
+        pos += vel * dt + (0.0 if g is None else 0.5 * g * dt * dt)
+        if g is not None:
+            vel += g * dt
+        for b in range(d):
+            if b not in walls:
+                pos[:, b] %= box[b]
+        t += dt
+        if tp <= tw:
+            dr = pos[i] - pos[j]
+            for b in range(d):
+                if b not in walls:
+                    dr[b] -= box[b] * np.round(dr[b] / box[b])
+            un = float(np.dot(vel[i] - vel[j], dr / np.linalg.norm(dr)))
+            e = 1.0 if -un < elastic_below else pair_restitution(eps, species, i, j, un, radii, masses)
+            collide(pos, vel, radii, masses, box, i, j, e, walls)
+            out.append((t, min(i, j), max(i, j)))
+            continue
+        w = kinds.get((a, side), {"kind": "hard"})
+        vn = vel[k, a]
+        e0 = 0.5 * masses[k] * float(vel[k] @ vel[k])
+        if w["kind"] == "thermal":
+            u1, u2, u3, u4 = wall_uniforms(seed, wall_count)
+            scale = np.sqrt(w["temperature"] / masses[k])
+            out_n = scale * np.sqrt(-2.0 * np.log(u1))
+            r = np.sqrt(-2.0 * np.log(u3))
+            tang = [scale * r * np.cos(2 * np.pi * u4), scale * r * np.sin(2 * np.pi * u4)]
+            vel[k, a] = out_n if side == 0 else -out_n
+            m = 0
+            for b in range(d):
+                if b != a:
+                    vel[k, b] = tang[m]
+                    m += 1
+            work += 0.5 * masses[k] * float(vel[k] @ vel[k]) - e0
+        else:
+            wv = 0.0
+            if w["kind"] == "vibrating":
+                wv = float(wall_velocity(w["waveform"], t, w["amplitude"], w["frequency"], w.get("phase", 0.0)))
+            u = vn - wv
+            e = 1.0 if abs(u) < elastic_below else wall_restitution(wall_eps, species, k, u, radii, masses)
+            vel[k, a] = wv - e * u
+            if w["kind"] == "vibrating":
+                work += 0.5 * masses[k] * float(vel[k] @ vel[k]) - e0 + 0.5 * (1 - e * e) * masses[k] * u * u
+        wall_count += 1
+        out.append((t, k, -1 - (2 * a + side)))
+    return out, pos, vel, work

@@ -228,3 +228,24 @@ def test_pressure_of_a_contact_equals_the_force_integral(tables):
     t0 = 0.5 / g  # gap 0.5 closed at speed g
     expected = m_eff * (g * g * t0 + kin_contact + virial + v_out * v_out * (t_end - t0 - tc))
     assert p == pytest.approx(expected, rel=1e-7)
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_gravity_in_a_periodic_box_leaves_the_contacts_unchanged(tables, dimension):
+    """Uniform gravity moves a pair's centre of mass only: the jump onto the outgoing line
+    (relative position and velocity) is the same, so a run with gravity has the collisions of
+    the run without it, positions shifted by g t^2 / 2 and velocities by g t."""
+    st = random_state(40, 0.2, dimension, seed=3)
+    g = np.array([0.3, -0.7, 0.5])[:dimension]
+    plain = Simulation(st, resolved(tables, 0.02), remove_drift=False)
+    fall = Simulation(st, resolved(tables, 0.02), remove_drift=False, gravity=g)
+    for k in range(80):
+        plain.run(np.inf, max_collisions=1)
+        fall.run(np.inf, max_collisions=1)
+        t = fall.time
+        assert t == pytest.approx(plain.time, rel=1e-10, abs=1e-12), k
+        np.testing.assert_allclose(fall.velocities, plain.velocities + g * t, rtol=0, atol=1e-8)
+        np.testing.assert_allclose(fall.unwrapped_positions, plain.unwrapped_positions + 0.5 * g * t * t,
+                                   rtol=0, atol=1e-8)
+    assert plain.three_body_contacts == fall.three_body_contacts
+    assert fall.dissipated_energy == pytest.approx(plain.dissipated_energy, rel=1e-10)

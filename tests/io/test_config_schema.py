@@ -112,8 +112,75 @@ def test_every_key_round_trips_through_to_toml():
     again = parse_config(cfg.to_toml(), "c.toml")
     assert dataclasses.astuple(again)[:6] == dataclasses.astuple(cfg)[:6]
     written = cfg.to_toml()
-    for key in (k for k in SCHEMA if not k.per_species):  # [[species]]: tests/io/test_config_species.py
+    for key in SCHEMA:
+        if key.template:  # walls.<side>: test_gravity_and_walls_round_trip
+            continue
+        if key.per_species:  # [[species]]: tests/io/test_config_species.py
+            continue
         value = None if key.section in c.SUBTABLES else getattr(getattr(cfg, key.section), key.attribute, None)
         if value is not None and "." not in key.key and key.dotted not in c.SUBTABLES:
             assert f"{key.key} = " in written, key.dotted
     assert math.isclose(cfg.particles.diameter, 1.0)
+
+
+GRAVITY_BASE = """[system]\ndimension = 3\nparticles = 100\npacking_fraction = 0.05\nboundary = ["periodic", "wall", "wall"]
+[collision]\nmodel = "constant"\nrestitution = 0.9\nelastic_below = 0.001
+[gravity]\nacceleration = [0.0, 0.0, -1.0]
+[walls]
+z_low = { kind = "vibrating", amplitude = 0.2, frequency = 1.5, waveform = "biparabolic", phase = 0.5 }
+z_high = { kind = "hard" }
+y_low = { kind = "thermal", temperature = 2.0 }
+[run]\nend_time = 1.0\n"""
+
+
+def test_gravity_and_walls_round_trip():
+    cfg = parse_config(GRAVITY_BASE, "c.toml")
+    assert cfg.gravity.vector == (0.0, 0.0, -1.0)
+    assert cfg.walls.side(2, 0) == c.WallConfig("vibrating", 0.2, 1.5, "biparabolic", 0.5, None)
+    assert cfg.walls.side(1, 0) == c.WallConfig("thermal", temperature=2.0, waveform=None, phase=None)
+    assert cfg.walls.side(0, 1) == c.WallConfig()  # not given: hard
+    assert cfg.walls.moving and cfg.collision.elastic_below == 0.001
+    again = parse_config(cfg.to_toml(), "c.toml")
+    assert (again.gravity, again.walls, again.collision) == (cfg.gravity, cfg.walls, cfg.collision)
+    # without the optional sections: None
+    plain = parse_config(BASE, "c.toml")
+    assert plain.gravity is None and plain.walls is None
+
+
+@pytest.mark.parametrize("edit, fragment", [
+    (("[0.0, 0.0, -1.0]", "[0.0, -1.0]"), "gravity.acceleration = [0, -1]: 2 entries for a 3D system"),
+    (("[0.0, 0.0, -1.0]", "[0.0, 0.0, nan]"), "gravity.acceleration = [0, 0, nan]: must be a list of 3 numbers"),
+    (("[0.0, 0.0, -1.0]", "-1.0"), "gravity.acceleration = -1: must be a list of 3 numbers"),
+    (("acceleration = [0.0, 0.0, -1.0]", ""), "gravity.acceleration: missing"),
+    (('"wall", "wall"]', '"wall", "periodic"]'), 'walls.z_low = {...}: the z axis is "periodic"'),
+    (("amplitude = 0.2", "amplitude = 0.0"), "walls.z_low.amplitude = 0: must be a number in (0, 1e50]"),
+    (("frequency = 1.5", "frequency = -1.5"), "walls.z_low.frequency = -1.5: must be a number in (0, 1e50]"),
+    (("frequency = 1.5, ", ""), 'walls.z_low.frequency: missing; kind = "vibrating" needs amplitude and frequency'),
+    (('"biparabolic"', '"square"'), 'walls.z_low.waveform = "square": must be one of "sine", "triangle"'),
+    (("temperature = 2.0", "temperature = 0.0"), "walls.y_low.temperature = 0: must be a number in [1e-100"),
+    (('{ kind = "thermal", temperature = 2.0 }', '{ kind = "thermal" }'), "walls.y_low.temperature: missing"),
+    (('{ kind = "hard" }', '{ kind = "hard", amplitude = 1.0 }'),
+     'walls.z_high.amplitude = 1: is only used with kind = "vibrating" (kind = "hard")'),
+    (('{ kind = "hard" }', '{ kind = "hard", ampltude = 1.0 }'), "walls.z_high.ampltude = 1: unknown key; did you mean"),
+    (('z_high = { kind = "hard" }', 'z_high = "hard"'), 'walls.z_high = "hard": must be a table'),
+    (('z_high = { kind = "hard" }', 'x_high = { kind = "hard" }'), 'walls.x_high = {...}: the x axis is "periodic"'),
+    (('z_high = { kind = "hard" }', 'w_high = { kind = "hard" }'), 'walls.w_high = { kind = "hard" }: unknown key; did you mean `z_high`?'),
+    (("[run]\n", '[run]\nmethod = "dsmc"\n'), '[gravity]: needs positions: method = "dsmc"'),
+    (('model = "constant"\nrestitution = 0.9', 'model = "elastic"'),
+     'collision.elastic_below = 0.001: is only used with model = "constant" or "viscoelastic"'),
+])
+def test_gravity_and_walls_refuse_with_one_line(edit, fragment):
+    text = GRAVITY_BASE.replace(*edit)
+    assert text != GRAVITY_BASE
+    with pytest.raises(ConfigError) as err:
+        parse_config(text, "c.toml")
+    msg = str(err.value)
+    assert fragment in msg and "\n" not in msg and msg.startswith("c.toml: "), msg
+
+
+def test_dsmc_refuses_walls_and_elastic_below():
+    base = '[collision]\nmodel = "constant"\nrestitution = 0.9\n[run]\nend_time = 1.0\nmethod = "dsmc"\n'
+    with pytest.raises(ConfigError, match=r"\[walls\]: needs positions"):
+        parse_config("[walls]\n" + base, "c.toml")
+    with pytest.raises(ConfigError, match="collision.elastic_below = 0.1: guards against"):
+        parse_config(base.replace("restitution = 0.9", "restitution = 0.9\nelastic_below = 0.1"), "c.toml")

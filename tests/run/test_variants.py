@@ -31,6 +31,9 @@ EXAMPLES = {
     "elastic_3d.toml": ["placement", "lists"],
     "hcs_dsmc_3d.toml": ["dsmc"],
     "clustering_2d_constant.toml": ["placement", "placement-large", "lists"],
+    "vibrated_bed_2d.toml": ["placement", "lists-gravity-walls"],
+    "vibrated_bed_3d.toml": ["placement", "cells-gravity-walls"],
+    "shaken_cell_3d.toml": ["placement", "cells-walls"],
     "rough_hcs_3d.toml": ["placement", "cells-rough"],
     "rough_driven_2d.toml": ["placement", "lists-rough", "lists-rough-driven"],
     "rough_mpemba_hot.toml": ["placement", "cells-rough", "cells-rough-driven"],
@@ -49,10 +52,9 @@ def test_example_configs_name_the_variants_they_compile(name, expected):
 def test_every_example_config_compiles_a_named_variant():
     for path in (ROOT / "configs").glob("*.toml"):
         names = [v.name for v in variants_for(load_config(path))]
-        assert any(n in ("lists", "cells", "resolved", "dsmc", "lists-rough", "cells-rough", "dsmc-rough",
-                         "lists-mixture", "cells-mixture", "dsmc-mixture")
-
-                   for n in names), (path.name, names)
+        assert any(n in ("lists", "cells", "resolved", "dsmc", "lists-walls", "cells-walls", "lists-gravity",
+                         "cells-gravity", "lists-gravity-walls", "cells-gravity-walls", "lists-rough", "cells-rough",
+                         "dsmc-rough", "lists-mixture", "cells-mixture", "dsmc-mixture") for n in names), (path.name, names)
 
 
 def test_each_variant_tiny_run_selects_it(tmp_path):
