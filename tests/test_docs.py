@@ -191,6 +191,9 @@ def _keys_of(toml_text: str):
             dotted = f"{prefix}.{k}" if prefix else k
             if dotted == "species" and isinstance(v, list):  # [[species]]: each table's keys
                 keys.update(f"species.{kk}" for table in v for kk in table)
+            elif prefix == "walls" and isinstance(v, dict):  # walls.z_low = { kind = ... }: one entry per side
+                keys.add(dotted)
+                keys.update(f"walls.<side>.{kk}" for kk in v)
             elif isinstance(v, dict) and dotted in named:
                 keys.add(dotted)
             elif isinstance(v, dict) and dotted not in ("particles.diameter",):

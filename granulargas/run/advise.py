@@ -565,6 +565,8 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         raise ConfigError(table)
     scene = Scene.from_config(config)
     rv = V.check_run(config)  # the run summary's prediction: one predicted end for both
+    if rv.errors and not math.isfinite(rv.t_end) and V.rough_gas_from_config(config) is not None:
+        raise ConfigError(rv.errors[0])  # the two-temperature theory cannot be solved for this gas
     T0 = gas.temperature
     t_end = rv.t_end
     adv = Advice(gas.model, tolerance, t_end, rv.T_end / T0, scene=scene, T0=T0, box=V.box_length(config),

@@ -90,7 +90,7 @@ import numpy as np
 from granulargas import theory
 from granulargas.contact import restitution_table
 from granulargas.contact.material import damping_from_prefactor, effective_modulus, rho_from_material
-from granulargas.errors import ConfigError
+from granulargas.errors import ConfigError, TableRangeError
 from granulargas.io.config import TABLE_BETA_MAX, RunConfig
 from granulargas.io.scene import Scene
 from granulargas.theory import rough as rough_theory
@@ -352,6 +352,12 @@ class RunValidity:
         return out
 
 
+def _damping_key(gas: RunGas) -> str:
+    """The config key that sets a viscoelastic gas's damping, with its value."""
+    return ("collision.material" if gas.material is not None
+            else f"collision.damping = {damping_from_prefactor(gas.prefactor):.6g}")
+
+
 def table_range_error(gas: RunGas) -> str | None:
     """One line when the fastest impacts the kinetic theory integrates over at T0 (its largest
     speed node, :func:`granulargas.theory.moments.speed_quadrature`) reach beta beyond the
@@ -362,9 +368,7 @@ def table_range_error(gas: RunGas) -> str | None:
     beta = float(gas.beta(math.sqrt(2.0 * gas.temperature / gas.mass) * u_max))
     if beta <= TABLE_BETA_MAX / 1.01:
         return None
-    key = ("collision.material" if gas.material is not None
-           else f"collision.damping = {damping_from_prefactor(gas.prefactor):.6g}")
-    return (f"{gas.source}: {key}: fast thermal impacts ({u_max:.3g} thermal speeds) reach beta = {beta:.3g}, "
+    return (f"{gas.source}: {_damping_key(gas)}: fast thermal impacts ({u_max:.3g} thermal speeds) reach beta = {beta:.3g}, "
             f"beyond the restitution table's {TABLE_BETA_MAX:g} (the viscoelastic model holds for beta well "
             "below 3)")
 
@@ -519,7 +523,14 @@ def check_run(config) -> RunValidity:
     t_end, ln_T_end = predicted_end(gas, curve)
     rough = rough_gas_from_config(config)
     if rough is not None:  # two temperatures: the rough theory's T_tr
-        t_end, ln_T_end = rough_end(rough, gas.end_time, gas.collisions_per_particle)
+        try:
+            t_end, ln_T_end = rough_end(rough, gas.end_time, gas.collisions_per_particle)
+        except TableRangeError:  # the rotational energy fed back makes impacts faster than at T0
+            rv = RunValidity(gas, math.nan, gas.temperature, math.nan, scene=scene)
+            rv.errors.append(f"{src}: {_damping_key(gas)}: the fastest impacts of the two-temperature theory "
+                             f"reach beyond the restitution table's beta = {TABLE_BETA_MAX:g} (the "
+                             "viscoelastic model holds for beta well below 3)")
+            return rv
     elif not isinstance(config, RunGas) and config.species and gas.model != "elastic":
         t_end, ln_T_end = _mixture_end(config, gas)
     T_end = math.exp(ln_T_end)

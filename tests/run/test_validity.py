@@ -180,3 +180,20 @@ def test_a_dsmc_run_gets_no_space_or_drift_warning():
         rv = V.check_run(cold)
         assert rv.T_end < 1e-35 and not rv.errors
         assert not any("centre-of-mass" in w for w in rv.warnings)
+
+
+def test_rough_theory_beyond_the_restitution_table_is_one_config_error():
+    """At T0 the smooth theory's fastest impacts stay inside the table, but the two-temperature
+    theory of rough grains (energy fed back from the spins) reaches beyond it: refused with the
+    damping named, by the run's checks and by advise alike (not a run-time error)."""
+    from granulargas.run.advise import advise
+
+    cfg = config('model = "viscoelastic"\ndamping = 20.0\n[collision.tangential]\nmodel = "coulomb"\n'
+                 'restitution = 0.4\nfriction = 0.3', run="end_time = 0.5",
+                 system="dimension = 3\nparticles = 64\npacking_fraction = 0.1")
+    gas = V.gas_from_config(cfg)
+    assert V.table_range_error(gas) is None
+    with pytest.raises(ConfigError, match=r"collision.damping = 20.*two-temperature theory"):
+        V.raise_if_invalid(cfg)
+    with pytest.raises(ConfigError, match=r"collision.damping = 20.*two-temperature theory"):
+        advise(cfg)
