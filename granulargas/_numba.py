@@ -9,7 +9,7 @@ for compiled code that allocates no arrays. Numba counts references to every
 array argument of a compiled function (an atomic increment at entry and a
 decrement at exit, through a call it cannot inline); the event loop passes a
 few dozen arrays to each of its per-event calls, and these counts cost ~20 % of
-its time (``scripts/profile_loop.py``). A kernel may not create arrays
+its time (``scripts/profiling/profile_loop.py``). A kernel may not create arrays
 (``np.empty`` etc. fail to compile in it); it may read and write the arrays it
 is given and call other kernels or jit functions.
 

@@ -11,7 +11,7 @@ is meant for the ``force`` end (delayed recovery): its expansion
 (our high-order series gives c_5 = 4/15, an independent check), and it goes to
 0 as beta -> infinity. Beyond that it is accurate to the per-cent level
 (max |error| ~ 0.009 near beta ~ 3; 1.2 % relative at beta = 1; see the tests and
-``scripts/epsilon_speed_accuracy.py``).
+``scripts/contact/epsilon_speed_accuracy.py``).
 """
 
 from __future__ import annotations

@@ -619,7 +619,61 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     radii = np.asarray(radii, dtype=float)
     masses = np.asarray(masses, dtype=float)
     box = np.asarray(box, dtype=float)
-    n, d = positions.shape
+    d = positions.shape[1]
+    type_masses, typeid = _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact, end_time,
+                                        species, prefactor)
+    ntypes = len(type_masses)
+    k_pairs = np.broadcast_to(np.asarray(prefactor, dtype=float), (ntypes, ntypes))
+    young, y_pairs, t_contact, tau_free, contact_fraction, g_thermal = _stiffness(
+        velocities, radii, masses, box, contact_fraction, young_modulus, poisson_ratio, typeid, ntypes)
+    pair_contact = {(i, j): DemContact.from_prefactor(float(k_pairs[i, j]), float(y_pairs[i, j]), poisson_ratio, end)
+                    for i in range(ntypes) for j in range(ntypes)}
+    contact = pair_contact[(0, 0)] if species is not None else DemContact.from_prefactor(
+        float(k_pairs[0, 0]), young, poisson_ratio, end)
+    steps, dt, thermo_every = _time_steps(end_time, steps_per_contact, t_contact, thermo_interval, source)
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    data_file = directory / f"data.{name}"
+    input_file = directory / f"in.{name}"
+    eta = {}
+    for i in range(ntypes):
+        for j in range(i, ntypes):
+            mi, mj = type_masses[i], type_masses[j]
+            eta[(i + 1, j + 1)] = float(pair_contact[(i, j)].eta_n0(mi * mj / (mi + mj)))
+
+    _write_data_file(data_file, positions, velocities, radii, masses, typeid + 1, ntypes, box, source)
+    header = [
+        f"# LAMMPS input written by granulargas export lammps{' from ' + source if source else ''}",
+        "# Same contact law as granulargas (Schwager & Pöschel (1997), eq. (2)): hertz/material + damping viscoelastic,",
+        "# E = Y, nu = nu, eta_n0 = A Y / ((1 - nu^2) m_eff) per pair of atom types;",
+        f"# end of contact '{end}'" + (" -> limit_damping" if end == "force" else " (no limit_damping)") + ".",
+        (f"# Dissipation time A = {contact.dissipation_time:.6g}, pair prefactor k = {float(k_pairs[0, 0]):.6g}."
+         if species is None else f"# A mixture of {ntypes} species = atom types 1..{ntypes}: prefactor k, stiffness "
+                                 "and A per pair of types (pair_coeff lines)."),
+        f"# Stiffness: elastic Hertz contact time {t_contact:.6g} at the thermal impact speed "
+        f"{g_thermal:.6g} = {contact_fraction:g} x Enskog mean free time {tau_free:.6g}.",
+        f"# Timestep {dt:.6g} <= contact time / {steps_per_contact}; {steps} steps to t = {end_time:.6g}.",
+        "# Thermo: c_granT = m<c^2>/d (peculiar velocity c, d N degrees of freedom).",
+        f"# LAMMPS time 0 is granulargas time {time_origin:.17g}.",
+    ]
+    lines = header + _input_commands(pair_contact, data_file.name, type_masses, eta, radii, box, boundary, dt, steps,
+                                     thermo_every, pressure, contact_pairs, name)
+    input_file.write_text("\n".join(lines))
+    export = LammpsExport(input_file, data_file, contact, dt, steps, thermo_every, t_contact, tau_free,
+                          contact_fraction, steps_per_contact, g_thermal, eta, tuple(float(m) for m in type_masses))
+    summary = {**export.summary(), "time_origin": float(time_origin)}
+    if species is not None:
+        summary["pairs"] = {f"{i + 1} {j + 1}": {"prefactor": float(k_pairs[i, j]), "young_modulus": c.young_modulus,
+                                                 "dissipation_time": c.dissipation_time}
+                            for (i, j), c in pair_contact.items() if i <= j}
+    (directory / "granulargas_lammps.json").write_text(json.dumps(summary, indent=2) + "\n")
+    return export
+
+
+def _check_export(d, masses, contact_fraction, young_modulus, steps_per_contact, end_time, species, prefactor):
+    """The export's arguments checked (one :class:`UserError` each); (masses of the atom types,
+    each particle's type index): a mixture's types are its species, otherwise the distinct masses."""
     if d not in (2, 3):
         raise ValueError(f"dimension must be 2 or 3, not {d}")
     if young_modulus is None and not 0.0 < contact_fraction < 1.0:  # also rejects nan
@@ -641,8 +695,17 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
             f"{len(type_masses)} distinct particle masses: LAMMPS export supports at most {MAX_MASS_TYPES} "
             "(eta_n0 is set per pair of atom types); use a common mass"
         )
+    return type_masses, typeid
 
-    # reference pair and thermal state
+
+def _stiffness(velocities, radii, masses, box, contact_fraction, young_modulus, poisson_ratio, typeid, ntypes):
+    """The stiffness from the reference pair (mean diameter and mass) at the initial temperature:
+    (Y of the reference pair, Y per pair of types, elastic Hertz contact time at the thermal
+    impact speed, Enskog mean free time, their ratio, the thermal impact speed). Y is
+    ``young_modulus`` when given (a number, or a table per pair of types whose mean pair sets
+    the contact time), else the one whose contact time is ``contact_fraction`` of the mean
+    free time."""
+    n, d = velocities.shape
     sigma = float(np.mean(2.0 * radii))
     mass = float(np.mean(masses))
     volume = float(np.prod(box))
@@ -654,8 +717,6 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     tau_free = enskog_mean_free_time(d, packing, sigma, mass, temperature)
     r_eff, m_eff = sigma / 4.0, mass / 2.0
     g_thermal = math.sqrt(2.0 * temperature / m_eff)
-    ntypes = len(type_masses)
-    k_pairs = np.broadcast_to(np.asarray(prefactor, dtype=float), (ntypes, ntypes))
     if young_modulus is None:
         t_contact = contact_fraction * tau_free
         young = stiffness_for_contact_time(t_contact, g_thermal, r_eff, m_eff, poisson_ratio)
@@ -669,11 +730,12 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         young = float(x @ y_pairs @ x)
         t_contact = DemContact(young, poisson_ratio, 0.0).hertz_contact_time(g_thermal, r_eff, m_eff)
         contact_fraction = t_contact / tau_free
-    pair_contact = {(i, j): DemContact.from_prefactor(float(k_pairs[i, j]), float(y_pairs[i, j]), poisson_ratio, end)
-                    for i in range(ntypes) for j in range(ntypes)}
-    contact = pair_contact[(0, 0)] if species is not None else DemContact.from_prefactor(
-        float(k_pairs[0, 0]), young, poisson_ratio, end)
-    # timestep <= t_contact / steps_per_contact, and a whole number of steps to end_time
+    return young, y_pairs, t_contact, tau_free, contact_fraction, g_thermal
+
+
+def _time_steps(end_time, steps_per_contact, t_contact, thermo_interval, source):
+    """(steps, timestep, steps between thermo lines): timestep <= t_contact / steps_per_contact and a
+    whole number of steps to ``end_time``."""
     steps = end_time * steps_per_contact / t_contact
     if not (1.0 - 1e-9 <= steps <= 2**53):  # at least one whole time step, an exact step count
         raise UserError(f"{source + ': ' if source else ''}run.end_time (or --end-time) = {end_time:g}: "
@@ -682,41 +744,26 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
     steps = int(math.ceil(steps - 1e-9))
     dt = end_time / steps
     thermo_interval = end_time / 200.0 if thermo_interval is None else thermo_interval
-    thermo_every = max(1, int(round(thermo_interval / dt)))
+    return steps, dt, max(1, int(round(thermo_interval / dt)))
 
-    directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
-    data_file = directory / f"data.{name}"
-    input_file = directory / f"in.{name}"
-    eta = {}
-    for i in range(ntypes):
-        for j in range(i, ntypes):
-            mi, mj = type_masses[i], type_masses[j]
-            eta[(i + 1, j + 1)] = float(pair_contact[(i, j)].eta_n0(mi * mj / (mi + mj)))
 
-    _write_data_file(data_file, positions, velocities, radii, masses, typeid + 1, ntypes, box, source)
+def _input_commands(pair_contact, data_name, type_masses, eta, radii, box, boundary, dt, steps, thermo_every,
+                    pressure, contact_pairs, name):
+    """The LAMMPS commands of the input script (after its comment header): the box and its
+    boundaries, the atoms' masses, the contact law per pair of types and at the walls (each
+    type's wall of its own material), the integration, the thermo output (with the pressure
+    and the contact dump when asked for) and the run."""
+    d = len(box)
     boundary = ("periodic",) * d if boundary is None else tuple(boundary)
     walls = [a for a in range(d) if boundary[a] == "wall"]
     lammps_boundary = " ".join("f" if a in walls else "p" for a in range(d)) + (" p" if d == 2 else "")
     lines = [
-        f"# LAMMPS input written by granulargas export lammps{' from ' + source if source else ''}",
-        "# Same contact law as granulargas (Schwager & Pöschel (1997), eq. (2)): hertz/material + damping viscoelastic,",
-        "# E = Y, nu = nu, eta_n0 = A Y / ((1 - nu^2) m_eff) per pair of atom types;",
-        f"# end of contact '{end}'" + (" -> limit_damping" if end == "force" else " (no limit_damping)") + ".",
-        (f"# Dissipation time A = {contact.dissipation_time:.6g}, pair prefactor k = {float(k_pairs[0, 0]):.6g}."
-         if species is None else f"# A mixture of {ntypes} species = atom types 1..{ntypes}: prefactor k, stiffness "
-                                 "and A per pair of types (pair_coeff lines)."),
-        f"# Stiffness: elastic Hertz contact time {t_contact:.6g} at the thermal impact speed "
-        f"{g_thermal:.6g} = {contact_fraction:g} x Enskog mean free time {tau_free:.6g}.",
-        f"# Timestep {dt:.6g} <= contact time / {steps_per_contact}; {steps} steps to t = {end_time:.6g}.",
-        "# Thermo: c_granT = m<c^2>/d (peculiar velocity c, d N degrees of freedom).",
-        f"# LAMMPS time 0 is granulargas time {time_origin:.17g}.",
         "units lj",
         f"dimension {d}",
         f"boundary {lammps_boundary}",
         "atom_style sphere",
         "comm_modify vel yes",
-        f"read_data {data_file.name}",
+        f"read_data {data_name}",
     ]
     for k, m in enumerate(type_masses):
         lines.append(f"set type {k + 1} mass {m:.17g}")
@@ -760,16 +807,7 @@ def write_lammps_gas(directory, positions, velocities, radii, masses, box, prefa
         f"run {steps}",
         "",
     ]
-    input_file.write_text("\n".join(lines))
-    export = LammpsExport(input_file, data_file, contact, dt, steps, thermo_every, t_contact, tau_free,
-                          contact_fraction, steps_per_contact, g_thermal, eta, tuple(float(m) for m in type_masses))
-    summary = {**export.summary(), "time_origin": float(time_origin)}
-    if species is not None:
-        summary["pairs"] = {f"{i + 1} {j + 1}": {"prefactor": float(k_pairs[i, j]), "young_modulus": c.young_modulus,
-                                                 "dissipation_time": c.dissipation_time}
-                            for (i, j), c in pair_contact.items() if i <= j}
-    (directory / "granulargas_lammps.json").write_text(json.dumps(summary, indent=2) + "\n")
-    return export
+    return lines
 
 
 def _write_data_file(path, positions, velocities, radii, masses, types, ntypes, box, source):

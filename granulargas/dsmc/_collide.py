@@ -33,7 +33,7 @@ with the energy loss (1 - eps^2) m_eff g_n^2 / 2. It is written here on p rather
 calling :func:`granulargas.engine._collide.pair_collision`, which takes the unit normal and
 u_n: building them costs a square root and a division per collision, which lowered the
 DSMC's collision rate by about 10 % (N = 10^5, 3D, constant eps, CPU time,
-``scripts/bench_dsmc.py``: 7.3 against 8.1 M collisions/s); the restitution itself is the
+``scripts/benchmarks/dsmc.py``: 7.3 against 8.1 M collisions/s); the restitution itself is the
 engine's (:func:`granulargas.engine._collide.restitution`).
 """
 

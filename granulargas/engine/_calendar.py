@@ -31,7 +31,7 @@ of dependent misses: its ids are read in sequence and their ``qt``/``where``
 rows are prefetched together. While the current window's events are
 processed, :func:`cal_look_ahead` walks the next bucket's chunks, one per
 event, and prefetches its ids' rows, so that the opening finds them in cache
-(at N = 10^6, ``scripts/profile_loop.py``: the peek at the next event from 515
+(at N = 10^6, ``scripts/profiling/profile_loop.py``: the peek at the next event from 515
 to 395 cycles per event, the whole loop from 9835 to 8648 cycles per collision).
 
 The small heap holds max(1024, N/16) nodes, at least ~20 windows' worth; if a
@@ -488,7 +488,7 @@ def cal_after_next(cal, skip):
     often its copy of the same collision, equal in time up to round-off); when
     ``skip``'s node is a child of the root, its children are candidates too.
     Only a hint for the prefetch: right for 97-98 % of events
-    (``scripts/profile_loop.py``).
+    (``scripts/profiling/profile_loop.py``).
     """
     small = cal.small
     size = cal.state[0].size

@@ -19,7 +19,7 @@ after a kick it is higher by H dt_k / 2, so output at multiples of dt_k samples
 the steady state without bias.
 The kick interval must be short compared with the time over which the gas
 cools, zeta dt_k << 1 (zeta the cooling rate); the steady state is then
-independent of dt_k (see ``scripts/driven_steady_state.py`` for the measured
+independent of dt_k (see ``scripts/validation/driven_steady_state.py`` for the measured
 dependence).
 
 Random numbers: g for particle id ``ident`` at step k, component a, is a

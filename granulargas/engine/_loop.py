@@ -55,13 +55,13 @@ independent passes (:mod:`granulargas.engine._cells`); and after each event
 per-particle row of the next event's particle and its partner, the records of
 its neighbours, and the rows of the likely event after it
 (:func:`granulargas.engine._calendar.cal_after_next`: right for 97-98 % of
-events, ``scripts/profile_loop.py``), so that these misses overlap with the
+events, ``scripts/profiling/profile_loop.py``), so that these misses overlap with the
 current work; before a list expiry it also prefetches the cell rows around the
 particle and its neighbours' list rows. Where the time goes per part of the
-loop: ``python scripts/profile_loop.py 1e4 1e6`` (cycle counters compiled into
+loop: ``python scripts/profiling/profile_loop.py 1e4 1e6`` (cycle counters compiled into
 a second build of this loop, :mod:`granulargas.engine._probe`); per source line of
-the production build: ``python scripts/perf_loop.py 1e4`` (``perf`` samples); two source
-trees compared by alternated runs: ``python scripts/bench_ab.py OTHER_TREE .
+the production build: ``python scripts/profiling/perf_loop.py 1e4`` (``perf`` samples); two source
+trees compared by alternated runs: ``python scripts/ab/alternated.py OTHER_TREE .
 --sizes 1e4 1e6``; the numbers are in docs/performance.md.
 
 Status codes (the Python driver raises ``granulargas.errors`` exceptions):
@@ -925,7 +925,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         Stop right after the pair collision that makes ``collisions`` reach it.
     probe : None or int64 array
         None: the production build. An array of :data:`_probe.PROBE_SIZE`
-        compiles the cycle counters in (``scripts/profile_loop.py``).
+        compiles the cycle counters in (``scripts/profiling/profile_loop.py``).
     shear : None or ShearGeometry
         Lees-Edwards boundaries (``prm.space.shear``; :mod:`granulargas.engine._shear`),
         an argument of its own so that numba removes its branches when it is None.

@@ -1,7 +1,7 @@
 """Cycle counters compiled into the event loop on request (numba leaf module).
 
 The loop takes an argument ``probe``: ``None`` in production, or an int64 array
-(:data:`PROBE_SIZE`) in the profiler (``scripts/profile_loop.py``). The
+(:data:`PROBE_SIZE`) in the profiler (``scripts/profiling/profile_loop.py``). The
 functions here are numba overloads whose code depends on that argument's
 *type*: for ``None`` they compile to nothing, so the production build of the
 loop is the loop without counters; for an array they read the CPU cycle counter

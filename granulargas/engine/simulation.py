@@ -63,7 +63,7 @@ SHEAR_FRESH_SIZE = 34
 #: faster of the two for the packing fraction (:func:`neighbour_mode`)
 NEIGHBOURS = ("lists", "cells", "auto")
 #: "auto" uses cell crossings below this packing fraction (measured faster than the lists at
-#: N = 10^4 and 10^5 with ``scripts/bench_cells.py``; in 2D they are not faster at 10^5)
+#: N = 10^4 and 10^5 with ``scripts/benchmarks/neighbours.py``; in 2D they are not faster at 10^5)
 CELLS_BELOW = {3: 0.2, 2: 0.0}
 #: cell-crossing mode: at most this many cells per particle (wider cells in very dilute gases)
 CELLS_PER_PARTICLE = 8
@@ -98,7 +98,7 @@ def default_shell(packing: float, dimension: int = 3) -> float:
 
     A thin shell means short lists but frequent expiries (a particle leaves its
     shell every shell/2 of travel), a wide one long lists that every prediction
-    scans. The fastest shells measured (``scripts/bench_shell.py``, 3D packing 0.05
+    scans. The fastest shells measured (``scripts/benchmarks/neighbours.py``, 3D packing 0.05
     to 0.45, 2D 0.05 to 0.55) keep about 12 list centres within the cut-off
     1 + shell of a particle, whatever the packing:
 
@@ -123,7 +123,7 @@ def default_shell(packing: float, dimension: int = 3) -> float:
 def neighbour_mode(neighbours: str, packing: float, dimension: int = 3) -> str:
     """The neighbour search a run uses: "lists" or "cells" ("auto": cells below
     :data:`CELLS_BELOW` of the dimension, where they were measured faster,
-    ``scripts/bench_cells.py``)."""
+    ``scripts/benchmarks/neighbours.py``)."""
     if neighbours not in NEIGHBOURS:
         raise ConfigError(f"neighbours = {neighbours!r}: must be one of {', '.join(NEIGHBOURS)}")
     if neighbours == "auto":

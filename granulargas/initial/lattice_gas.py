@@ -313,116 +313,192 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
     box = np.asarray(box, dtype=np.float64)
     n, d = len(radii), len(box)
     eta = float(np.sum(theory.particle_volume(2.0 * radii, d))) / float(np.prod(box))
-    # M sites for N particles: S(k) = 1 - N/M = S0 at long wavelengths (docstring)
-    m_sites = max(n, round(n / max(_MIN_OCCUPANCY, 1.0 - fluid_s0(eta, d))))
-    sites, dist, z_order, cell = _lattice(m_sites, box)
-    dmax = 2.0 * float(radii.max())
-    # M sites kept, the extra ones dropped evenly in space; N of them at random,
-    # in lattice (memory ~ space) order for fast sweeps; particle ids are
-    # shuffled at the end
-    kept = _spread_out(m_sites, z_order, rng)
-    chosen = np.sort(kept[rng.permutation(m_sites)[:n]])
-    pos = sites[chosen]
-    ids = rng.permutation(n)
-    radii = radii[ids]  # radii[k] belongs to the particle placed at site k
-    r3 = np.zeros((n, 3))
-    r3[:, :d] = pos
-    box3 = np.ones(3)
-    box3[:d] = box
-    ncell = np.ones(3, dtype=np.int64)
-    ncell[:d] = np.maximum(1, np.floor(box / dmax)).astype(np.int64)
-    head = np.empty(int(np.prod(ncell)), dtype=np.int32)
-    nxt = np.empty(n, dtype=np.int32)
-    prv = np.empty(n, dtype=np.int32)
-    cof = np.empty(n, dtype=np.int32)
-    mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
+    p = _Placement(radii, box, eta, rng)
     melt = MELT_SWEEPS if sweeps is None else sweeps
     default_melt = sweeps is None
     if sweeps is None:
         sweeps = MELT_SWEEPS if n <= 100_000 else FINAL_SWEEPS_LARGE
-    state = {"step": 0.1 * dmax, "stale": False}
-    # large systems: sweeps over cell-sorted particles (parallel), their random numbers
-    # from a per-sweep key; small ones: cell lists, random numbers from the generator
-    large = n >= SORTED_MIN_PARTICLES
-    u = np.empty((0 if large else n, d))  # uniform random numbers of a sweep (small systems)
-    sorting = {}  # the sort's offsets and scratch arrays (large systems)
-
-    def sweep_key():  # a sweep's random numbers: a 64-bit key or u filled (_montecarlo docstring)
-        if large:
-            return np.uint64(rng.integers(0, 2**63, dtype=np.int64))
-        rng.random(out=u)
-        return np.uint64(0)
-
-    def lists():  # the cell lists, after sweeps or pushes over sorted particles
-        if state["stale"]:
-            mc.wrap_positions(r3, box3)
-            mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
-            state["stale"] = False
-
-    def sort(grid):  # particles (and their radii and ids) sorted by the cells of grid
-        if not sorting:
-            sorting.update(start=np.empty(0, dtype=np.int32), cell_of=np.empty(n, dtype=np.int32),
-                           r=np.empty_like(r3), f=np.empty(n), i=np.empty(n, dtype=ids.dtype),
-                           dest=np.empty(n, dtype=np.int32))
-        if len(sorting["start"]) <= int(np.prod(grid)):
-            sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int32)
-        mc.sort_by_cell(r3, radii, ids, box3, grid, sorting["start"], sorting["cell_of"], sorting["r"],
-                        sorting["f"], sorting["i"], sorting["dest"])
-        state["stale"] = True
-
-    def do_sweep(scale):
-        step = state["step"]
-        grid = _sorted_grid(box, dmax * scale, step) if large else None
-        if grid is None:  # small system, small box or long moves: cell lists
-            lists()
-            acc = mc.sweep(r3, radii * scale, box3, ncell, head, nxt, prv, cof, step, sweep_key(), u, d)
-        else:
-            sort(grid)
-            acc = mc.sorted_sweep(r3, radii * scale, box3, grid, sorting["start"], step, sweep_key(), d)
-        acc /= n
-        state["step"] = min(0.5 * float(box.min()), step * min(2.0, max(0.5, acc / 0.4)))
 
     # Dense systems (and lattices too tight for the largest particles) start
     # diluted, radii scaled by lam so that the packing is <= 0.25 and the sweeps
     # melt the lattice; then the radii grow to full size: large systems in one
-    # compression (compress), the others in steps of a few per cent, the
+    # compression (_Placement.compress), the others in steps of a few per cent, the
     # overlaps each step creates pushed apart (Gauss-Seidel descent on the
     # overlaps, :func:`_montecarlo.push_some`), each step followed by a sweep.
-    lam = min(1.0, dist / dmax * (1.0 - 1e-9), (0.25 / eta) ** (1.0 / d))
+    lam = min(1.0, p.dist / p.dmax * (1.0 - 1e-9), (0.25 / eta) ** (1.0 / d))
     if lam == 1.0:  # no growth: the final sweeps melt the lattice, at least MELT_SWEEPS of them
         sweeps = max(int(melt), int(sweeps))
     # large systems: growth by one compression (below) where the box holds its grid
     swell = min(SWELL, (SWELL_PACKING_MAX[d] / eta) ** (1.0 / d) - 1.0)
-    squeeze = (fire.compression_grid(box, dmax * (1.0 + swell + FIRE_SKIN))
-               if large and lam < 1.0 and eta >= COMPRESSION_MIN_PACKING[d] else None)
+    squeeze = (fire.compression_grid(box, p.dmax * (1.0 + swell + FIRE_SKIN))
+               if p.large and lam < 1.0 and eta >= COMPRESSION_MIN_PACKING[d] else None)
     if squeeze is not None and d == 3:  # melt: each particle displaced uniformly over a lattice cell
-        r3[:, :d] += (rng.random((n, d)) - 0.5) * cell
-        state["stale"] = True
+        p.displace_within_cells()
         if default_melt:
             melt = 0
     elif squeeze is not None and default_melt:
         melt = COMPRESSION_MELT_SWEEPS
     if lam < 1.0:
         for _ in range(int(melt)):
-            do_sweep(lam)
-    # pushed particles' partners (pushes over cell lists: small systems, and large ones in
-    # boxes too small for the sorted scans); allocated on first use
-    buf = np.empty(0, dtype=np.int64)
-    near = np.empty(256, dtype=np.int64)
-    uniq = np.empty(n, dtype=np.int64)
-    seen = np.zeros(n, dtype=np.bool_)
+            p.sweep(lam)
+    if squeeze is not None:
+        p.compress(squeeze, swell)
+        lam = 1.0
+        # the melt's step at packing <= 0.25 would be rejected almost always at full size
+        p.step = min(p.step, 0.1 * p.dmax)
+    p.grow(lam)
+    for _ in range(int(sweeps)):
+        p.sweep(1.0)
+    return p.positions()
 
-    def pushes(rad, grow):  # a growth step's pushes over cell lists; returns the overlapping left
-        nonlocal buf
-        if len(buf) == 0:
-            buf = np.empty(max(64, 40 * n), dtype=np.int64)
+
+class _Placement:
+    """One random placement under way (:func:`random_positions`): positions (N, 3) in lattice
+    (memory ~ space) order, the radii and particle ids in the same order, the cell lists, the
+    sort of large systems, and the Monte Carlo step. Large systems (N >=
+    :data:`SORTED_MIN_PARTICLES`) sweep and push over cell-sorted particles (parallel), their
+    random numbers from a per-sweep key; small ones over cell lists, their random numbers from
+    the generator."""
+
+    def __init__(self, radii, box, eta, rng):
+        n, d = len(radii), len(box)
+        self.n, self.d, self.box, self.eta, self.rng = n, d, box, eta, rng
+        # M sites for N particles: S(k) = 1 - N/M = S0 at long wavelengths (docstring)
+        m_sites = max(n, round(n / max(_MIN_OCCUPANCY, 1.0 - fluid_s0(eta, d))))
+        sites, self.dist, z_order, self.cell = _lattice(m_sites, box)
+        self.dmax = 2.0 * float(radii.max())
+        # M sites kept, the extra ones dropped evenly in space; N of them at random,
+        # in lattice (memory ~ space) order for fast sweeps; particle ids are
+        # shuffled at the end
+        kept = _spread_out(m_sites, z_order, rng)
+        chosen = np.sort(kept[rng.permutation(m_sites)[:n]])
+        pos = sites[chosen]
+        self.ids = rng.permutation(n)
+        self.radii = radii[self.ids]  # radii[k] belongs to the particle placed at site k
+        self.r3 = np.zeros((n, 3))
+        self.r3[:, :d] = pos
+        self.box3 = np.ones(3)
+        self.box3[:d] = box
+        self.ncell = np.ones(3, dtype=np.int64)
+        self.ncell[:d] = np.maximum(1, np.floor(box / self.dmax)).astype(np.int64)
+        self.head = np.empty(int(np.prod(self.ncell)), dtype=np.int32)
+        self.nxt = np.empty(n, dtype=np.int32)
+        self.prv = np.empty(n, dtype=np.int32)
+        self.cof = np.empty(n, dtype=np.int32)
+        mc.fill_cells(self.r3, self.box3, self.ncell, self.head, self.nxt, self.prv, self.cof)
+        self.step = 0.1 * self.dmax
+        self.stale = False  # the cell lists lag behind the positions
+        self.large = n >= SORTED_MIN_PARTICLES
+        self.u = np.empty((0 if self.large else n, d))  # uniform random numbers of a sweep (small systems)
+        self.sorting = {}  # the sort's offsets and scratch arrays (large systems)
+        # pushed particles' partners (pushes over cell lists: small systems, and large ones in
+        # boxes too small for the sorted scans); buf allocated on first use
+        self.buf = np.empty(0, dtype=np.int64)
+        self.near = np.empty(256, dtype=np.int64)
+        self.uniq = np.empty(n, dtype=np.int64)
+        self.seen = np.zeros(n, dtype=np.bool_)
+
+    def _cells(self):
+        return self.ncell, self.head, self.nxt, self.prv, self.cof
+
+    def sweep_key(self):
+        """A sweep's random numbers: a 64-bit key, or u filled (_montecarlo docstring)."""
+        if self.large:
+            return np.uint64(self.rng.integers(0, 2**63, dtype=np.int64))
+        self.rng.random(out=self.u)
+        return np.uint64(0)
+
+    def lists(self):
+        """The cell lists brought up to date, after sweeps or pushes over sorted particles."""
+        if self.stale:
+            mc.wrap_positions(self.r3, self.box3)
+            mc.fill_cells(self.r3, self.box3, *self._cells())
+            self.stale = False
+
+    def sort(self, grid):
+        """Particles (and their radii and ids) sorted by the cells of ``grid``."""
+        n, sorting = self.n, self.sorting
+        if not sorting:
+            sorting.update(start=np.empty(0, dtype=np.int32), cell_of=np.empty(n, dtype=np.int32),
+                           r=np.empty_like(self.r3), f=np.empty(n), i=np.empty(n, dtype=self.ids.dtype),
+                           dest=np.empty(n, dtype=np.int32))
+        if len(sorting["start"]) <= int(np.prod(grid)):
+            sorting["start"] = np.empty(int(np.prod(grid)) + 1, dtype=np.int32)
+        mc.sort_by_cell(self.r3, self.radii, self.ids, self.box3, grid, sorting["start"], sorting["cell_of"],
+                        sorting["r"], sorting["f"], sorting["i"], sorting["dest"])
+        self.stale = True
+
+    def sweep(self, scale):
+        """One hard-sphere Monte Carlo sweep at radii * scale; the step adapts to 40 % acceptance."""
+        step = self.step
+        grid = _sorted_grid(self.box, self.dmax * scale, step) if self.large else None
+        if grid is None:  # small system, small box or long moves: cell lists
+            self.lists()
+            acc = mc.sweep(self.r3, self.radii * scale, self.box3, *self._cells(), step, self.sweep_key(), self.u,
+                           self.d)
+        else:
+            self.sort(grid)
+            acc = mc.sorted_sweep(self.r3, self.radii * scale, self.box3, grid, self.sorting["start"], step,
+                                  self.sweep_key(), self.d)
+        acc /= self.n
+        self.step = min(0.5 * float(self.box.min()), step * min(2.0, max(0.5, acc / 0.4)))
+
+    def displace_within_cells(self):
+        """The melt of large 3D systems: each particle displaced uniformly over its lattice cell."""
+        self.r3[:, : self.d] += (self.rng.random((self.n, self.d)) - 0.5) * self.cell
+        self.stale = True
+
+    def grow(self, lam):
+        """Radii from lam of full size to full size in steps of a few per cent (at most 5 %), the
+        overlaps of each step pushed apart, each step followed by a sweep; a step that stays stuck
+        is undone and retried at half the growth."""
+        r3, radii, ids, box3, seen = self.r3, self.radii, self.ids, self.box3, self.seen
+        grow = 0.05
+        while lam < 1.0:
+            if grow < 1e-4:
+                raise ConfigError(f"packing fraction {self.eta:.4g}: too dense for random placement of these "
+                                  f"radii (reached {lam:.4f} of the target size)")
+            trial = min(1.0, lam * (1.0 + grow))
+            cap = PUSH_CAP * self.dmax * trial
+            grid = _sorted_grid(self.box, self.dmax * trial, cap) if self.large else None
+            if grid is not None:  # large systems: census and pushes over sorted particles
+                self.sort(grid)
+                mc.sorted_overlapping(r3, radii * trial, box3, grid, self.sorting["start"], seen)
+                idx = np.flatnonzero(seen)
+                seen[:] = False
+                saved = (r3.copy(), radii.copy(), ids.copy())
+                idx = self.sorted_pushes(idx, grid, trial, grow, cap)
+                if len(idx):
+                    r3[:], radii[:], ids[:] = saved
+                    self.stale = True
+            else:
+                self.lists()
+                saved = r3.copy()
+                idx = self.pushes(radii * trial, grow)
+                if len(idx):
+                    r3[:] = saved
+                    mc.fill_cells(r3, box3, *self._cells())
+            if len(idx):  # stuck: undone, grow more gently
+                grow *= 0.5
+                continue
+            grow = min(0.05, grow * 1.5)
+            lam = trial
+            self.sweep(lam)
+
+    def pushes(self, rad, grow):
+        """A growth step's pushes over cell lists; returns the particles still overlapping."""
+        n, d, r3, box3, rng = self.n, self.d, self.r3, self.box3, self.rng
+        ncell, head, nxt, prv, cof = self._cells()
+        if len(self.buf) == 0:
+            self.buf = np.empty(max(64, 40 * n), dtype=np.int64)
+        buf, near, uniq, seen = self.buf, self.near, self.uniq, self.seen
         idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
         for it in range(600):
             if len(idx) == 0:
                 break
             if it % 100 == 99:  # jammed spots: let the hard-sphere surroundings make room
-                key = sweep_key()
-                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, key, u, d)
+                key = self.sweep_key()
+                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * self.dmax, key, self.u, d)
                 idx = buf[: mc.overlapping(r3, rad, box3, ncell, head, nxt, buf)].copy()
                 continue
             kick = rng.uniform(0.5, 1.5, size=len(idx))
@@ -432,22 +508,24 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             idx = uniq[: mc.distinct(buf, m, seen, uniq)].copy()
         return idx
 
-
-    def sorted_pushes(idx, grid, scale, grow, cap):  # the same over sorted particles (large systems)
+    def sorted_pushes(self, idx, grid, scale, grow, cap):
+        """The same over sorted particles (large systems)."""
+        d, r3, box3, rng, sorting = self.d, self.r3, self.box3, self.rng, self.sorting
+        uniq, seen = self.uniq, self.seen
         start = sorting["start"]
         slabs = int(grid[2] if d == 3 else grid[1])
         slab_start = np.empty(slabs + 1, dtype=np.int64)
         out_n = np.empty(slabs, dtype=np.int64)
-        rad = radii * scale
+        rad = self.radii * scale
         for it in range(600):
             if len(idx) == 0:
                 break
             if it % 100 == 99:  # jammed spots: as in pushes(), then sorted again
-                lists()
-                key = sweep_key()
-                mc.relax_sweep(r3, rad, box3, ncell, head, nxt, prv, cof, 0.5 * grow * dmax, key, u, d)
-                sort(grid)
-                rad = radii * scale
+                self.lists()
+                key = self.sweep_key()
+                mc.relax_sweep(r3, rad, box3, *self._cells(), 0.5 * grow * self.dmax, key, self.u, d)
+                self.sort(grid)
+                rad = self.radii * scale
                 mc.sorted_overlapping(r3, rad, box3, grid, start, seen)
                 idx = np.flatnonzero(seen)
                 seen[:] = False
@@ -459,16 +537,19 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             push = mc.sorted_push if len(idx) >= PARALLEL_MIN_PUSHES else mc.sorted_push_serial
             clamped = push(idx, slab_start, r3, rad, box3, grid, start, sorting["cell_of"], cap, kick,
                            PUSH_MARGIN * grow, out, out_n)
-            state["stale"] = True
+            self.stale = True
             # in order of first appearance (a pushed particle's new partners, then itself)
             idx = uniq[: mc.distinct_runs(out, 40 * slab_start[:-1], out_n, seen, uniq)].copy()
             del out  # (a buffer per pass: its untouched pages are never mapped)
             if clamped:  # pushes held back at the cap: sort again
-                sort(grid)
-                rad = radii * scale
+                self.sort(grid)
+                rad = self.radii * scale
                 idx = sorting["dest"][idx].astype(np.int64)
         return idx
-    def compress(grid, swell):  # growth to full size in one FIRE minimisation (large systems)
+
+    def compress(self, grid, swell):
+        """Growth to full size in one FIRE minimisation (large systems)."""
+        n, d, r3, radii, box3, dmax, sorting = self.n, self.d, self.r3, self.radii, self.box3, self.dmax, self.sorting
         skin = FIRE_SKIN * dmax
         v = np.zeros((n, 3))
         f = np.empty((n, 3))
@@ -478,7 +559,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
         offsets = np.zeros(n + 1, dtype=np.int64)
 
         def rebuild(pairs):  # sorted again (v with the particles), neighbour lists from the sort
-            sort(grid)
+            self.sort(grid)
             start = sorting["start"]
             # v and the last counts (room for as many pairs as the particle had neighbours,
             # + NEIGHBOUR_SLACK) to the particles' new places
@@ -507,7 +588,7 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             if stray:
                 raise RuntimeError(f"compression: {stray} listed pairs reach beyond the next slab")
             if hard == 0:  # no pair closer than contact
-                state["stale"] = True
+                self.stale = True
                 return
             if hard <= max(SEPARATE_MAX_PAIRS, n // SEPARATE_PER_PAIR) and it >= separated + 5:
                 # the last few overlaps: pushed apart directly, the lists built afresh
@@ -525,55 +606,19 @@ def random_positions(radii, box, seed=0, sweeps=None, rng=None):
             else:
                 downhill, dt, alpha, keep, mix = 0, 0.5 * dt, 0.1, 0.0, 0.0
             fire.fire_move(r3, v, f, r0, keep, mix, dt, FIRE_MAX_MOVE * dmax, FIRE_BLOCK, moved)
-            state["stale"] = True
+            self.stale = True
             far = np.sort(moved.ravel())[-2:]  # the two largest distances moved since the build
             if far[0] + far[1] > skin:
                 pairs = rebuild(pairs)
-        raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these radii "
+        raise ConfigError(f"packing fraction {self.eta:.4g}: too dense for random placement of these radii "
                           f"(the compression to full size did not converge in {FIRE_MAX_STEPS} steps)")
 
-    if squeeze is not None:
-        compress(squeeze, swell)
-        lam = 1.0
-        # the melt's step at packing <= 0.25 would be rejected almost always at full size
-        state["step"] = min(state["step"], 0.1 * dmax)
-    grow = 0.05
-    while lam < 1.0:
-        if grow < 1e-4:
-            raise ConfigError(f"packing fraction {eta:.4g}: too dense for random placement of these "
-                              f"radii (reached {lam:.4f} of the target size)")
-        trial = min(1.0, lam * (1.0 + grow))
-        cap = PUSH_CAP * dmax * trial
-        grid = _sorted_grid(box, dmax * trial, cap) if large else None
-        if grid is not None:  # large systems: census and pushes over sorted particles
-            sort(grid)
-            mc.sorted_overlapping(r3, radii * trial, box3, grid, sorting["start"], seen)
-            idx = np.flatnonzero(seen)
-            seen[:] = False
-            saved = (r3.copy(), radii.copy(), ids.copy())
-            idx = sorted_pushes(idx, grid, trial, grow, cap)
-            if len(idx):
-                r3[:], radii[:], ids[:] = saved
-                state["stale"] = True
-        else:
-            lists()
-            saved = r3.copy()
-            idx = pushes(radii * trial, grow)
-            if len(idx):
-                r3[:] = saved
-                mc.fill_cells(r3, box3, ncell, head, nxt, prv, cof)
-        if len(idx):  # stuck: undone, grow more gently
-            grow *= 0.5
-            continue
-        grow = min(0.05, grow * 1.5)
-        lam = trial
-        do_sweep(lam)
-    for _ in range(int(sweeps)):
-        do_sweep(1.0)
-    mc.wrap_positions(r3, box3)
-    out = np.empty((n, d))
-    out[ids] = r3[:, :d]
-    return out
+    def positions(self):
+        """The positions (N, d) in [0, L), in the particles' (shuffled) id order."""
+        mc.wrap_positions(self.r3, self.box3)
+        out = np.empty((self.n, self.d))
+        out[self.ids] = self.r3[:, : self.d]
+        return out
 
 
 def maxwell_velocities(masses, dimension, temperature=1.0, seed=0, rng=None):

@@ -25,20 +25,20 @@ advice predicts, with kinetic theory and no simulation
    homogeneous dilute gas, where it solves the same Enskog-Boltzmann equation much
    faster: no walls or TC model, a box below the instability length and a
    packing fraction up to :data:`DSMC_MAX_PACKING`; EDMD otherwise. The predicted
-   speed-up is the ratio of collision rates measured by ``scripts/bench_dsmc.py``
+   speed-up is the ratio of collision rates measured by ``scripts/benchmarks/dsmc.py``
    (docs/performance.md, DSMC section), interpolated in the packing fraction.
 
 7. the duration of the contacts (:func:`choose_duration`, material route only, where the
    stiffness fixes the contact time): from the contact-time ratio ``<t_c> omega`` at T0
    (:func:`granulargas.run.validity.contact_time_ratio`) and the errors of instantaneous
    and resolved EDMD against LAMMPS measured at a few ratios by
-   ``scripts/resolved_lammps.py`` (:data:`RESOLVED_LAMMPS_MEASURED`; docs/validation.md,
+   ``scripts/lammps/resolved_collisions.py`` (:data:`RESOLVED_LAMMPS_MEASURED`; docs/validation.md,
    "Against LAMMPS"), interpolated as a power law in the ratio: instantaneous
    collisions where their predicted error is within the tolerance; else
    ``[collision] duration = "resolved"`` where its error is and a DEM at t_c/10 (whose error
    stayed within 1 %) would take longer (measured CPU-time ratio, :func:`dem_cost`;
    the resolved rule itself runs at about :data:`RESOLVED_COST` the collisions per CPU
-   second of the instantaneous one, ``scripts/bench_resolved.py``); else a time-stepped
+   second of the instantaneous one, ``scripts/benchmarks/resolved.py``); else a time-stepped
    DEM (``granulargas export lammps --material-stiffness``). Above the largest measured
    ratio the resolved scheme is not vouched for, nor where the fastest impact expected
    among the config's particles (:func:`fastest_impact_bounds`) is beyond its table,
@@ -71,7 +71,7 @@ over the run, plus the inelastic-collapse risk.
 The prediction is the kinetic theory of :mod:`granulargas.theory.gas`: a homogeneous
 gas whose temperature and second Sonine coefficient a2 evolve together (moment
 equations with the exact eps(g)); it is checked against real runs in
-``scripts/rule_choice.py`` (docs/choosing-a-model.md).
+``scripts/validation/rule_choice.py`` (docs/choosing-a-model.md).
 
 Runner API: :func:`summary_line` ``(config, tolerance=DEFAULT_TOLERANCE) -> str | None``.
 """
@@ -112,13 +112,13 @@ POLYDISPERSE_MEASURED = 0.917
 
 #: largest packing fraction for which advise recommends DSMC. Enskog's equation neglects the
 #: velocity correlations of a dense gas; at packing 0.02 the engine's T(t) and a2(t) agree
-#: with DSMC within 0.33 % and 0.005 (scripts/dsmc_vs_engine.py), and the engine's energy
+#: with DSMC within 0.33 % and 0.005 (scripts/validation/dsmc_vs_engine.py), and the engine's energy
 #: loss per collision falls below DSMC's by about 1 % at packing 0.1 and 5 % at 0.4 for
-#: eps = 0.8 (scripts/dsmc_packing_gap.py; docs/dsmc.md, "denser packings").
+#: eps = 0.8 (scripts/validation/dsmc_packing_gap.py; docs/dsmc.md, "denser packings").
 DSMC_MAX_PACKING = 0.1
 
 #: (packing fraction, DSMC / engine collision rate): CPU-time medians at N = 10^5, 3D,
-#: constant eps = 0.9 (``scripts/bench_dsmc.py``; docs/performance.md, DSMC section)
+#: constant eps = 0.9 (``scripts/benchmarks/dsmc.py``; docs/performance.md, DSMC section)
 DSMC_SPEEDUP_MEASURED = ((0.02, 252.0), (0.3, 26.0))
 
 
@@ -128,7 +128,7 @@ DSMC_SPEEDUP_MEASURED = ((0.02, 252.0), (0.3, 26.0))
 #: collision count, the mean pressure and the mean P / (n T), of |mean| + 2 standard errors over 8 seeds
 #: of the relative deviation from LAMMPS at t_c/80 (LAMMPS at t_c/10 stays within 1 % of it). 3D,
 #: N = 2000, packing 0.05, damping 0.1, t = 0..20 (about 12 collisions per particle), one core each
-#: (``scripts/resolved_lammps.py``; docs/validation.md, "Against LAMMPS"). At t_c/t_free = 0.2 the
+#: (``scripts/lammps/resolved_collisions.py``; docs/validation.md, "Against LAMMPS"). At t_c/t_free = 0.2 the
 #: resolved scheme refuses some initial states of this gas: the fastest impact is beyond its table.
 RESOLVED_LAMMPS_MEASURED = ((0.01, 0.0168, 0.0098, 7.16), (0.03, 0.0255, 0.0089, 2.98), (0.1, 0.0756, 0.0182, 1.42),
                             (0.15, 0.1101, 0.0166, 1.15))
@@ -138,7 +138,7 @@ RESOLVED_LAMMPS_MEASURED = ((0.01, 0.0168, 0.0098, 7.16), (0.03, 0.0255, 0.0089,
 RESOLVED_THREE_BODY_CHECKED = 0.166
 
 #: resolved / instantaneous collisions per CPU second, 3D N = 10^4 packing 0.1
-#: (``scripts/bench_resolved.py``; docs/performance.md)
+#: (``scripts/benchmarks/resolved.py``; docs/performance.md)
 RESOLVED_COST = 0.80
 
 
@@ -207,7 +207,7 @@ def choose_duration(config, tolerance: float = DEFAULT_TOLERANCE) -> tuple[str, 
     largest = RESOLVED_LAMMPS_MEASURED[-1][0]
     e_inst = duration_error(ratio, "instantaneous")
     dem = "use a time-stepped DEM (granulargas export lammps --material-stiffness)"
-    measured = (f"t_c/t_free = {ratio:.3g} at T0: against LAMMPS (scripts/resolved_lammps.py, measured at "
+    measured = (f"t_c/t_free = {ratio:.3g} at T0: against LAMMPS (scripts/lammps/resolved_collisions.py, measured at "
                 f"{', '.join(f'{row[0]:g}' for row in RESOLVED_LAMMPS_MEASURED)}) instantaneous collisions are off "
                 f"by about {100 * e_inst:.2g} %")
     if e_inst <= tolerance:
@@ -229,7 +229,7 @@ def choose_duration(config, tolerance: float = DEFAULT_TOLERANCE) -> tuple[str, 
                        f"about x{cost:.2g} the CPU time of the resolved run: {dem}")
     return "resolved", (f"{measured}, resolved collisions by about {100 * e_res:.2g} % (tolerance "
                         f"{100 * tolerance:g} %): use [collision] duration = \"resolved\" (about x{RESOLVED_COST:g} "
-                        f"the collisions per CPU second of instantaneous ones, scripts/bench_resolved.py; a DEM at "
+                        f"the collisions per CPU second of instantaneous ones, scripts/benchmarks/resolved.py; a DEM at "
                         f"t_c/10 about x{cost:.2g} its CPU time)")
 
 
@@ -432,7 +432,7 @@ class Advice:
                        "(at T0)")
         if self.method_reason:
             name = {"dsmc": "DSMC", "edmd": "EDMD"}[self.method]
-            speed = (f"; about x{self.speedup:.3g} the collisions per CPU second of EDMD (scripts/bench_dsmc.py, "
+            speed = (f"; about x{self.speedup:.3g} the collisions per CPU second of EDMD (scripts/benchmarks/dsmc.py, "
                      "interpolated in the packing fraction)" if self.method == "dsmc" else "")
             out.append(f"method       {name} (run.method = \"{self.method}\"): {self.method_reason}{speed}")
             if self.configured_method != self.method:
@@ -667,7 +667,7 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
     if scene.shows("collapse") and (gas.restitution <= 0.7 or (gas.dimension == 2 and gas.packing_fraction >= 0.3)):
         notes.append(f"eps = {gas.restitution:g} without tc_time: dense or strongly inelastic regions can collapse "
                      "(InelasticCollapseError); set [collision] tc_time (TC model) or use the viscoelastic "
-                     "rule (scripts/collapse_demo.py)")
+                     "rule (scripts/validation/collapse_demo.py)")
     if scene.shows("species_temperatures"):
         adv.species = tuple(species_advice(config, t_end))
     if scene.shows("mixture_mean_particle"):

@@ -102,7 +102,7 @@ class RunSummary:
         if self.three_body_contacts is not None:
             share = self.three_body_contacts / self.collisions if self.collisions else 0.0
             note = (f"; more than the {100 * RESOLVED_THREE_BODY_CHECKED:.2g} % met at the longest contacts for which "
-                    "the resolved scheme was checked against LAMMPS (scripts/resolved_lammps.py): use DEM"
+                    "the resolved scheme was checked against LAMMPS (scripts/lammps/resolved_collisions.py): use DEM"
                     if share > RESOLVED_THREE_BODY_CHECKED else "")
             extra.append(f"three-body   {self.three_body_contacts} collisions with a pair still in contact "
                          f"({100.0 * share:.3g} % of the collisions{note})")
@@ -418,28 +418,11 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
     st = setup.state
     check_output_size(config, len(st.radii))
     schedule = output_schedule(config)
-    run = config.run
-    if run.end_time is not None and st.time >= run.end_time:
-        raise ConfigError(f"{config.source}: run.end_time = {run.end_time:g}: the restart file "
-                          f"{setup.source} is already at t = {st.time:g}; nothing to run")
-    if run.collisions_per_particle is not None and st.collisions >= collision_budget(config):
-        raise ConfigError(f"{config.source}: run.collisions_per_particle = {run.collisions_per_particle:g}: the "
-                          f"restart file {setup.source} already has {st.collisions} collisions; nothing to run")
+    _check_something_to_run(config, setup, st)
 
     dsmc = config.run.method == "dsmc"
     watch.armed = True  # from here on a compile is announced (bad input has had its one line)
-    if dsmc:
-        sim = make_dsmc(config, setup)
-    else:
-        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
-                         shear=setup.shear, stress=_stress(setup), gravity=setup.gravity, walls=setup.walls,
-                         tangential=setup.tangential)
-    if not dsmc:  # the engine's own choice of neighbour mode ("auto" at the state's packing)
-        what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
-    # a zero-length run compiles (or loads) the engine and builds its queue before
-    # the file exists and outside the timed part, so collisions/s measures the
-    # event loop; both paths of a restart do it, so restart equality is unaffected
-    sim.run(until=sim.time)
+    sim = _build_simulation(config, setup, st, what)
 
     start_key = st.time if schedule.clock == "time" else st.collisions
     keep = schedule.targets > start_key
@@ -449,36 +432,8 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
         budget = collision_budget(config)
 
     resolved = not dsmc and sim.rule.resolved
-    fields = stored_fields(config, sim)
-    if append:
-        writer = H5MDWriter.append(path, st, fields=fields)
-        writer.set_parameters(_continuation_record(writer, config, setup, st))
-    else:
-        writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None or (setup.shear is not None and setup.shear.thermostat),
-                            gravity=setup.gravity is not None,
-                            wall_kinds=setup.walls is not None and setup.walls.moving,
-                            tensor=(not dsmc and _stress(setup)) or setup.shear is not None,
-                            species=setup.rule.species)
-    try:
-        if stop is not None:
-            stop.arm()  # from here on a signal keeps the state reached
-    except BaseException:
-        writer.close()
-        if not append:
-            path.unlink(missing_ok=True)
-        raise
-
-    show = _want_progress(quiet, progress)
-    bar = None
-    callback = None
-    if show:
-        if callable(progress) and not isinstance(progress, bool):
-            callback = progress
-        else:
-            total = targets[-1] if len(targets) else start_key
-            bar = _Progress(total, schedule.clock, start_key, sim)
-            callback = bar
+    writer = _open_writer(config, setup, st, sim, path, append, overwrite, stop)
+    bar, callback = _progress_display(quiet, progress, targets, schedule.clock, start_key, sim)
 
     def between_chunks(sim_):
         if stop:
@@ -525,78 +480,159 @@ def _run(config, overwrite, quiet, progress, log, append, stop, start, what, wat
                 stop_reason = "collisions_per_particle"
                 break
     except _Stop:
-        # the state at the last chunk boundary: every event up to sim.time is processed
-        name = signal.Signals(stop.signum).name
-        try:
-            if (sim.events, sim.time) != last_sample:  # the stop may fall right after a sample
-                writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
-            if (sim.events, sim.time) != frame[0]:  # ... or right after a scheduled frame
-                snapshot()
-            writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
-            writer.set_parameters({"summary": {"stop_reason": f"interrupted by {name}", "time": float(sim.time),
-                                               "collisions": int(sim.collisions), "events": int(sim.events)}})
-        finally:
-            writer.close()
-            if bar is not None:
-                bar.close()
-        raise RunInterrupted(
-            f"{name} at t = {sim.time:.6g} ({sim.collisions} collisions); {path} keeps the state reached as its "
-            "last frame", signum=stop.signum, time=float(sim.time), collisions=int(sim.collisions),
-            output=path) from None
+        raise _close_stopped(stop, sim, writer, bar, path, last_sample, frame[0], snapshot) from None
     except BaseException as exc:
-        reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else f"error: {exc}"
-        try:
-            writer.set_parameters({"summary": {"stop_reason": reason, "time": float(sim.time),
-                                               "collisions": int(sim.collisions)}})
-            kept = writer.frames
-        finally:
-            writer.close()
-            if bar is not None:
-                bar.close()
-        if isinstance(exc, InelasticCollapseError):
-            raise InelasticCollapseError(f"{collapse_message(config, exc.where)} ({path} keeps {kept} snapshots)",
-                                         where=exc.where) from None
-        if isinstance(exc, SimulationError) and type(exc).__init__ is Exception.__init__:
-            raise type(exc)(f"{exc} ({path} keeps {kept} snapshots)") from None
-        if isinstance(exc, KeyboardInterrupt):  # a second signal: stopped at once
-            signum = getattr(exc, "signum", signal.SIGINT)
-            raise RunInterrupted(
-                f"{signal.Signals(signum).name} again: stopped at once at t = {sim.time:.6g}; {path} keeps the "
-                f"{kept} frames flushed before", signum=signum, time=float(sim.time), collisions=int(sim.collisions),
-                output=path) from None
+        err = _close_failed(exc, config, sim, writer, bar, path)
+        if err is not None:
+            raise err from None
         raise
     late = watch.seconds - compiled0  # compiled during the run: start-up, not run time
     wall = _time.perf_counter() - wall0 - late
-    startup = wall0 - start + late
-    done = sim.collisions - c0
     summary = RunSummary(
         output=path,
         collisions=int(sim.collisions),
         events=int(sim.events),
         time=float(sim.time),
         wall_time=wall,
-        collisions_per_second=done / wall if wall > 0 else math.nan,
+        collisions_per_second=(sim.collisions - c0) / wall if wall > 0 else math.nan,
         final_temperature=float(sim.temperature),
         snapshots=writer.frames,
         stop_reason=stop_reason,
         particles=len(st.radii),
         warnings=tuple(setup.warnings),
-        startup_time=startup,
+        startup_time=wall0 - start + late,
         compile_time=watch.seconds,
         three_body_contacts=int(sim.three_body_contacts) if resolved else None,
         method=config.run.method,
         candidates=int(sim.candidates) if dsmc else None,
     )
+    _close_finished(writer, bar, summary)
+    return summary
+
+
+def _check_something_to_run(config: RunConfig, setup, st) -> None:
+    """A restart that is already at the run's end is bad input (nothing to run)."""
+    run = config.run
+    if run.end_time is not None and st.time >= run.end_time:
+        raise ConfigError(f"{config.source}: run.end_time = {run.end_time:g}: the restart file "
+                          f"{setup.source} is already at t = {st.time:g}; nothing to run")
+    if run.collisions_per_particle is not None and st.collisions >= collision_budget(config):
+        raise ConfigError(f"{config.source}: run.collisions_per_particle = {run.collisions_per_particle:g}: the "
+                          f"restart file {setup.source} already has {st.collisions} collisions; nothing to run")
+
+
+def _build_simulation(config: RunConfig, setup, st, what):
+    """The engine or the DSMC of the run, compiled (or loaded) and with its queue built, before the
+    file exists and outside the timed part (so that collisions/s measures the event loop; both
+    paths of a restart do it, so restart equality is unaffected). ``what[0]`` becomes what the
+    engine compiles for the neighbour mode it chose ("auto" at the state's packing)."""
+    if config.run.method == "dsmc":
+        sim = make_dsmc(config, setup)
+    else:
+        sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
+                         shear=setup.shear, stress=_stress(setup), gravity=setup.gravity, walls=setup.walls,
+                         tangential=setup.tangential)
+        what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
+    sim.run(until=sim.time)
+    return sim
+
+
+def _open_writer(config: RunConfig, setup, st, sim, path, append: bool, overwrite: bool, stop) -> H5MDWriter:
+    """The run's H5MD file, new or continued; from here on a stop request keeps the state reached.
+    A failure to arm the stop leaves no new file behind."""
+    fields = stored_fields(config, sim)
+    if append:
+        writer = H5MDWriter.append(path, st, fields=fields)
+        writer.set_parameters(_continuation_record(writer, config, setup, st))
+    else:
+        writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
+                            driven=sim.driving is not None or (setup.shear is not None and setup.shear.thermostat),
+                            gravity=setup.gravity is not None,
+                            wall_kinds=setup.walls is not None and setup.walls.moving,
+                            tensor=(config.run.method != "dsmc" and _stress(setup)) or setup.shear is not None,
+                            species=setup.rule.species)
+    try:
+        if stop is not None:
+            stop.arm()
+    except BaseException:
+        writer.close()
+        if not append:
+            path.unlink(missing_ok=True)
+        raise
+    return writer
+
+
+def _progress_display(quiet: bool, progress, targets, clock: str, start_key, sim):
+    """(bar or None, callback or None): what runs between compiled chunks to show progress."""
+    if not _want_progress(quiet, progress):
+        return None, None
+    if callable(progress) and not isinstance(progress, bool):
+        return None, progress
+    bar = _Progress(targets[-1] if len(targets) else start_key, clock, start_key, sim)
+    return bar, bar
+
+
+def _close_stopped(stop, sim, writer, bar, path, last_sample, last_frame, snapshot) -> RunInterrupted:
+    """A stop request: the state at the last chunk boundary (every event up to ``sim.time``
+    processed) becomes the file's last sample and frame, marked as interrupted; the file is
+    closed. Returns the :class:`RunInterrupted` to raise."""
+    name = signal.Signals(stop.signum).name
+    try:
+        if (sim.events, sim.time) != last_sample:  # the stop may fall right after a sample
+            writer.write_observables(sim.events, sim.time, _observables(sim, True), flush=False)
+        if (sim.events, sim.time) != last_frame:  # ... or right after a scheduled frame
+            snapshot()
+        writer.mark_interrupted(f"stopped by {name} at t = {sim.time!r}")
+        writer.set_parameters({"summary": {"stop_reason": f"interrupted by {name}", "time": float(sim.time),
+                                           "collisions": int(sim.collisions), "events": int(sim.events)}})
+    finally:
+        writer.close()
+        if bar is not None:
+            bar.close()
+    return RunInterrupted(
+        f"{name} at t = {sim.time:.6g} ({sim.collisions} collisions); {path} keeps the state reached as its "
+        "last frame", signum=stop.signum, time=float(sim.time), collisions=int(sim.collisions), output=path)
+
+
+def _close_failed(exc: BaseException, config: RunConfig, sim, writer, bar, path) -> BaseException | None:
+    """A run that cannot go on: the file records why and closes with the frames written so far.
+    Returns the error to raise in place of ``exc`` (its message names what the file keeps), or
+    None to re-raise ``exc`` itself."""
+    reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else f"error: {exc}"
+    try:
+        writer.set_parameters({"summary": {"stop_reason": reason, "time": float(sim.time),
+                                           "collisions": int(sim.collisions)}})
+        kept = writer.frames
+    finally:
+        writer.close()
+        if bar is not None:
+            bar.close()
+    if isinstance(exc, InelasticCollapseError):
+        return InelasticCollapseError(f"{collapse_message(config, exc.where)} ({path} keeps {kept} snapshots)",
+                                      where=exc.where)
+    if isinstance(exc, SimulationError) and type(exc).__init__ is Exception.__init__:
+        return type(exc)(f"{exc} ({path} keeps {kept} snapshots)")
+    if isinstance(exc, KeyboardInterrupt):  # a second signal: stopped at once
+        signum = getattr(exc, "signum", signal.SIGINT)
+        return RunInterrupted(
+            f"{signal.Signals(signum).name} again: stopped at once at t = {sim.time:.6g}; {path} keeps the "
+            f"{kept} frames flushed before", signum=signum, time=float(sim.time), collisions=int(sim.collisions),
+            output=path)
+    return None
+
+
+def _close_finished(writer, bar, summary: RunSummary) -> None:
+    """The run's summary into the file's parameters; the file and the progress bar closed."""
     writer.set_parameters({"summary": {
-        "stop_reason": stop_reason, "time": summary.time, "collisions": summary.collisions,
-        "events": summary.events, "wall_time": wall, "collisions_per_second": summary.collisions_per_second,
-        "startup_time": startup, "compile_time": watch.seconds,
-        **({"three_body_contacts": summary.three_body_contacts} if resolved else {}),
+        "stop_reason": summary.stop_reason, "time": summary.time, "collisions": summary.collisions,
+        "events": summary.events, "wall_time": summary.wall_time,
+        "collisions_per_second": summary.collisions_per_second, "startup_time": summary.startup_time,
+        "compile_time": summary.compile_time,
+        **({"three_body_contacts": summary.three_body_contacts} if summary.three_body_contacts is not None else {}),
     }})
     writer.close()
     if bar is not None:
         bar.close()
-    return summary
 
 
 def _stress(setup) -> bool:

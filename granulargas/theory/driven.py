@@ -90,7 +90,7 @@ def driving_interval(cooling_rate, fraction=0.02):
     """Interval between white-noise kicks: ``dt_k = fraction / zeta``.
 
     Between kicks the gas cools by ``zeta dt_k`` of its temperature, and a kick puts
-    as much back. Measured with ``scripts/driven_steady_state.py`` (3D, eps = 0.8,
+    as much back. Measured with ``scripts/validation/driven_steady_state.py`` (3D, eps = 0.8,
     packing 0.05, N = 2000, 200 cooling times, T sampled half-way between kicks):
     T_ss / T_theory = 1.0071(15), 1.0058(9), 1.0049(17), 1.0025(22), 0.9870(21),
     0.9334(14) for ``zeta dt_k`` = 0.002, 0.01, 0.05, 0.2, 0.5, 1, and a2 the same

@@ -19,7 +19,7 @@ Two references give them:
 * **Enskog-Boltzmann, DSMC table** (:data:`DSMC_TABLE`): the homogeneous
   Enskog-Boltzmann equation solved by this package's DSMC, which is exact up to
   statistics, at eps = 0.10, 0.15, ..., 0.95 in 2D and 3D
-  (``hcs_dsmc_table.csv`` beside this module, made by ``scripts/hcs_reference_table.py``
+  (``hcs_dsmc_table.csv`` beside this module, made by ``scripts/validation/hcs_reference_table.py``
   from 7e9 collisions, 10-15 minutes on one idle core; 8 independent gases of 10^5
   particles per point, each 400 collisions per particle; errors are the standard errors
   of those 8 means).

@@ -13,7 +13,7 @@ SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
 
 
 def _load(name):
-    spec = importlib.util.spec_from_file_location(name, SCRIPTS / f"{name}.py")
+    spec = importlib.util.spec_from_file_location(Path(name).name, SCRIPTS / f"{name}.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
@@ -35,7 +35,7 @@ def tiny_run(tmp_path):
 
 
 def test_clustering_analysis_script(tiny_run, tmp_path, capsys):
-    mod = _load("clustering_analysis")
+    mod = _load("figures/clustering_analysis")
     assert mod.main([str(tiny_run), "--prefix", str(tmp_path / "c"), "--frames", "0", "2"]) == 0
     for name in ("c_series.png", "c_t000.png", "c_t002.png"):
         assert (tmp_path / name).stat().st_size > 5000
@@ -44,21 +44,21 @@ def test_clustering_analysis_script(tiny_run, tmp_path, capsys):
 
 
 def test_movie_script_writes_gif(tiny_run, tmp_path):
-    mod = _load("movie")
+    mod = _load("figures/movie")
     out = tmp_path / "m.gif"
     assert mod.main([str(tiny_run), "--out", str(out), "--pixels", "50"]) == 0
     assert out.stat().st_size > 1000
 
 
 def test_kinetic_theory_check_script(capsys):
-    mod = _load("kinetic_theory_check")
+    mod = _load("validation/kinetic_theory_check")
     assert mod.main(["--quick"]) == 0
     out = capsys.readouterr().out
     assert "engine/theory-1" in out and "a2 theory" in out
 
 
 def test_models_speed_accuracy_script(tmp_path, capsys):
-    mod = _load("models_speed_accuracy")
+    mod = _load("validation/models_speed_accuracy")
     assert mod.main(["--quick", "--prefix", str(tmp_path / "m")]) == 0
     for name in ("m_speed_accuracy.png", "m_where_dsmc_fails.png"):
         assert (tmp_path / name).stat().st_size > 5000
@@ -71,14 +71,14 @@ def test_models_speed_accuracy_script(tmp_path, capsys):
 
 
 def test_headline_figure_draws_the_theory_of_analyze(tmp_path):
-    # scripts/haff_comparison.py (docs/figures/cooling_haff.png): T/T_theory is taken against
+    # scripts/validation/haff_comparison.py (docs/figures/cooling_haff.png): T/T_theory is taken against
     # the theory granulargas analyze uses (theory.gas.cooling_curve, exact eps(g) for the
     # viscoelastic gas), not against the leading-order law, which is several per cent off
     from granulargas.analysis.run import analyze_cooling
     from granulargas.io.config import parse_config
     from granulargas.run.runner import run_config
 
-    mod = _load("haff_comparison")
+    mod = _load("validation/haff_comparison")
     path = tmp_path / "v.h5"
     text = ('[system]\ndimension = 3\nparticles = 5000\npacking_fraction = 0.05\nseed = 1\n\n[collision]\n'
             'model = "viscoelastic"\ndamping = 0.1\n\n[run]\nmethod = "dsmc"\nend_time = 200.0\n\n'

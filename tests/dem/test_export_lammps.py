@@ -233,7 +233,7 @@ def test_lammps_cools_like_granulargas(tmp_path, dimension, end_time, boundary):
     runs from one initial state decorrelate after a few collisions, so they
     differ by the spread between independent runs: max over time of
     |T_LAMMPS / T_ours - 1| is about 0.5-2 % (single runs; over 8 seeds at N = 2000
-    in 3D the mean difference is +0.5 +- 0.4 %, scripts/compare_lammps.py --ensemble). A factor
+    in 3D the mean difference is +0.5 +- 0.4 %, scripts/lammps/cooling_gas.py --ensemble). A factor
     1.5 error in the damping mapping moves T(t_end) by 10-20 %; the tolerance is 4 %.
     With walls on z (LAMMPS ``fix wall/gran``, the engine's sphere-plane contact) too.
     """

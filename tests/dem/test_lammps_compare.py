@@ -1,4 +1,4 @@
-"""Smoke test of scripts/compare_lammps.py on a tiny gas (keeps the script from rotting)."""
+"""Smoke test of scripts/lammps/cooling_gas.py on a tiny gas (keeps the script from rotting)."""
 
 import importlib.util
 import json
@@ -8,7 +8,7 @@ import pytest
 
 from granulargas.dem.lammps import find_lmp
 
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "compare_lammps.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "lammps" / "cooling_gas.py"
 
 
 def load_script():
@@ -22,7 +22,7 @@ def load_script():
 def test_compare_script_tiny(tmp_path):
     script = load_script()
     figure = tmp_path / "cooling.png"
-    script.main([str(SCRIPT.parents[1] / "configs" / "viscoelastic_3d.toml"), "--end-time", "0.5",
+    script.main([str(SCRIPT.parents[2] / "configs" / "viscoelastic_3d.toml"), "--end-time", "0.5",
                  "--set", "system.particles=300", "--fractions", "0.05", "--repeats", "1", "--seeds", "2",
                  "--workdir", str(tmp_path / "work"), "--figure", str(figure)])
     assert figure.stat().st_size > 10_000

@@ -21,7 +21,7 @@ from granulargas.dem.lammps import DemContact, find_lmp, oblique_input, stiffnes
 
 needs_lmp = pytest.mark.skipif(find_lmp() is None,
                                reason="LAMMPS executable `lmp` not installed (apt-get install lammps)")
-SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "oblique_lammps.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "scripts" / "lammps" / "oblique_collisions.py"
 
 
 def load_script():
@@ -56,7 +56,7 @@ def test_oblique_input_sets_the_relative_velocity():
 
 def test_script_refuses_without_lammps(tmp_path):
     env = {"GRANULARGAS_LMP": "no-such-lmp-executable", "PATH": "/usr/bin:/bin",
-           "PYTHONPATH": str(SCRIPT.parents[1])}
+           "PYTHONPATH": str(SCRIPT.parents[2])}
     proc = subprocess.run([sys.executable, str(SCRIPT), "--workdir", str(tmp_path)], capture_output=True, text=True,
                           env=env, timeout=120)
     assert proc.returncode == 2

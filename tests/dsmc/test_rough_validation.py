@@ -1,6 +1,6 @@
 """Rough grains against independent numbers: the DSMC against published driven steady states
 (Megías & Santos 2022) and the Maxwellian theory; EDMD against DSMC in the homogeneous
-cooling state and the Mpemba crossing time (slow). ``scripts/rough_validation.py`` runs the
+cooling state and the Mpemba crossing time (slow). ``scripts/validation/rough_validation.py`` runs the
 full set (docs page "Rough grains")."""
 
 import math

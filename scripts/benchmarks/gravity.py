@@ -1,0 +1,120 @@
+"""What gravity and a vibrating wall cost per collision: paired in-process comparisons.
+
+Two simulations from the same initial state run in one process, in alternating chunks of
+``--chunk`` pair collisions (A B B A A B ...), so that each pair of chunks shares the
+machine's state; the figure is the median over rounds of the ratio of CPU time per
+collision (pair and wall collisions) of B over A, with the first two chunks of each left
+out as warm-up (compiling is not timed). Scenes:
+
+* ``gravity``: an elastic gas in a periodic box, A without gravity, B falling freely under
+  g along z. Uniform gravity changes no pair collision (the same sequence, shifted by
+  g t^2 / 2), so B does the work of A plus what the flight costs: parabolic streaming, the
+  partners streamed on their flight, the list-expiry bound (lists) or the quadratic face
+  times (cells). g is chosen so that the fall adds ``--fall`` thermal speeds over the
+  timed chunks.
+* ``wall``: an elastic gas between walls on z (thickness ``--slab`` diameters, so that wall
+  collisions are a good share), A with hard walls at rest, B with the lower wall vibrating
+  as a sine (A omega = 0.3 thermal speeds): the contact search and the moving-wall
+  collision. Also the ratio per wall collision: (t_B - t_A) / (wall collisions of B) over
+  the time of A per collision of any kind, i.e. what one wall collision of B costs more in
+  units of a collision of A.
+
+Usage::
+
+    python scripts/benchmarks/gravity.py --n 1e4 1e5 --modes lists cells
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+from granulargas.engine import CollisionRule, Simulation, Wall, Walls
+from granulargas.initial import random_state
+
+
+def _pair(scene, n, mode, packing, fall, slab, seed):
+    rule = CollisionRule.elastic()
+    if scene == "gravity":
+        st = random_state(n, packing, 3, seed=seed)
+        a = Simulation(st, rule, neighbours=mode, remove_drift=False)
+        return a, None, st
+    d = 3
+    side = math.sqrt(n * (math.pi / 6.0) / (packing * slab))
+    st = random_state(n, packing, d, seed=seed, aspect=[side, side, slab],
+                      boundary=("periodic", "periodic", "wall"), margins=[[0, 0], [0, 0], [0.1, 0]])
+    a = Simulation(st, rule, neighbours=mode)
+    b = Simulation(st, rule, neighbours=mode, walls=Walls(z_low=Wall.vibrating(0.05, 0.3 / (2 * math.pi * 0.05))))
+    return a, b, st
+
+
+def measure(scene, n, mode, packing, rounds, chunk, fall, slab, seed):
+    a, b, st = _pair(scene, n, mode, packing, fall, slab, seed)
+    if scene == "gravity":
+        # the time the timed chunks take, from a warm-up of A: g adds ``fall`` thermal speeds over it
+        a.run(math.inf, max_collisions=chunk)
+        span = a.time * (rounds + 1)
+        g = fall * math.sqrt(a.temperature) / span
+        b = Simulation(st, CollisionRule.elastic(), neighbours=mode, remove_drift=False, gravity=[0.0, 0.0, -g])
+        b.run(math.inf, max_collisions=chunk)
+    else:
+        a.run(math.inf, max_collisions=chunk)
+        b.run(math.inf, max_collisions=chunk)
+    sims = (a, b)
+    per = [[], []]
+    walls = [[], []]
+    for r in range(rounds):
+        for k in ((0, 1) if r % 2 == 0 else (1, 0)):
+            s = sims[k]
+            c0, w0 = s.collisions, s.wall_collisions
+            t0 = time.process_time()
+            s.run(math.inf, max_collisions=chunk)
+            dt = time.process_time() - t0
+            per[k].append(dt / (s.collisions - c0 + s.wall_collisions - w0))
+            walls[k].append((s.wall_collisions - w0, dt, s.collisions - c0 + s.wall_collisions - w0))
+    pa, pb = np.array(per[0]), np.array(per[1])
+    ratio = float(np.median(pb / pa))
+    extra = math.nan
+    if scene == "wall":
+        # what one wall collision of B costs more than a collision of A, in collisions of A
+        ext = [(wb[1] - pa_i * wb[2]) / max(wb[0], 1) / pa_i for wb, pa_i in zip(walls[1], pa)]
+        extra = float(np.median(ext))
+    share = float(np.mean([w[0] / w[2] for w in walls[1]]))
+    return ratio, 1.0 / float(np.median(pa)), 1.0 / float(np.median(pb)), share, extra
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenes", nargs="+", default=["gravity", "wall"], choices=("gravity", "wall"))
+    ap.add_argument("--n", type=lambda s: int(float(s)), nargs="+", default=[10000, 100000])
+    ap.add_argument("--modes", nargs="+", default=["lists", "cells"], choices=("lists", "cells"))
+    ap.add_argument("--packing", type=float, default=None, help="default: 0.3 (lists), 0.05 (cells)")
+    ap.add_argument("--rounds", type=int, default=20)
+    ap.add_argument("--chunk", type=int, default=20000)
+    ap.add_argument("--fall", type=float, default=0.3, help="thermal speeds gravity adds over the timed chunks")
+    ap.add_argument("--slab", type=float, default=6.0, help="the wall scene's thickness in diameters")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args(argv)
+    print(f"# load {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}; {args.rounds} rounds "
+          f"of {args.chunk} pair collisions; ratio = CPU time per collision of B / of A (median)")
+    print(f"{'scene':>8} {'mode':>6} {'N':>7} {'packing':>8} {'A M/s':>8} {'B M/s':>8} {'B/A':>7} {'wall share':>10} "
+          f"{'+ per wall coll.':>16}")
+    for scene in args.scenes:
+        for mode in args.modes:
+            for n in args.n:
+                packing = args.packing or (0.3 if mode == "lists" else 0.05)
+                ratio, ra, rb, share, extra = measure(scene, n, mode, packing, args.rounds, args.chunk, args.fall,
+                                                      args.slab, args.seed)
+                print(f"{scene:>8} {mode:>6} {n:>7d} {packing:>8.3g} {ra / 1e6:>8.4f} {rb / 1e6:>8.4f} {ratio:>7.3f} "
+                      f"{share:>10.3f} {extra:>16.3g}", flush=True)
+    print(f"# load {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
