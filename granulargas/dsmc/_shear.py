@@ -226,6 +226,9 @@ def advance_usf(rec, dim, hist, rng, kind, coeffs, until, t_end_window, target, 
     status = DONE
     while True:
         if pi < 0:
+            if k >= end:  # the budget also bounds the candidates that steps 2 and 3 reject
+                status = BUDGET
+                break
             # ---- step 1: candidates until one is accepted with its window bound
             prod = 1.0
             logs = 0.0
@@ -361,9 +364,6 @@ def advance_usf(rec, dim, hist, rng, kind, coeffs, until, t_end_window, target, 
                 inv_rate = 1.0 / (rate_per_bound * bound)
         if coll >= target:
             status = MAX_COLLISIONS
-            break
-        if k >= end:
-            status = BUDGET
             break
     scal[S_TIME] = time
     scal[S_NEXT] = t_next

@@ -393,6 +393,10 @@ class DSMC:
     def _advance_sheared(self, until, target, progress):
         d = self.dimension
         chunk = max(1 << 21, 4 * self.n)
+        # a rebase costs a pass over the particles: at a high shear rate (short windows) the
+        # work between two progress calls is bounded by this many rebases
+        rebases_per_call = max(1, chunk // (4 * self.n))
+        rebases = 0
         sc, isc = self._uscal, self._uiscal
         while True:
             t_w = self._window_end()
@@ -405,6 +409,10 @@ class DSMC:
             if status == _shear.DONE:
                 if sc[_shear.S_TIME] < until:  # the window ended
                     self._rebase(sc[_shear.S_TIME])
+                    rebases += 1
+                    if progress is not None and rebases % rebases_per_call == 0:
+                        self._sync_back()
+                        progress(self)
                     continue
                 break
             if status == _shear.MAX_COLLISIONS:
