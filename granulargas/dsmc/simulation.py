@@ -539,6 +539,8 @@ class DSMC:
                     if self.collisions >= target:
                         break
                     self._rescale()
+                    if progress is not None and self._rescale_step % max(1, (1 << 19) // self.n) == 0:
+                        progress(self)  # a pass over the particles per rescaling: bounded work between calls
             if self.collisions < target:
                 self._advance_sheared(until, target, progress)
             self._sync_back()

@@ -827,8 +827,11 @@ SCHEMA: tuple[Key, ...] = (
         unit="T0", low=SCALE_RANGE[0], high=SCALE_RANGE[1], reason=_SPEED),
     Key("shear", "thermostat_interval", "number",
         "Time between the thermostat's rescalings (with `thermostat_temperature`).",
-        default_text="0.1 of the mean free time at the thermostat temperature", unit="reduced time",
-        low=0.0, low_open=True, high=TIME_MAX, reason=_TIME),
+        default_text="0.1 of the shorter of the mean free time at the thermostat temperature and "
+                     "1 / rate", unit="reduced time",
+        low=0.0, low_open=True, high=TIME_MAX, reason=_TIME,
+        run_check="rate × interval must not exceed 0.5 (the viscous heating would change the "
+                  "temperature by order one between two rescalings)"),
     # [run]
     Key("run", "end_time", "number",
         "Stop at this time (give `end_time`, `collisions_per_particle` or both; the first reached stops).",

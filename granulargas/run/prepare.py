@@ -425,7 +425,9 @@ def sheared_energy_bound(config: RunConfig, prefactor: float, state: State) -> f
 
 def make_shear(config: RunConfig, state: State):
     """(Shear or None, parameters) of the config's ``[shear]``: the thermostat's interval,
-    unless given, 0.1 of the mean free time at its temperature."""
+    unless given, 0.1 of the shorter of the mean free time at its temperature and the
+    shear time 1/rate (so that neither collisions nor the viscous heating change the
+    temperature much between two rescalings)."""
     sh = config.shear
     if sh is None:
         return None, None
@@ -439,7 +441,7 @@ def make_shear(config: RunConfig, state: State):
         sigma, m = mean_particle(config)
         n = float(len(state.radii)) / float(np.prod(state.box))
         omega = float(theory.collision_frequency(n, sh.thermostat_temperature, config.system.dimension, sigma, m))
-        interval = 0.1 / omega
+        interval = 0.1 / max(omega, sh.rate)
     params.update(thermostat_temperature=sh.thermostat_temperature, thermostat_interval=interval,
                   thermostat="the peculiar velocities rescaled to thermostat_temperature at (k + 1/2) interval")
     return Shear(sh.rate, sh.thermostat_temperature, interval), params

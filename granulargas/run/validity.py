@@ -81,7 +81,10 @@ shear rate drives the gas there more slowly than the run lasts: the dilute Grad 
 equations (collision rates times chi) from T0 do not bring T within a factor 1.25 of
 ``T_s`` by ``end_time`` or within ``collisions_per_particle``
 (:func:`granulargas.theory.shear.grad_transient`); and, as any run, when the clock at
-the end cannot resolve the events at ``T_s``.
+the end cannot resolve the events at ``T_s``. A thermostat holds the temperature only
+if the viscous heating changes it little between two rescalings: an interval with
+rate x interval above ``THERMOSTAT_STRAIN_MAX`` is refused (the default interval is
+0.1 of the shorter of the mean free time and 1/rate).
 
 Runner API (one line each, for the run summary)
 -----------------------------------------------
@@ -152,6 +155,10 @@ TC_RATIO_WARN = 0.01
 UNDERFLOW_T = 1e-250
 #: the float64 clock must resolve this fraction of the time between a particle's events
 CLOCK_RESOLUTION = 1e-6
+#: largest shear strain a x thermostat_interval between two rescalings of a thermostatted
+#: shear flow (the viscous heating's relative change of T over one interval is at most
+#: (2/d) a dt |P_xy|/p, and |P_xy| <= p)
+THERMOSTAT_STRAIN_MAX = 0.5
 #: beta above which the viscoelastic force is questionable (contact.material.BETA_VALID_MAX)
 BETA_VALID = 1.0
 
@@ -475,6 +482,13 @@ def _check_sheared(config, gas, scene) -> RunValidity:
         rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, sh.thermostat_temperature,
                          scene=scene, T_steady=float(sh.thermostat_temperature))
         rv.steady = "the thermostat"
+        dt = sh.thermostat_interval
+        if dt is not None and sh.rate * dt > THERMOSTAT_STRAIN_MAX:
+            rv.errors.append(f"{src}: shear.thermostat_interval = {dt:g}: rate x interval = {sh.rate * dt:.3g} > "
+                             f"{THERMOSTAT_STRAIN_MAX:g}: the viscous heating changes the temperature by order one "
+                             f"between two rescalings, so the thermostat does not hold it; give an interval "
+                             f"below {THERMOSTAT_STRAIN_MAX / sh.rate:.3g} (or leave it out) or a lower shear.rate")
+            return rv
         t_end = gas.end_time if gas.end_time is not None else math.nan
         clock = _clock_error(gas, t_end, math.log(sh.thermostat_temperature), "run.end_time")
         if clock:

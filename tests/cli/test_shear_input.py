@@ -69,6 +69,9 @@ BAD = {
                           "the DSMC of uniform shear flow takes identical particles"),
     "rate far from steady in the run time": (_with("rate = 0.114", "rate = 0.001"),
                                              "shear.rate = 0.001: the gas would move from T0 = 1 to its steady T"),
+    "thermostat too sparse for the shear": (_with("rate = 0.114", "rate = 0.114\nthermostat_temperature = 1.0\n"
+                                                                   "thermostat_interval = 5.0"),
+                                            "shear.thermostat_interval = 5: rate x interval = 0.57 > 0.5"),
     "run too short to reach the steady state": (_with("rate = 0.114", "rate = 0.03"), "beyond run.end_time = 200"),
 }
 
