@@ -220,6 +220,7 @@ def _property_advise(mc):
 @example(case("material-3d", ("system", ...), ("collision.material.young_modulus", 2**63 - 1)))  # exit 3
 @example(case("constant-3d", ("particles.mass", 6.666666666666668e49)))  # ValueError in the bracket
 @example(case("viscoelastic-2d", ("collision.damping!", 26.484131033112767)))  # the theory's nodes beyond the table
+@example(case("material-3d", ("system.packing_fraction", 1e-300)))  # cooling curve's clock beyond float64: nan beta
 def test_advise_any_config(mc):
     _property_advise(mc)
 
