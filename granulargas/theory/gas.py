@@ -109,7 +109,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.polynomial.legendre import leggauss
-from scipy.integrate import solve_ivp
 
 from granulargas.contact import restitution_table
 from granulargas.contact.material import pair_constant
@@ -542,6 +541,8 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
         events = cooled
         if not math.isfinite(x_end):
             x_end = 200.0  # t = t_free e^200: the event comes first for any cooling gas
+    from scipy.integrate import solve_ivp  # here, not at the top: a run's start-up loads no scipy
+
     sol = solve_ivp(rhs, (0.0, x_end), y0, method="LSODA", rtol=rtol, atol=atol, dense_output=True, events=events)
     if sol.status < 0:
         raise RuntimeError(f"cooling_curve: the ODE solver failed ({sol.message})")
