@@ -134,7 +134,8 @@ class Result:
 
 def observable_columns(observables: dict, source="observables", species=None) -> dict:
     """Columns of the observables table from :func:`granulargas.io.h5md.read_observables`:
-    ``time``, ``step`` and one column per scalar observable (one per axis for a vector; a
+    ``time``, ``step`` and one column per scalar observable (one per axis for a vector; the
+    pressure tensor's independent components, ``pressure_tensor_xx``, ``pressure_tensor_xy``, ...; a
     mixture's per species, ``species_temperature_<name>``, and per pair of species,
     ``species_collisions_<a>_<b>``, with the species' ``species`` names or their indices).
 
@@ -150,7 +151,10 @@ def observable_columns(observables: dict, source="observables", species=None) ->
         if not (np.array_equal(t, time[:n]) and np.array_equal(s, step[:n])):
             raise InputFileError(f"{source}: observables/{name} is not sampled on the clock of the others")
         value = np.asarray(value)
-        if name.startswith("species_") and value.ndim >= 2:  # per species, per pair of species
+        if name == "pressure_tensor" and value.ndim == 3:  # one column per independent component
+            d = value.shape[1]
+            parts = {f"{name}_{AXES[a]}{AXES[b]}": value[:, a, b] for a in range(d) for b in range(a, d)}
+        elif name.startswith("species_") and value.ndim >= 2:  # per species, per pair of species
             label = list(species) if species is not None else [str(k) for k in range(value.shape[1])]
             parts = ({f"{name}_{label[k]}": value[:, k] for k in range(value.shape[1])} if value.ndim == 2 else
                      {f"{name}_{label[a]}_{label[b]}": value[:, a, b] for a in range(value.shape[1])

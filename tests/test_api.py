@@ -63,7 +63,10 @@ def test_observables_table_holds_the_files_numbers(result):
     # a vector observable: one column per axis
     np.testing.assert_array_equal(df[["momentum_x", "momentum_y"]].to_numpy(), raw["momentum"][2])
     assert "momentum" not in df.columns and "momentum_z" not in df.columns
-    assert set(raw) - {"momentum"} <= set(df.columns)
+    assert set(raw) - {"momentum", "pressure_tensor"} <= set(df.columns)
+    # the pressure tensor: one column per independent component
+    np.testing.assert_array_equal(df["pressure_tensor_xy"].to_numpy(), raw["pressure_tensor"][2][:, 0, 1])
+    assert "pressure_tensor_yx" not in df.columns
     # the run's last sample is its end, with the summary's temperature
     assert df.index[-1] == 3.0 and math.isclose(df["temperature"].iloc[-1], result.summary.final_temperature)
     # the dict readers stay

@@ -18,6 +18,7 @@ from granulargas.analysis.driven import analyze_driven
 from granulargas.analysis.elastic import analyze_elastic
 from granulargas.analysis.rough import analyze_rough
 from granulargas.analysis.run import RunInfo, analyze_cooling
+from granulargas.analysis.shear import analyze_shear
 from granulargas.analysis.vibrated import analyze_vibrated
 from granulargas.errors import InputFileError
 from granulargas.io.scene import MODELS
@@ -29,6 +30,7 @@ ANALYSES = {
     "cooling": analyze_cooling,
     "elastic": analyze_elastic,
     "driven": analyze_driven,
+    "shear": analyze_shear,
     "vibrated": analyze_vibrated,
     "rough": analyze_rough,
 }

@@ -17,7 +17,7 @@ from granulargas.analysis.run import A2_ERROR_METHOD
 from granulargas.theory.hcs import FIRST_SONINE
 
 __all__ = ["PLOTS", "plot_analysis", "ratio_limits", "plot_cooling", "plot_density_profiles", "plot_driven", "plot_elastic",
-           "plot_rough", "plot_sweep", "plot_vibrated"]
+           "plot_rough", "plot_shear", "plot_sweep", "plot_vibrated"]
 
 
 def _plt():
@@ -368,6 +368,57 @@ def plot_driven(analysis, path):
 PLOTS["driven"] = plot_driven
 
 
+def plot_shear(analysis, path):
+    """T(t) of a sheared run with the steady part marked, and the steady reduced quantities
+    (a*, eta*, P_ii/p) against the Grad solution.
+
+    Parameters
+    ----------
+    analysis : granulargas.analysis.shear.ShearAnalysis
+    path : str or Path
+    """
+    plt = _plt()
+    a, info = analysis, analysis.info
+    s = a.summary()
+    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.2), gridspec_kw={"width_ratios": [1.2, 1.0]})
+    ax = axes[0]
+    ax.plot(a.time, a.temperature, "-", color="C0", lw=1, label="simulation")
+    T_th = a.theory.temperature
+    if math.isfinite(T_th):
+        ax.axhline(T_th, color="k", lw=1.0, ls="--", label=f"Grad steady T = {T_th:.4g}")
+    if s.get("T_steady") is not None:
+        e = s.get("T_steady_error") or 0.0
+        ax.axhspan(s["T_steady"] - e, s["T_steady"] + e, color="C0", alpha=0.25, lw=0,
+                   label=f"steady mean {s['T_steady']:.4g} $\\pm$ {e:.2g}")
+    ax.axvline(a.t_relaxed, color="0.7", lw=0.8, ls=":")
+    _no_offset(ax)
+    ax.set_xlabel(f"time t; steady from t = {a.t_relaxed:.3g}")
+    ax.set_ylabel("temperature T (peculiar)")
+    ax.legend(fontsize=7.5, framealpha=0.7)
+    ax = axes[1]
+    keys = [("a_star", "$a^*$"), ("eta_star", "$\\eta^*$"), ("P_xx_over_p", "$P_{xx}/p$"), ("P_yy_over_p", "$P_{yy}/p$")]
+    if info.dimension == 3:
+        keys.append(("P_zz_over_p", "$P_{zz}/p$"))
+    keys.append(("P_xy_over_p", "$P_{xy}/p$"))
+    x = np.arange(len(keys))
+    sim = np.array([s.get(k) if s.get(k) is not None else np.nan for k, _ in keys], dtype=float)
+    err = np.array([s.get(k + "_error") or 0.0 for k, _ in keys], dtype=float)
+    th = np.array([s.get(k + "_theory") if s.get(k + "_theory") is not None else np.nan for k, _ in keys],
+                  dtype=float)
+    ax.errorbar(x - 0.1, sim, yerr=err, fmt="o", color="C0", ms=5, capsize=3, label="simulation (steady)")
+    ax.plot(x + 0.1, th, "s", color="k", ms=5, mfc="none", label="Grad solution")
+    ax.axhline(0.0, color="0.8", lw=0.5)
+    ax.set_xticks(x)
+    ax.set_xticklabels([lab for _, lab in keys])
+    ax.legend(fontsize=7.5, framealpha=0.7)
+    held = "viscous heating = loss" if a.thermostat is None else f"thermostat T = {a.thermostat:g}"
+    fig.suptitle(_title(info, f"Uniform shear flow, a = {a.rate:.3g} ({held}) against the Grad solution"), fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def plot_vibrated(analysis, path):
     """Figure of a :class:`granulargas.analysis.vibrated.VibratedAnalysis`: the density profile
     (with the hydrostatic one for an elastic gas on a thermal floor), the temperature profile
@@ -480,6 +531,7 @@ def plot_rough(analysis, path):
 
 PLOTS["vibrated"] = plot_vibrated
 PLOTS["rough"] = plot_rough
+PLOTS["shear"] = plot_shear
 
 
 def plot_density_profiles(info, walls: dict, path):

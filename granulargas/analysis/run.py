@@ -249,10 +249,11 @@ def _mean_particle_mass(radii, masses, dim) -> float:
 
 
 def run_kind(info: RunInfo) -> str:
-    """``"vibrated"`` (gravity, thermal or vibrating walls; rough particles too),
-    ``"rough"`` (rough particles, cooling or driven: :mod:`granulargas.analysis.rough`),
-    ``"driven"`` (white-noise driving), ``"elastic"`` (energy conserved: eps = 1 or damping
-    0), ``"cooling"``, or ``"unknown"`` (the file does not record its collision model, :class:`granulargas.io.scene.Scene`)."""
+    """``"shear"`` (uniform shear flow), ``"vibrated"`` (gravity, thermal or vibrating walls;
+    rough particles too), ``"rough"`` (rough particles, cooling or driven:
+    :mod:`granulargas.analysis.rough`), ``"driven"`` (white-noise driving), ``"elastic"``
+    (energy conserved: eps = 1 or damping 0), ``"cooling"``, or ``"unknown"`` (the file does
+    not record its collision model, :class:`granulargas.io.scene.Scene`)."""
     if info.scene.rough and info.scene.model != "unknown" and info.scene.kind != "vibrated":
         return "rough"
     return info.scene.kind
@@ -266,6 +267,8 @@ def theory_name(info: RunInfo) -> str:
         return f"Enskog, {eos} equation of state"
     if info.kind == "driven":
         return "Enskog, driven steady state (zeta(T) T = H)"
+    if info.kind == "shear":
+        return "Grad solution of uniform shear flow (theory.shear)"
     if info.model == "viscoelastic":
         return (f"moment equations of the Enskog-Boltzmann equation, first Sonine, exact eps(g) "
                 f"(Brilliantov & Pöschel 2000); chi from {eos}")

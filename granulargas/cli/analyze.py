@@ -77,8 +77,9 @@ def _header(info) -> list[str]:
         + (f" (damping {info.damping:.4g})" if info.damping is not None else ""),
     ]
     if info.method == "dsmc":
-        lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; the pressure is not "
-                     "sampled)")
+        lines.append("  method = dsmc: the homogeneous Enskog-Boltzmann equation (no positions; "
+                     + ("uniform shear flow in the Lagrangian frame)" if info.scene.kind == "shear"
+                        else "the pressure is not sampled)"))
     if info.scene.shows("polydisperse_theory"):
         lines.append(f"  note: polydisperse run (solid fraction {info.solid_fraction:.4g}); the theory below is that of "
                      f"identical particles of the mean diameter {info.diameter:.4g} and its mass {info.mass:.4g} at the "
@@ -246,6 +247,33 @@ def driven_report(a, rows: int = 10) -> str:
     return "\n".join(lines)
 
 
+def shear_report(a, rows: int = 10) -> str:
+    """Text report of a :class:`granulargas.analysis.shear.ShearAnalysis`."""
+    s = a.summary()
+    lines = _header(a.info)
+    held = ("viscous heating balances the collisional loss" if a.thermostat is None
+            else f"Gaussian thermostat at T = {a.thermostat:g}, rescaling the peculiar velocities")
+    lines.append(f"  uniform shear flow: rate a = {a.rate:.5g} (flow along x, gradient along y); {held}")
+    lines.append(f"  theory: {a.theory_name}")
+    lines.append(f"  steady state from t = {a.t_relaxed:.4g} ({s['samples']} intervals; errors from block means)")
+    lines.append(f"  {'quantity':<22} {'simulation':>22} {'theory':>10}")
+    names = [("T", "T_steady"), ("a* = a / nu0", "a_star"), ("eta* = -P_xy/(a eta0)", "eta_star"),
+             ("P_xx / p", "P_xx_over_p"), ("P_yy / p", "P_yy_over_p")]
+    if a.info.dimension == 3:
+        names.append(("P_zz / p", "P_zz_over_p"))
+    names += [("P_xy / p", "P_xy_over_p"), ("(P_xx - P_yy) / p", "N1")]
+    if a.info.dimension == 3:
+        names.append(("(P_yy - P_zz) / p", "N2"))
+    names.append(("p / (n T)", "Z"))
+    for label, key in names:
+        lines.append(f"  {label:<22} {_pm(s.get(key), s.get(key + '_error')):>22} {_fmt(s.get(key + '_theory'), '.5g'):>10}"
+                     f"{_dev(s.get(key), s.get(key + '_theory'))}")
+    lines.append(f"  Navier-Stokes eta* (first Sonine, a* -> 0): {_fmt(s.get('eta_star_navier_stokes'), '.5g')}")
+    lines.append(f"  energy balance (per unit time): viscous heating -a P_xy V = {_fmt(s.get('viscous_heating'), '.6g')}, "
+                 f"dissipation {_fmt(s.get('dissipation_rate'), '.6g')}, thermostat {_fmt(s.get('thermostat_removal'), '.6g')}")
+    return "\n".join(lines)
+
+
 def vibrated_report(a, rows: int = 10) -> str:
     """Text report of a :class:`granulargas.analysis.vibrated.VibratedAnalysis`."""
     s = a.summary()
@@ -326,7 +354,7 @@ def rough_report(a, rows: int = 10) -> str:
 
 #: kind -> text report ``f(analysis, rows) -> str``
 REPORTS = {"cooling": cooling_report, "elastic": elastic_report, "driven": driven_report, "rough": rough_report,
-           "vibrated": vibrated_report}
+           "shear": shear_report, "vibrated": vibrated_report}
 
 
 def walls_report(w: dict) -> str:

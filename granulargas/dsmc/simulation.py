@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from granulargas import theory
-from granulargas.dsmc import _loop
+from granulargas.dsmc import _loop, _shear
 from granulargas.dsmc._majorant import build_histogram, class_edge, largest_component, new_histogram, top_classes
 from granulargas.dsmc._random import STATE_WORDS, seed_state
 from granulargas.engine._drive import kick_scale, kick_velocities
@@ -31,6 +31,7 @@ from granulargas.engine.tangential import (
     spin_kick_scale,
     spins_of,
 )
+from granulargas.engine.shear import Shear
 from granulargas.errors import ConfigError, SimulationError, TableRangeError
 from granulargas.observables import energy_moments, kinetic_energy_momentum
 from granulargas.state import PARTICLE_FIELDS, DSMCContinuation, State
@@ -116,7 +117,8 @@ class DSMC:
 
     def __init__(self, state: State, rule: CollisionRule, *, number_density: float | None = None,
                  packing_fraction: float | None = None, volume: float | None = None, chi: float | None = None,
-                 seed: int = 0, driving: WhiteNoise | None = None, tangential: TangentialRule | None = None):
+                 seed: int = 0, driving: WhiteNoise | None = None, shear: Shear | None = None,
+                 tangential: TangentialRule | None = None):
         if not isinstance(state, State):
             raise TypeError("state must be a granulargas.state.State")
         state.check_shapes()
@@ -151,6 +153,7 @@ class DSMC:
         if "wall" in state.boundary:
             raise ConfigError(f"boundary = {list(state.boundary)}: the DSMC simulates a homogeneous gas, "
                               f"without walls")
+        self._boundary = state.boundary
         time, collisions, dissipated_energy = state.time, state.collisions, state.dissipated_energy
         kick_step, injected_energy = state.kick_step, state.injected_energy
         cont = state.dsmc
@@ -273,6 +276,7 @@ class DSMC:
                 scal[_loop.S_NEXT] = cont.pending_time
         self.frame_velocity = frame
         self._rng = rng
+        self.shear = shear
         # rough particles: spins (N, 3) in id order and the tangential law (None: smooth)
         self._spins = None
         if tangential is not None:
@@ -309,12 +313,195 @@ class DSMC:
             if tangential is not None:
                 self._kick_inertia = self._kappa * mas * rad**2
                 self._spin_kick_scale = spin_kick_scale(driving, d)
+        if shear is not None:
+            if tangential is not None:
+                raise ConfigError("shear: rough particles (a tangential rule) are not available in the DSMC of "
+                                  "uniform shear flow")
+            self._init_shear(shear, chi, sigma_max, r0, m0, eps, pref, inv_h, driving)
 
     # ------------------------------------------------------------------ helpers
     def _rate(self):
         """Current majorant rate Lambda (candidates per unit time)."""
         k1, k2 = top_classes(self._hist, self._iscal[_loop.I_TOP])
         return self._scal[_loop.S_RATE] * (class_edge(k1) + class_edge(k2))
+
+    # ------------------------------------------------------------------ shear
+    def _init_shear(self, shear, chi, sigma_max, r0, m0, eps, pref, inv_h, driving):
+        """The uniform shear flow's loop state (:mod:`granulargas.dsmc._shear`)."""
+        if not isinstance(shear, Shear):
+            raise TypeError("shear must be a granulargas.engine.shear.Shear or None")
+        if not self._mono or self._species is not None:
+            raise ConfigError("shear: the DSMC of uniform shear flow takes identical particles (one diameter "
+                              "and mass, no species table)")
+        if driving is not None:
+            raise ConfigError("shear: the DSMC of uniform shear flow takes no white-noise driving (use the "
+                              "shear's thermostat)")
+        d, n = self.dimension, self.n
+        scal = np.zeros(_shear.N_SCAL)
+        scal[_shear.S_TIME] = self._scal[_loop.S_TIME]
+        scal[_shear.S_NEXT] = self._scal[_loop.S_NEXT]
+        scal[_shear.S_DISSIPATED] = self._scal[_loop.S_DISSIPATED]
+        scal[_shear.S_RATE] = self._scal[_loop.S_RATE]
+        scal[_shear.S_REF] = self._scal[_loop.S_TIME]
+        scal[_shear.S_SHEAR] = shear.rate
+        scal[_shear.S_SIGMA] = sigma_max
+        scal[_shear.S_EPS] = eps
+        scal[_shear.S_PREFACTOR] = pref
+        scal[_shear.S_INV_H] = inv_h
+        scal[_shear.S_MASS] = m0
+        scal[_shear.S_C] = _shear.C_OVER_B[d] * shear.rate * sigma_max
+        iscal = np.zeros(_shear.N_ISCAL, dtype=np.int64)
+        for a, b in ((_shear.I_COLLISIONS, _loop.I_COLLISIONS), (_shear.I_CANDIDATES, _loop.I_CANDIDATES),
+                     (_shear.I_TOP, _loop.I_TOP), (_shear.I_PENDING_I, _loop.I_PENDING_I),
+                     (_shear.I_PENDING_J, _loop.I_PENDING_J)):
+            iscal[a] = self._iscal[b]
+        iscal[_shear.I_ERR_I] = iscal[_shear.I_ERR_J] = -1
+        self._uscal, self._uiscal = scal, iscal
+        if iscal[_shear.I_PENDING_I] >= 0:  # a state's pending candidate: the sheared majorant restarts
+            iscal[_shear.I_PENDING_I] = iscal[_shear.I_PENDING_J] = -1
+            scal[_shear.S_NEXT] = math.nan
+        self._tensor_start = float(scal[_shear.S_TIME])
+        self._stress = np.zeros(18)
+        _shear.stress_sums(self._rec, d, m0, shear.rate, 0.0, self._stress)
+        self._rescale_step = shear.first_step(self.time)
+        self._injected_shear = float(self._injected)
+
+    def _window_end(self):
+        return self._uscal[_shear.S_REF] + _shear.WINDOW / self.shear.rate
+
+    def _rebase(self, t):
+        """Stored velocities brought to time t (eq. (U1) of dsmc._shear), the pending candidate
+        dropped (the majorant restarts at t: exact)."""
+        sc = self._uscal
+        d = self.dimension
+        self._uiscal[_shear.I_TOP] = _shear.rebase(self._rec, d, self.shear.rate, t - sc[_shear.S_REF], self._hist)
+        sc[_shear.S_REF] = t
+        k = self._stress[6:].copy()
+        _shear.stress_sums(self._rec, d, self._m0, self.shear.rate, 0.0, self._stress)
+        self._stress[6:] = k
+        self._uiscal[_shear.I_PENDING_I] = self._uiscal[_shear.I_PENDING_J] = -1
+        sc[_shear.S_NEXT] = math.nan
+        self._uiscal[_shear.I_REBASES] += 1
+
+    def synchronise(self) -> "DSMC":
+        """Under shear: bring the stored velocities to ``time`` and restart the majorant there
+        (what ``DSMC(dsmc.state, ...)`` does, so that the two continue alike); otherwise nothing."""
+        if self.shear is not None and self._uscal[_shear.S_REF] != self.time:
+            self._rebase(self.time)
+        return self
+
+    def _advance_sheared(self, until, target, progress):
+        d = self.dimension
+        chunk = max(1 << 21, 4 * self.n)
+        # a rebase costs a pass over the particles: at a high shear rate (short windows) the
+        # work between two progress calls is bounded by this many rebases
+        rebases_per_call = max(1, chunk // (4 * self.n))
+        rebases = 0
+        sc, isc = self._uscal, self._uiscal
+        while True:
+            t_w = self._window_end()
+            status = _shear.advance_usf(self._rec, d, self._hist, self._rng, self._kind, self._coeffs, until, t_w,
+                                        target, chunk, self._ring, sc, isc, self._stress)
+            if status == _shear.BUDGET:
+                if progress is not None:
+                    progress(self)
+                continue
+            if status == _shear.DONE:
+                if sc[_shear.S_TIME] < until:  # the window ended
+                    self._rebase(sc[_shear.S_TIME])
+                    rebases += 1
+                    if progress is not None and rebases % rebases_per_call == 0:
+                        self._sync_back()
+                        progress(self)
+                    continue
+                break
+            if status == _shear.MAX_COLLISIONS:
+                break
+            self._raise_sheared(status)
+
+    def _raise_sheared(self, status):
+        i, j = int(self._uiscal[_shear.I_ERR_I]), int(self._uiscal[_shear.I_ERR_J])
+        where = f"at t = {self.time:.12g} after {self.collisions} collisions (particles {[i, j]})"
+        if status == _shear.TABLE_RANGE:
+            raise TableRangeError(f"impact beyond the restitution table {where}: build the table "
+                                  f"with a larger beta_max")
+        raise SimulationError(f"DSMC status {status} {where}")
+
+    def _rescale(self):
+        """The thermostat's step at its time: peculiar velocities scaled to its temperature."""
+        sh = self.shear
+        t = (self._rescale_step + 0.5) * sh.interval
+        sc = self._uscal
+        # the stress integrals up to t, then the velocities at t
+        self._integrate_stress(t - sc[_shear.S_TIME])
+        sc[_shear.S_TIME] = t
+        self._rebase(t)
+        v = self._rec[:, : self.dimension]
+        e2 = float(np.sum(v * v)) * self._m0
+        target = sh.temperature * self.dimension * self.n
+        lam = math.sqrt(target / e2) if e2 > 0 else 1.0
+        self._rec[:, : self.dimension] *= lam
+        self._injected_shear += 0.5 * (target - e2)
+        self._stress[:6] *= lam * lam
+        self._uiscal[_shear.I_TOP] = build_histogram(self._rec, self.dimension, self._hist)
+        self._rescale_step += 1
+        self._sync_back()
+
+    def _integrate_stress(self, dt):
+        """The kinetic sums over dt of free flight (dsmc._shear eq. (U1)), as the loop does."""
+        st, a = self._stress, self.shear.rate
+        ad = a * dt
+        s0, s1, s2, s3, s4, s5 = st[:6]
+        st[6:12] += np.array([s0 - ad * s3 + ad * ad * s1 / 3.0, s1, s2, s3 - 0.5 * ad * s1, s4 - 0.5 * ad * s5,
+                              s5]) * dt
+        st[0] = s0 + (-2.0 * s3 + ad * s1) * ad
+        st[3] = s3 - ad * s1
+        st[4] = s4 - ad * s5
+
+    def _sync_back(self):
+        """The sheared loop's counters into the ones the properties read."""
+        sc, isc = self._uscal, self._uiscal
+        self._scal[_loop.S_TIME] = sc[_shear.S_TIME]
+        self._scal[_loop.S_NEXT] = sc[_shear.S_NEXT]
+        self._scal[_loop.S_DISSIPATED] = sc[_shear.S_DISSIPATED]
+        for a, b in ((_shear.I_COLLISIONS, _loop.I_COLLISIONS), (_shear.I_CANDIDATES, _loop.I_CANDIDATES),
+                     (_shear.I_TOP, _loop.I_TOP), (_shear.I_PENDING_I, _loop.I_PENDING_I),
+                     (_shear.I_PENDING_J, _loop.I_PENDING_J)):
+            self._iscal[b] = isc[a]
+        self._injected = self._injected_shear
+
+    def _current_rec(self):
+        """The velocity rows at ``time`` (under shear the stored ones moved by eq. (U1))."""
+        if self.shear is None:
+            return self._rec
+        rec = self._rec.copy()
+        rec[:, 0] -= self.shear.rate * (self.time - self._uscal[_shear.S_REF]) * rec[:, 1]
+        return rec
+
+    def _shear_velocities(self):
+        """V(time) of the stored V(t_r), eq. (U1)."""
+        v = self._rec[:, : self.dimension].copy()
+        v[:, 0] -= self.shear.rate * (self.time - self._uscal[_shear.S_REF]) * v[:, 1]
+        return v
+
+    def pressure_tensor_window(self) -> np.ndarray:
+        """Under shear: the mean pressure tensor (d, d) since the previous call (or construction),
+        kinetic (peculiar velocities) plus collisional transfer, then reset (dsmc._shear)."""
+        if self.shear is None:
+            raise ConfigError("pressure_tensor_window: the DSMC keeps the pressure tensor under shear only")
+        t = self.time
+        dt = t - self._tensor_start
+        self._tensor_start = t
+        k = self._stress[6:12].copy()
+        w = self._stress[12:18].copy()
+        self._stress[6:] = 0.0
+        d = self.dimension
+        if dt <= 0:
+            return np.full((d, d), np.nan)
+        full = np.empty((3, 3))
+        for q, (a, b) in enumerate(((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))):
+            full[a, b] = full[b, a] = k[q] + w[q]
+        return full[:d, :d] / (self.volume * dt)
 
     # ---------------------------------------------------------------------- run
     def run(self, until: float, max_collisions: int | None = None, progress=None) -> "DSMC":
@@ -341,7 +528,23 @@ class DSMC:
             raise ValueError("run(until=inf) needs max_collisions")
         start_time, start_coll, start_cand = self.time, self.collisions, self.candidates
         target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
-        if self.driving is not None:
+        if self.shear is not None:
+            sh = self.shear
+            if sh.thermostat:
+                while (self._rescale_step + 0.5) * sh.interval <= until:
+                    t_r = (self._rescale_step + 0.5) * sh.interval
+                    if t_r > self.time:
+                        self._advance_sheared(t_r, target, progress)
+                        self._sync_back()
+                    if self.collisions >= target:
+                        break
+                    self._rescale()
+                    if progress is not None and self._rescale_step % max(1, (1 << 19) // self.n) == 0:
+                        progress(self)  # a pass over the particles per rescaling: bounded work between calls
+            if self.collisions < target:
+                self._advance_sheared(until, target, progress)
+            self._sync_back()
+        elif self.driving is not None:
             dt = self.driving.interval
             while (self._kick_step + 0.5) * dt <= until:
                 t_kick = (self._kick_step + 0.5) * dt
@@ -350,7 +553,7 @@ class DSMC:
                 if self.collisions >= target:
                     break
                 self._kick()
-        if self.collisions < target:
+        if self.collisions < target and self.shear is None:
             self._advance(until, target, progress)
         dt = self.time - start_time
         dc = self.collisions - start_coll
@@ -436,8 +639,9 @@ class DSMC:
 
     @property
     def velocities(self) -> np.ndarray:
-        """Peculiar velocities (N, d), centre-of-mass frame (a copy)."""
-        return self._rec[:, : self.dimension].copy()
+        """Peculiar velocities (N, d), centre-of-mass frame (a copy; under shear relative to the
+        flow, at ``time``)."""
+        return self._current_rec()[:, : self.dimension].copy()
 
     @property
     def radii(self) -> np.ndarray:
@@ -452,10 +656,12 @@ class DSMC:
         """What continues this run bit for bit besides velocities, clock and counters:
         random words, position in the pair stream, the pending collision (already drawn)
         and the frame velocity (:class:`granulargas.state.DSMCContinuation`)."""
+        pending = (int(self._iscal[_loop.I_PENDING_I]), int(self._iscal[_loop.I_PENDING_J]))
+        if self.shear is not None:  # as synchronise() leaves it: the majorant restarts at time
+            pending = (-1, -1)
         return DSMCContinuation(
             rng=self._rng.copy(), candidates=self.candidates, frame_velocity=self.frame_velocity.copy(),
-            pending_pair=(int(self._iscal[_loop.I_PENDING_I]), int(self._iscal[_loop.I_PENDING_J])),
-            pending_time=float(self._scal[_loop.S_NEXT]))
+            pending_pair=pending, pending_time=float(self._scal[_loop.S_NEXT]) if pending[0] >= 0 else math.nan)
 
     @property
     def state(self) -> State:
@@ -468,6 +674,7 @@ class DSMC:
                      time=self.time, collisions=self.collisions, events=self.collisions,
                      dissipated_energy=self.dissipated_energy, injected_energy=self.injected_energy,
                      kick_step=None if self.driving is None else self.kick_step, dsmc=self.continuation,
+                     boundary=self._boundary,
                      species_collisions=self.species_collisions,
                      **({} if self._spins is None else {"angular_velocities": self.angular_velocities,
                                                         "inertia": self._kappa.copy()}),
@@ -513,17 +720,18 @@ class DSMC:
 
     # ------------------------------------------------------------- observables
     def _moments(self):
-        return energy_moments(self._rec, self.dimension, self._mass_arg)
+        return energy_moments(self._current_rec(), self.dimension, self._mass_arg)
 
     @property
     def kinetic_energy(self) -> float:
         """Kinetic energy of the peculiar motion, sum m c^2 / 2."""
-        return float(kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)[0])
+        return float(kinetic_energy_momentum(self._current_rec(), self.dimension, self._mass_arg)[0])
 
     @property
     def momentum(self) -> np.ndarray:
         """Total momentum (d,) in the centre-of-mass frame: zero up to rounding."""
-        return np.array(kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)[1:1 + self.dimension])
+        return np.array(kinetic_energy_momentum(self._current_rec(), self.dimension,
+                                                self._mass_arg)[1:1 + self.dimension])
 
     @property
     def temperature(self) -> float:

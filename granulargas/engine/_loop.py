@@ -107,6 +107,25 @@ from granulargas.engine._flight import expiry_delay, pair_delay, partner_at, str
 from granulargas.engine._geometry import collision_delay, min_image, wall_delay
 from granulargas.engine._prefetch import prefetch
 from granulargas.engine._resolved import resolved_pair
+from granulargas.engine._shear import (
+    cross_le,
+    integrate_stress,
+    le_separation,
+    le_wrap,
+    next_rescale,
+    next_slide,
+    peculiar_x,
+    predict_crossing_le,
+    predict_expiry_le,
+    predict_pair_cells_le,
+    predict_pair_le,
+    rebuild_list_le,
+    scan_new_layer_le,
+    slide_scan,
+    stress_jump,
+    stress_sums,
+    stress_virial,
+)
 from granulargas.engine._species import count_pair, pair_law, wall_law
 from granulargas.engine._spin import kick_spins, rough_pair, rough_wall
 from granulargas.engine._walls import (
@@ -353,8 +372,32 @@ def settle_event(i, t, best, p, tag, rec, events, space, flight, wallkinds):
     return best
 
 
+@inlined
+def predict_sheared(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, shear):
+    """:func:`predict` under Lees-Edwards boundaries (:mod:`granulargas.engine._shear`: list
+    centres and cells in the frames of sliding rows, pairs through the sheared images)."""
+    best = math.inf
+    kind = np.int64(EXPIRY)
+    tag = np.int64(0)
+    p = np.int64(-1)
+    if onlists is not None:
+        best = predict_expiry_le(i, t, rec, lists.centre, space.period, half_shell, shear)
+        best, p = predict_pair_le(i, t, best, rec, lists.nbl, lists.nbn, space.period, shear)
+    if oncells is not None:
+        best, face = predict_crossing_le(i, t, rec, lists, space, shear)
+        kind = np.int64(CROSS)
+        tag = np.int64(face)
+        best, p = predict_pair_cells_le(i, t, best, rec, count, lists, space, shear)
+    if p >= 0:
+        tag = np.int64(count[p])
+    else:
+        p = kind
+    return settle_event(i, t, best, p, tag, rec, events, space, None, None)
+
+
 @kernel(python=False)
-def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight, wallkinds):
+def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight, wallkinds,
+            shear):
     """Earliest event of particle i (streamed to t); sets its slot and returns the time.
 
     ``lists`` is the neighbour lists (``onlists`` = 1, ``oncells`` = None) or the cell
@@ -369,7 +412,12 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
 
     ``flight`` (None: straight; gravity: the (3,) acceleration) and ``wallkinds`` (None:
     hard walls at rest; else a :class:`~granulargas.engine._state.WallSpec`): numba removes
-    their branches for None, as for the mode flags."""
+    their branches for None, as for the mode flags.
+
+    ``shear`` (Lees-Edwards; None otherwise): :func:`predict_sheared` (straight flights and
+    hard walls only: gravity and wall kinds are refused with shear)."""
+    if shear is not None:
+        return predict_sheared(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, shear)
     best = math.inf
     kind = np.int64(EXPIRY)
     tag = np.int64(0)
@@ -395,9 +443,11 @@ def predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell
 
 
 @inlined
-def predict_listed(i, t, rec, count, events, lists, space, half_shell, contacts, flight, wallkinds):
+def predict_listed(i, t, rec, count, events, lists, space, half_shell, contacts, flight, wallkinds, shear):
     """:func:`predict` in the neighbour-list mode, inlined into the loop's two hot sites
     (the particle of the event and its collision partner; ``predict`` itself is a call)."""
+    if shear is not None:
+        return predict_sheared(i, t, rec, count, events, lists, 1, None, space, half_shell, shear)
     best = predict_expiry(i, t, rec, lists.centre, space.period, half_shell, flight)
     tag = np.int64(0)
     if in_contact(contacts, i, t):
@@ -412,12 +462,14 @@ def predict_listed(i, t, rec, count, events, lists, space, half_shell, contacts,
 
 
 @inlined_ir
-def predict_cells(i, t, rec, count, events, grid, space, flight, wallkinds):
+def predict_cells(i, t, rec, count, events, grid, space, flight, wallkinds, shear):
     """:func:`predict` in the cell-crossing mode (no contacts there), for the loop to inline
     at its two hot sites, the event's own particle and a collision partner: the crossing,
     the best pair (the stored one right after a crossing of i, else the scan of the cells
     around i), the walls. (Inlined at the partner too it costs ~0.4 s of first compile and
     saves 1-4 % of the run time at packing 0.05-0.1.)"""
+    if shear is not None:
+        return predict_sheared(i, t, rec, count, events, grid, None, 1, space, 0.0, shear)
     best, face = predict_crossing(i, t, rec, grid, space, flight)
     tag = np.int64(face)
     p = np.int64(CROSS)
@@ -430,11 +482,11 @@ def predict_cells(i, t, rec, count, events, grid, space, flight, wallkinds):
 
 @kernel
 def predict_all(t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight, wallkinds,
-                times):
+                shear, times):
     """Predict the event of every particle (all clocks at t) into ``times``."""
     for i in range(rec.shape[0]):
         times[i] = predict(i, t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight,
-                           wallkinds)
+                           wallkinds, shear)
 
 
 # --------------------------------------------------------------------- execute
@@ -449,7 +501,7 @@ def _collapse_watch(i, te, p, prm):
 
 
 @inlined_ir
-def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins, species):
+def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress, spins, species):
     """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
 
     Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
@@ -459,6 +511,8 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     collisions, which are also frictionless. With ``species`` (a mixture; None otherwise) the
     pair's normal law comes from the species table and the collision is counted per pair of
     species (:mod:`granulargas.engine._species`); the tangential law is the same for every pair.
+    ``shear``: the pair through its nearest Lees-Edwards image; ``stress``: the pressure tensor's
+    sums take the collision (smooth particles only).
     """
     rec = p.rec
     period = prm.space.period
@@ -467,12 +521,15 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     wallkinds = prm.wallkinds
     stream(i, te, rec, p.img, period, flight)
     stream(j, te, rec, p.img, period, flight)
-    dx = min_image(rec[i, 0] - rec[j, 0], period[0])
-    dy = min_image(rec[i, 1] - rec[j, 1], period[1])
-    dz = min_image(rec[i, 2] - rec[j, 2], period[2])
-    ux = rec[i, 3] - rec[j, 3]
-    uy = rec[i, 4] - rec[j, 4]
-    uz = rec[i, 5] - rec[j, 5]
+    if shear is not None:
+        dx, dy, dz, ux, uy, uz = le_separation(i, j, te, rec, period, shear)
+    else:
+        dx = min_image(rec[i, 0] - rec[j, 0], period[0])
+        dy = min_image(rec[i, 1] - rec[j, 1], period[1])
+        dz = min_image(rec[i, 2] - rec[j, 2], period[2])
+        ux = rec[i, 3] - rec[j, 3]
+        uy = rec[i, 4] - rec[j, 4]
+        uz = rec[i, 5] - rec[j, 5]
     b = dx * ux + dy * uy + dz * uz
     if b >= 0.0:  # receding (round-off): nothing happens
         return DONE
@@ -508,6 +565,10 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
             c.sum_mv2 -= 2.0 * drot
         else:
             fi, fj, loss, impulse = pair_collision(un, mi, mj, eps)
+            if stress is not None:
+                stress_jump(stress, mi, peculiar_x(i, rec, shear), rec[i, 4], rec[i, 5], -fi * nx, -fi * ny, -fi * nz)
+                stress_jump(stress, mj, peculiar_x(j, rec, shear), rec[j, 4], rec[j, 5], fj * nx, fj * ny, fj * nz)
+                stress_virial(stress, -impulse * dist, nx, ny, nz)
             rec[i, 3] -= fi * nx
             rec[i, 4] -= fi * ny
             rec[i, 5] -= fi * nz
@@ -524,14 +585,15 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
     if onlists is not None:
-        tj = predict_listed(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, flight, wallkinds)
+        tj = predict_listed(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, flight, wallkinds,
+                            shear)
     if oncells is not None:
-        tj = predict_cells(j, te, rec, p.count, ev, lists, prm.space, flight, wallkinds)
+        tj = predict_cells(j, te, rec, p.count, ev, lists, prm.space, flight, wallkinds, shear)
     if not cal_update_ring(j, tj, cal):
         return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
         ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts,
-                     flight, wallkinds)
+                     flight, wallkinds, shear)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
         c.events += 1
         c.err_i = i
@@ -541,11 +603,17 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
 
 
 @inlined_ir
-def execute_expiry(i, te, p, lists, cells, c, prm):
+def execute_expiry(i, te, p, lists, cells, c, prm, shear):
     """List expiry of i at te: a new list centre and neighbour list (OVERFLOW/CELL_OVERFLOW
-    if a list or a cell is full: nothing changed, the driver enlarges and calls again)."""
+    if a list or a cell is full: nothing changed, the driver enlarges and calls again).
+    ``shear``: i first back inside [0, L_y) through the sheared boundary, the centre in its
+    row's frame (:func:`granulargas.engine._shear.rebuild_list_le`)."""
     stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
-    st = rebuild_list(i, p.rec, lists, cells, prm.space, prm.rmax, prm.shell)
+    if shear is not None:
+        c.sum_mv2 += p.mass[i] * le_wrap(i, te, p.rec, p.img, shear)
+        st = rebuild_list_le(i, te, p.rec, lists, cells, prm.space, prm.rmax, prm.shell, shear)
+    else:
+        st = rebuild_list(i, p.rec, lists, cells, prm.space, prm.rmax, prm.shell)
     if st != 0:
         c.err_i = i
         c.err_j = -1
@@ -555,20 +623,24 @@ def execute_expiry(i, te, p, lists, cells, c, prm):
 
 
 @inlined_ir
-def execute_crossing(i, face, te, p, grid, c, prm):
+def execute_crossing(i, face, te, p, grid, c, prm, shear):
     """Cell crossing of i at te through face ``face`` (2 a + side): into the next cell
     (:func:`granulargas.engine._crossing.cross`) and its best pair updated with the
     layer of cells that became adjacent (:func:`~granulargas.engine._crossing.scan_new_layer`);
     the loop's prediction of i then uses it."""
     stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
-    cross(i, face, grid, prm.space)
-    scan_new_layer(i, te, face, p.rec, p.count, grid, prm.space, prm.flight)
+    if shear is not None:
+        c.sum_mv2 += p.mass[i] * cross_le(i, face, te, p.rec, p.img, grid, prm.space, shear)
+        scan_new_layer_le(i, te, face, p.rec, p.count, grid, prm.space, shear)
+    else:
+        cross(i, face, grid, prm.space)
+        scan_new_layer(i, te, face, p.rec, p.count, grid, prm.space, prm.flight)
     c.crossings += 1
     return DONE
 
 
 @kernel(python=False)
-def execute_wall(i, wall, te, p, c, walls, prm, flight, wallkinds, spins, species):
+def execute_wall(i, wall, te, p, c, walls, prm, flight, wallkinds, shear, stress, spins, species):
     """Collision of i with wall ``wall`` (2 a + side) at te, by the run's rule at R_eff = R_i,
     m_eff = m_i (rough particles: :func:`granulargas.engine._spin.rough_wall`, except the TC
     model's elastic collisions; a mixture: the normal law of i's species; hard walls at rest;
@@ -600,6 +672,10 @@ def execute_wall(i, wall, te, p, c, walls, prm, flight, wallkinds, spins, specie
             c.sum_mv2 -= 2.0 * drot
         else:
             v_new, loss, impulse = wall_collision(vn, mi, eps)
+            if stress is not None:
+                dv = v_new - vn
+                stress_jump(stress, mi, peculiar_x(i, rec, shear), rec[i, 4], rec[i, 5], dv if a == 0 else 0.0,
+                            dv if a == 1 else 0.0, dv if a == 2 else 0.0)
             rec[i, 3 + a] = v_new
         c.dissipated += loss
         c.sum_mv2 -= 2.0 * loss
@@ -680,7 +756,7 @@ def execute_wall_kind(i, wall, te, p, c, walls, prm, spec, species):
 
 
 @kernel(python=False)
-def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins):
+def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress, spins):
     """Driving step at t: every particle streamed to t and kicked (:mod:`_drive`, eq. 1; rough
     particles' spins too, :func:`granulargas.engine._spin.kick_spins`); every event predicted
     anew and the calendar rebuilt (O(N))."""
@@ -698,8 +774,43 @@ def execute_kick(t, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins
     c.sum_mv2 = s
     c.kick_step += 1
     c.kicks += 1
+    if stress is not None:
+        stress_sums(rec, p.mass, shear, stress[0].s)
     predict_all(t, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts, prm.flight,
-                prm.wallkinds, cal.qt)
+                prm.wallkinds, shear, cal.qt)
+    return DONE if cal_build(t, cal) else CALENDAR
+
+
+@kernel(python=False)
+def execute_rescale(t, p, ev, lists, onlists, oncells, cal, c, prm, shear, stress):
+    """Thermostat step at t (sheared runs): every particle streamed to t, the peculiar
+    velocities c = v - a (y - L_y/2) x scaled so that m <c^2>/d is the thermostat's
+    temperature (a Gaussian thermostat applied at discrete times), every event predicted anew
+    and the calendar rebuilt. The energy taken out counts as negative injected energy."""
+    rec = p.rec
+    n = rec.shape[0]
+    for i in range(n):
+        stream(i, t, rec, p.img, prm.space.period, prm.flight)
+    e2 = 0.0
+    for i in range(n):
+        cx = peculiar_x(i, rec, shear)
+        e2 += p.mass[i] * (cx * cx + rec[i, 4] * rec[i, 4] + rec[i, 5] * rec[i, 5])
+    target = shear.thermostat[1] * prm.space.dims * n
+    scale = math.sqrt(target / e2) if e2 > 0.0 else 1.0
+    s = 0.0
+    for i in range(n):
+        u = rec[i, 3] - peculiar_x(i, rec, shear)
+        rec[i, 3] = u + scale * (rec[i, 3] - u)
+        rec[i, 4] *= scale
+        rec[i, 5] *= scale
+        s += p.mass[i] * (rec[i, 3] * rec[i, 3] + rec[i, 4] * rec[i, 4] + rec[i, 5] * rec[i, 5])
+    c.injected += 0.5 * (target - e2)
+    c.sum_mv2 = s
+    shear.rescales[0] += 1
+    if stress is not None:
+        stress_sums(rec, p.mass, shear, stress[0].s)
+    predict_all(t, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, None, prm.flight,
+                prm.wallkinds, shear, cal.qt)
     return DONE if cal_build(t, cal) else CALENDAR
 
 
@@ -796,7 +907,7 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
 
 # ------------------------------------------------------------------------ loop
 @kernel
-def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, probe):
+def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear=None, stress=None):
     """Process events in time order until ``until`` (or a budget); see module doc.
 
     Parameters
@@ -815,6 +926,11 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
     probe : None or int64 array
         None: the production build. An array of :data:`_probe.PROBE_SIZE`
         compiles the cycle counters in (``scripts/profiling/profile_loop.py``).
+    shear : None or ShearGeometry
+        Lees-Edwards boundaries (``prm.space.shear``; :mod:`granulargas.engine._shear`),
+        an argument of its own so that numba removes its branches when it is None.
+    stress : None or STRESS record
+        The pressure tensor's sums (``engine.stress``), likewise.
 
     Returns
     -------
@@ -869,6 +985,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         else:
             zero_advance = 0
         c.kin_int += c.sum_mv2 * (te - time)
+        integrate_stress(stress, te - time, shear)
         time = te
         j = np.int64(ev.partner[i])  # one signature for the callees (partner is int32)
         probe_guess(probe, i == pending)
@@ -878,26 +995,27 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if onlists is not None:  # j's list row is in cache: start the misses of predict(j)
                 for k in range(lists.nbn[j]):
                     prefetch(rec, lists.nbl[j, k])
-            status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, spins,
-                                  species)
+            status = execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress,
+                                  spins, species)
             clock = tick(probe, COLLIDE, clock)
             if status != DONE:
                 break
         elif j == EXPIRY or j == CROSS:  # the one of the two this mode has
             if onlists is not None:
-                status = execute_expiry(i, te, p, lists, cells, c, prm)
+                status = execute_expiry(i, te, p, lists, cells, c, prm, shear)
             if oncells is not None:
-                status = execute_crossing(i, ev.tag[i], te, p, lists, c, prm)
+                status = execute_crossing(i, ev.tag[i], te, p, lists, c, prm, shear)
             clock = tick(probe, REBUILD, clock)
             if status != DONE:
                 break
         elif j == WALL:
-            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, prm.flight, prm.wallkinds, spins, species)
+            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, prm.flight, prm.wallkinds, shear, stress, spins,
+                                  species)
             clock = tick(probe, P_WALL, clock)
             if status != DONE:
                 if status == COLLAPSE:
                     ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
-                                 contacts, prm.flight, prm.wallkinds)
+                                 contacts, prm.flight, prm.wallkinds, shear)
                     if not cal_update(i, ti, cal):
                         status = CALENDAR
                     c.events += 1
@@ -910,9 +1028,9 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         # ---- re-predict the particle of the event
         if onlists is not None:
             ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, prm.flight,
-                                prm.wallkinds)
+                                prm.wallkinds, shear)
         if oncells is not None:
-            ti = predict_cells(i, te, rec, p.count, ev, lists, prm.space, prm.flight, prm.wallkinds)
+            ti = predict_cells(i, te, rec, p.count, ev, lists, prm.space, prm.flight, prm.wallkinds, shear)
         clock = tick(probe, PREDICT, clock)
         if not cal_update_root(i, ti, cal):  # i's event is the small heap's root
             status = CALENDAR
@@ -940,12 +1058,13 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
     c.time = time
     if status == DONE and until < math.inf:
         c.kin_int += c.sum_mv2 * (until - time)
+        integrate_stress(stress, until - time, shear)
         c.time = until
     return status
 
 
 @kernel
-def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisions, probe):
+def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear=None, stress=None):
     """:func:`advance` with the white-noise driving: the driving step is a global event.
 
     Runs :func:`advance` up to the next driving step (k + 1/2) dt_k (:func:`predict_kick`;
@@ -958,11 +1077,51 @@ def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisi
     while True:
         t_kick = predict_kick(c, prm)
         stop = t_kick if t_kick < until else until
-        status = advance(engine, onlists, oncells, prm, stop, events_end - c.events, max_collisions, probe)
+        status = advance(engine, onlists, oncells, prm, stop, events_end - c.events, max_collisions, probe, shear,
+                         stress)
         if status != DONE or t_kick > until:
             return status
         status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
-                              engine.calendar, c, prm, engine.contacts, engine.spins)
+                              engine.calendar, c, prm, engine.contacts, shear, stress, engine.spins)
+        c.events += 1
+        if status != DONE or c.time >= until:
+            return status
+        if c.events >= events_end:
+            return BUDGET
+
+
+@kernel
+def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear, stress):
+    """:func:`advance` under Lees-Edwards boundaries, with their global events: the slides of
+    the cell mode (:func:`granulargas.engine._shear.slide_scan`), the thermostat's rescaling
+    (:func:`execute_rescale`) and the white-noise driving's steps (:func:`execute_kick`).
+    Events of the loop at the same time come first; a global event due at ``until`` itself
+    is executed. Same arguments and status codes as :func:`advance`."""
+    c = engine.counters[0]
+    sh = shear
+    events_end = c.events + max_events
+    while True:
+        t_kick = predict_kick(c, prm)
+        t_slide = next_slide(sh, oncells)
+        t_rescale = next_rescale(sh)
+        t_next = min(t_kick, t_slide, t_rescale)
+        stop = t_next if t_next < until else until
+        status = advance(engine, onlists, oncells, prm, stop, events_end - c.events, max_collisions, probe, shear,
+                         stress)
+        if status != DONE or t_next > until:
+            return status
+        if t_slide == t_next:
+            if oncells is not None:  # slides only in the cell mode
+                if not slide_scan(c.time, engine.particles.rec, engine.particles.img, engine.particles.count,
+                                  engine.events, engine.lists, prm.space, engine.calendar, sh):
+                    return CALENDAR
+        elif t_rescale == t_next:
+            status = execute_rescale(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
+                                     engine.calendar, c, prm, sh, stress)
+        else:
+            status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
+                                  engine.calendar, c, prm, engine.contacts, sh, stress,
+                                  engine.spins)
         c.events += 1
         if status != DONE or c.time >= until:
             return status

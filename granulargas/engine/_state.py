@@ -61,6 +61,9 @@ Record layout
   the thermal and vibrating walls have given the gas (cumulative, net); ``rechecks``
   (1,) i8: wall events that were re-checks of a vibrating wall's contact search
   (:mod:`granulargas.engine._walls`).
+* ``stress`` (1,) :data:`granulargas.engine._shear.STRESS` record -- the pressure
+  tensor's kinetic sums and their time integrals and the collisional sums (None
+  unless asked for: the loop then compiles without them).
 * ``contacts`` :class:`Contacts` -- collisions that take time
   (:mod:`granulargas.engine._resolved`): ``until`` f8, the time at which the
   particle's last contact ends (-inf: none), ``partner`` i4 the slot of that
@@ -99,7 +102,7 @@ Spins = namedtuple("Spins", ["w", "kappa", "model", "beta", "mu", "wall_beta", "
 Species = namedtuple("Species", ["of", "count", "eps", "prefactor", "wall_eps", "wall_prefactor", "weight",
                                  "pairs"])
 Engine = namedtuple("Engine", ["particles", "events", "lists", "cells", "calendar", "counters",
-                               "walls", "contacts", "spins", "species"])
+                               "walls", "contacts", "stress", "spins", "species"])
 
 # Read-only parameters.
 #: Collision rule (see :mod:`granulargas.engine._collide`): ``kind`` code, constant
@@ -114,9 +117,13 @@ RuleParams = namedtuple("RuleParams", ["kind", "eps", "tc_time", "prefactor", "i
                                        "ob_coeffs", "elastic_below"])
 #: Geometry: ``box`` (3,) side lengths (the cell grid spans [0, L)); ``period`` (3,)
 #: the period of each axis (L when periodic, inf on a wall axis, so that the
-#: minimum image and the wrap leave wall axes alone); ``ncell`` (3,) cells per
-#: axis; ``wall_axes`` (k,) the axes with flat walls at 0 and L; ``dims`` 2 or 3.
-Space = namedtuple("Space", ["box", "period", "ncell", "wall_axes", "dims"])
+#: minimum image and the wrap leave wall axes alone; inf on the sheared axis too,
+#: which :mod:`granulargas.engine._shear` wraps); ``ncell`` (3,) cells per
+#: axis; ``wall_axes`` (k,) the axes with flat walls at 0 and L; ``dims`` 2 or 3;
+#: ``shear`` the Lees-Edwards geometry (:class:`~granulargas.engine._shear.ShearGeometry`)
+#: or None. The kernels take ``shear`` as an argument of their own, so that numba removes
+#: its branches when it is None.
+Space = namedtuple("Space", ["box", "period", "ncell", "wall_axes", "dims", "shear"])
 #: Everything else the loop reads: ``shell`` (list shell width), ``half_shell``
 #: (how far a particle may move from its list centre, with a round-off margin),
 #: ``rmax`` (largest radius), ``collapse_dt`` and ``collapse_count`` (inelastic-
@@ -202,12 +209,12 @@ def species_record(of, table, pairs=None, weight=None) -> Species:
                    flat(np.ones((size, size)) if weight is None else weight), counts)
 
 
-def space(box3, period3, ncell, wall_axes, dims) -> Space:
+def space(box3, period3, ncell, wall_axes, dims, shear=None) -> Space:
     """A :class:`Space` with the dtypes the kernels are compiled for."""
     return Space(np.ascontiguousarray(box3, dtype=np.float64),
                  np.ascontiguousarray(period3, dtype=np.float64),
                  np.ascontiguousarray(ncell, dtype=np.int64),
-                 np.ascontiguousarray(wall_axes, dtype=np.int64), int(dims))
+                 np.ascontiguousarray(wall_axes, dtype=np.int64), int(dims), shear)
 
 
 def params(rule: RuleParams, spc: Space, shell: float, rmax: float, collapse_dt: float,

@@ -22,7 +22,7 @@ import numpy as np
 
 from granulargas.contact.material import pair_constant
 from granulargas.contact.oblique import pair_compression_constant
-from granulargas.engine import _loop, _state
+from granulargas.engine import _loop, _shear, _state
 from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
 from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
@@ -31,6 +31,7 @@ from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
 from granulargas.engine.pairs import pair_count_matrix, species_of_state
 from granulargas.engine.rules import CollisionRule
+from granulargas.engine.shear import Shear
 from granulargas.engine.walls import Walls
 from granulargas.engine.tangential import (
     TangentialRule,
@@ -54,8 +55,10 @@ OWN_FIELDS = ("positions", "velocities", "images", "radii", "masses", "last_coll
               "contact_partner")
 #: and, with a tangential rule (rough particles), these too
 ROUGH_FIELDS = ("angular_velocities", "inertia")
-#: boundary conditions of an axis
-BOUNDARIES = ("periodic", "wall")
+#: boundary conditions of an axis ("lees-edwards": the sheared y axis, with ``shear``)
+BOUNDARIES = ("periodic", "wall", "lees-edwards")
+#: scratch of a cell scan under shear: the heads of 3 + 4 + 4 columns times 3 layers, and one
+SHEAR_FRESH_SIZE = 34
 #: neighbour search: neighbour lists with a shell, cell crossings (no lists), or the
 #: faster of the two for the packing fraction (:func:`neighbour_mode`)
 NEIGHBOURS = ("lists", "cells", "auto")
@@ -212,6 +215,17 @@ class Simulation:
         Remove the centre-of-mass velocity that round-off accumulates on the
         periodic axes (see :meth:`run`). False keeps any centre-of-mass motion,
         e.g. a mean flow given on purpose.
+    shear : Shear, optional
+        Uniform shear flow (:class:`granulargas.engine.shear.Shear`): Lees-Edwards
+        boundaries on y (the state's ``boundary`` marks y "lees-edwards"; x periodic, z
+        periodic or walls), the flow along x at the rate ``shear.rate``, optionally a
+        thermostat (:mod:`granulargas.engine._shear`). Velocities are those of the
+        laboratory frame (the flow a (y - L_y/2) included); ``temperature`` and
+        ``kinetic_energy`` are peculiar; ``images`` count the image shifts (module doc
+        there).
+    stress : bool
+        Accumulate the pressure tensor for :meth:`pressure_tensor_window` (always on
+        with ``shear``; off by default, when the loop carries none of it).
     gravity : sequence of d floats, optional
         A uniform acceleration g (on wall and periodic axes alike; a periodic axis
         falls freely): particles fly on parabolas between events
@@ -248,7 +262,8 @@ class Simulation:
 
     def __init__(self, state: State, rule: CollisionRule, *, driving: WhiteNoise | None = None,
                  neighbours: str = "lists", shell: float | None = None, collapse_count: int = 100,
-                 remove_drift: bool = True, gravity=None, walls: Walls | None = None,
+                 remove_drift: bool = True, shear: Shear | None = None, stress: bool = False, gravity=None,
+                 walls: Walls | None = None,
                  tangential: TangentialRule | None = None):
         if not isinstance(state, State):
             raise TypeError("state must be a granulargas.state.State")
@@ -276,6 +291,11 @@ class Simulation:
         if not isinstance(rule, CollisionRule):
             raise TypeError("rule must be a granulargas.engine.CollisionRule")
         self.boundary = _boundary(state.boundary, d)
+        if shear is not None and not isinstance(shear, Shear):
+            raise TypeError("shear must be a granulargas.engine.shear.Shear or None")
+        _check_shear(self.boundary, shear, rule)
+        self.shear = shear
+        self.stress = bool(stress) or shear is not None
         wall = np.array([b == "wall" for b in self.boundary])
         img = state.array("images")
         if np.any(img[:, wall] != 0):
@@ -297,6 +317,19 @@ class Simulation:
                                   f"wall (radius {rad[k]:.6g}, walls at {lo:.6g} and {hi:.6g} at t = "
                                   f"{state.time:.6g}); every sphere must lie within [R, L - R] on a wall "
                                   f"axis, clear of a vibrating wall's position")
+        if shear is not None and (self.gravity is not None or self.walls is not None and self.walls.moving):
+            raise ConfigError("shear: gravity and thermal or vibrating walls are not available with Lees-Edwards "
+                              "boundaries (hard walls at rest only)")
+        if self.stress and (self.gravity is not None or self.walls is not None and self.walls.moving):
+            raise ConfigError("stress: the pressure tensor under gravity or with thermal or vibrating walls is "
+                              "not available (stress=False)")
+        if shear is not None:
+            # y into [0, L_y) through the sheared images: x shifted by the unreduced image offset
+            ky = np.floor(pos[:, 1] / bx[1]).astype(np.int64)
+            pos[:, 1] -= ky * bx[1]
+            pos[:, 0] -= ky * (shear.rate * bx[1] * float(state.time))
+            vel[:, 0] -= ky * (shear.rate * bx[1])
+            img[:, 1] += ky
         shift = np.floor(pos / bx).astype(np.int64)
         shift[:, wall] = 0
         pos -= shift * bx
@@ -324,6 +357,11 @@ class Simulation:
         if driving is not None and driving.rotational_fraction > 0.0 and tangential is None:
             raise ConfigError(f"driving: rotational_fraction = {driving.rotational_fraction}: smooth particles "
                               "have no spins to drive (give a tangential rule)")
+        if tangential is not None and shear is not None:
+            raise ConfigError("shear: rough particles (a tangential rule) are not available with Lees-Edwards "
+                              "boundaries")
+        if tangential is not None and self.stress:
+            raise ConfigError("stress: the pressure tensor of rough particles is not available (stress=False)")
         if tangential is not None and self.walls is not None and self.walls.moving:
             raise ConfigError("tangential: rough particles take hard walls at rest only (thermal and vibrating "
                               "walls act on smooth particles)")
@@ -364,6 +402,8 @@ class Simulation:
                                   f"current time ((k + 1/2) interval > {self._time:.17g})")
         self._virial = 0.0
         self._kin_int = 0.0
+        self._stress_window = np.zeros(12)  # kinetic integrals and collisional sums when not built
+        self._rescale_step = shear.first_step(self._time) if shear is not None else 0
         self._wall_impulse = np.zeros((3, 2))
         self._window_start = self._time
         self._wall_window_start = self._time
@@ -409,6 +449,8 @@ class Simulation:
         box3[:d] = bx
         period3 = box3.copy()
         period3[:d][wall] = np.inf
+        if shear is not None:
+            period3[1] = np.inf  # the sheared axis: wrapped by engine._shear
         ncell = np.ones(3, dtype=np.int64)
         if self.neighbours == "cells":
             # the shell is the cells' width beyond the largest diameter
@@ -452,13 +494,26 @@ class Simulation:
             lastcoll=np.ascontiguousarray(self._last_collision[order]),
             rapid=np.zeros(n, dtype=np.int32), ident=order.astype(np.int32))
         ncells = int(np.prod(spc.ncell))
+        sh = None
+        if self.shear is not None:
+            sh = _shear.shear_geometry(
+                self.shear.rate, spc.box, spc.ncell, n,
+                math.inf if self.shear.interval is None else self.shear.interval,
+                self.shear.temperature or 1.0, rescales=self._rescale_step, lists=self.neighbours == "lists")
+            sh.slide[0] = int(math.floor(self._time / sh.slide_time))
+            spc = spc._replace(shear=sh)
+            self._space = spc
+            rec[:, 1] += sh.ly  # the compiled state keeps y + L_y (engine._shear)
         if self.neighbours == "cells":
             cell, partner, tag, where, qt, pair_t = particle_rows(n)
             events = _state.Events(partner=partner, tag=tag)
             lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), cell=cell,
                                 width=spc.box / spc.ncell, pair_t=pair_t,
-                                fresh=np.full(FRESH_SIZE, -1, dtype=np.int64))
-            build_grid(rec, lists, spc)
+                                fresh=np.full(FRESH_SIZE if sh is None else SHEAR_FRESH_SIZE, -1, dtype=np.int64))
+            if sh is None:
+                build_grid(rec, lists, spc)
+            else:
+                _shear.build_grid_le(self._time, rec, lists, spc, sh)
             self._finish_build(particles, events, lists, None, order, qt=qt, where=where)
             return
         partner, tag, where, qt = _state.event_rows(n)
@@ -472,7 +527,10 @@ class Simulation:
                                  stencil=stencil, mark=np.zeros(n, dtype=np.uint8))
             cells = _state.Cells(ids=_aligned_int_rows(ncells, self._cell_width),
                                  n=np.zeros(ncells, dtype=np.int32))
-            st = build_all_lists(pos, rec, lists, cells, spc, self.shell)
+            if sh is None:
+                st = build_all_lists(pos, rec, lists, cells, spc, self.shell)
+            else:
+                st = _shear.build_all_lists_le(self._time, rec, lists, cells, spc, self.shell, sh)
             if st == OVERFLOW:
                 self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
             elif st == CELL_OVERFLOW:
@@ -512,7 +570,7 @@ class Simulation:
                                    ) if self.rule.resolved else None
         _loop.predict_all(self._time, rec, particles.count, events, lists, *_loop.mode_flags(cells), spc,
                           0.5 * self.shell * (1.0 - 1e-9), contacts, self._flight(), self._wallkinds(),
-                          calendar.qt)
+                          spc.shear, calendar.qt)
         counters = np.zeros(1, dtype=_state.COUNTERS)
         c = counters[0]
         with np.errstate(over="ignore", under="ignore"):
@@ -529,6 +587,12 @@ class Simulation:
         c["three_body"] = self._three_body
         c["err_i"] = c["err_j"] = -1
         walls = _state.walls(impulse=self._wall_impulse)  # work: since this build (added to _wall_work)
+        stress = None
+        if self.stress:
+            stress = np.zeros(1, dtype=_shear.STRESS)
+            _shear.stress_sums(rec, particles.mass, spc.shear, stress[0]["s"])
+            stress[0]["k"] = self._stress_window[:6]
+            stress[0]["w"] = self._stress_window[6:]
         tg = self.tangential  # rough particles; None: the loop compiles without spins
         spins = None if tg is None else _state.spins(
             self._spins[order], self._kappa[order], tg.code, tg.restitution, tg.friction, tg.wall_beta, tg.wall_mu,
@@ -537,7 +601,7 @@ class Simulation:
         species = None if self._species_of is None else _state.species_record(
             self._species_of[order], self.rule.pairs, self._pair_counts)
         self._engine = _state.Engine(particles, events, lists, cells, calendar, counters, walls, contacts,
-                                     spins, species)
+                                     stress, spins, species)
         self._place_events(self._time)
         self._built = True
 
@@ -661,9 +725,11 @@ class Simulation:
             if not 0.5 <= ratio <= 2.0:
                 self._place_events(self.time)
         advance = _loop.advance if self.driving is None else _loop.advance_driven
+        if self.shear is not None:
+            advance = _loop.advance_sheared
         while True:
             e = self._engine
-            status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None)
+            status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None, prm.space.shear, e.stress)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
@@ -694,6 +760,7 @@ class Simulation:
         """Subtract the centre-of-mass velocity on periodic axes once it exceeds
         ``DRIFT_LIMIT`` of the thermal speed (see :meth:`run`); True if it did."""
         axes = [a for a in range(self.dimension) if self.boundary[a] == "periodic"
+                and not (a == 0 and self.shear is not None)  # the flow's axis keeps its momentum
                 and (self.gravity is None or self.gravity[a] == 0.0)]  # a falling axis is no drift
         if not self.remove_drift or not axes:
             return False
@@ -800,6 +867,10 @@ class Simulation:
             self._kick_step = int(c["kick_step"])
             self._three_body = int(c["three_body"])
             self._wall_impulse = e.walls.impulse.copy()
+            if e.stress is not None:
+                self._stress_window = np.concatenate([e.stress[0]["k"], e.stress[0]["w"]])
+            if self.shear is not None:
+                self._rescale_step = int(self._space.shear.rescales[0])
             if e.spins is not None:
                 self._spins = np.empty((n, 3))
                 self._spins[inv] = e.spins.w
@@ -816,18 +887,26 @@ class Simulation:
         return self
 
     def _synchronised(self):
+        """Positions, images and velocities at ``time``, wrapped (particle-id order)."""
         e = self._engine
         n, d = self._positions.shape
         r = np.empty((n, 3))
         img = np.empty((n, 3), dtype=np.int32)
-        v = np.empty((n, 3))
-        _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, self._flight(), r, img, v)
+        vel = np.empty((n, d))
+        if self.shear is None:
+            v = np.empty((n, 3))
+            _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, self._flight(), r,
+                               img, v)
+            vel[self._order] = v[:, :d]
+        else:
+            v3 = np.empty((n, 3))
+            _shear.synchronised_le(e.particles.rec, e.particles.img, self._space.period, self.time,
+                                   self._space.shear, r, img, v3)
+            vel[self._order] = v3[:, :d]
         pos = np.empty((n, d))
         pos[self._order] = r[:, :d]
         im = np.empty((n, d), dtype=np.int64)
         im[self._order] = img[:, :d]
-        vel = np.empty((n, d))
-        vel[self._order] = v[:, :d]
         return pos, im, vel
 
     # ----------------------------------------------------------- public state
@@ -895,18 +974,32 @@ class Simulation:
 
     @property
     def unwrapped_positions(self) -> np.ndarray:
+        """Positions + images times the box (with shear, x also + images_y a L_y t)."""
         pos, img = self._synchronised()[:2] if self._built else (self._positions, self._images)
-        return pos + img * self._box
+        out = pos + img * self._box
+        if self.shear is not None:
+            out[:, 0] += img[:, 1] * (self.shear.rate * self._box[1] * self.time)
+        return out
 
     @property
     def velocities(self) -> np.ndarray:
-        """Velocities (N, d) at ``time`` (a copy; under gravity each streamed from its clock)."""
+        """Velocities (N, d) at ``time`` (a copy; laboratory frame; with shear those of the wrapped
+        positions; under gravity each streamed from its clock)."""
         if not self._built:
             return self._velocities.copy()
-        if self._flight() is not None:
+        if self.shear is not None or self._flight() is not None:
             return self._synchronised()[2]
         out = np.empty_like(self._velocities)
         out[self._order] = self._engine.particles.rec[:, 3 : 3 + self.dimension]
+        return out
+
+    def peculiar_velocities(self) -> np.ndarray:
+        """Velocities relative to the flow, c = v - a (y - L_y/2) x (v without shear), (N, d)."""
+        if self.shear is None:
+            return self.velocities
+        pos, _, vel = self._synchronised() if self._built else (self._positions, None, self._velocities)
+        out = vel.copy()
+        out[:, 0] -= self.shear.rate * (pos[:, 1] - 0.5 * self._box[1])
         return out
 
     @property
@@ -983,10 +1076,13 @@ class Simulation:
         continues bit for bit where :meth:`synchronise` would. ``contact_until`` and
         ``contact_partner`` are None unless collisions take time, ``kick_step`` without driving;
         the per-particle fields the engine does not use are those it was given."""
-        pos, img = self._synchronised()[:2] if self._built else (self._positions.copy(), self._images.copy())
+        if self._built:
+            pos, img, vel = self._synchronised()
+        else:
+            pos, img, vel = self._positions.copy(), self._images.copy(), self._velocities.copy()
         resolved = self.rule.resolved
         return State(
-            positions=pos, velocities=self.velocities, radii=self.radii, masses=self.masses, box=self.box,
+            positions=pos, velocities=vel, radii=self.radii, masses=self.masses, box=self.box,
             boundary=self.boundary, images=img, last_collision=self.last_collision,
             contact_until=self.contact_until if resolved else None,
             contact_partner=self.contact_partner if resolved else None,
@@ -1001,6 +1097,8 @@ class Simulation:
 
     # ------------------------------------------------------------ observables
     def _vm(self):
+        if self.shear is not None:
+            return self.peculiar_velocities(), self._masses
         if self._built:
             if self._flight() is not None:  # velocities at time (the order of masses matches)
                 return self._synchronised()[2], self._masses
@@ -1030,19 +1128,20 @@ class Simulation:
 
     @property
     def kinetic_energy(self) -> float:
-        """Total kinetic energy sum m v^2 / 2."""
+        """Total kinetic energy sum m v^2 / 2 (with shear: of the peculiar velocities)."""
         v, m = self._vm()
         return float(0.5 * np.sum(m[:, None] * v * v))
 
     @property
     def momentum(self) -> np.ndarray:
-        """Total momentum (d,)."""
+        """Total momentum (d,) (with shear: of the peculiar velocities)."""
         v, m = self._vm()
         return np.sum(m[:, None] * v, axis=0)
 
     @property
     def temperature(self) -> float:
-        """Granular temperature m <c^2> / d with c the peculiar velocity (k_B = 1)."""
+        """Granular temperature m <c^2> / d with c the peculiar velocity (k_B = 1; with shear
+        relative to the flow, :meth:`peculiar_velocities`, less their mean)."""
         v, m = self._vm()
         vcm = np.sum(m[:, None] * v, axis=0) / np.sum(m)
         c = v - vcm
@@ -1070,15 +1169,33 @@ class Simulation:
         (kinetic plus collisional virial; c is the peculiar velocity). With walls
         the sphere-wall forces are not included: this is then the volume average of
         the trace of the kinetic and collisional stress, and
-        :meth:`wall_pressure_window` is the pressure on the walls. Under gravity NaN (the
-        kinetic integral is not kept for velocities that change between events).
+        :meth:`wall_pressure_window` is the pressure on the walls. With shear the trace
+        of :meth:`pressure_tensor_window` over d. Shares its window with
+        :meth:`pressure_tensor_window` (:meth:`pressure_windows` gives both). Under gravity
+        NaN (the kinetic integral is not kept for velocities that change between events).
         """
+        return self.pressure_windows()[0]
+
+    def pressure_tensor_window(self) -> np.ndarray:
+        """Mean pressure tensor (d, d) since the previous call (or construction), then reset.
+
+        P_ab = [ integral of sum_i m_i c_ia c_ib dt + sum_coll r_ij,a Delta p_i,b ] / (V Delta t),
+        c the peculiar velocity (with shear relative to the flow a (y - L_y/2) x; without,
+        relative to the centre of mass at the end of the window); the collisional part
+        r_ij (x) Delta p_i through the pair's (sheared) image. Needs ``stress=True`` or
+        ``shear``. Shares its window with :meth:`pressure_window`."""
+        if not self.stress:
+            raise ConfigError("pressure_tensor_window: construct the Simulation with stress=True")
+        return self.pressure_windows()[1]
+
+    def pressure_windows(self):
+        """(pressure, pressure tensor or None) of the window since the previous call, then reset."""
         if self.gravity is not None:
             self._window_start = self.time
             if self._built:
                 self._counters["virial"] = self._counters["kin_int"] = 0.0
             self._virial = self._kin_int = 0.0
-            return float("nan")
+            return float("nan"), None
         if self._built:
             c = self._counters
             kin, vir = float(c["kin_int"]), float(c["virial"])
@@ -1091,11 +1208,42 @@ class Simulation:
         t = self.time
         dt = t - self._window_start
         self._window_start = t
+        d = self.dimension
+        if not self.stress:
+            if dt <= 0:
+                return float("nan"), None
+            p = self.momentum
+            kin -= float(p @ p) / float(np.sum(self._masses)) * dt
+            return (kin + vir) / (d * float(np.prod(self._box)) * dt), None
+        k, w = self._stress_sums()
         if dt <= 0:
-            return float("nan")
+            return float("nan"), np.full((d, d), np.nan)
+        full = np.empty((3, 3))
+        for q, (a, b) in enumerate(((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))):
+            full[a, b] = full[b, a] = k[q] + w[q]
+        tensor = full[:d, :d].copy()
         p = self.momentum
-        kin -= float(p @ p) / float(np.sum(self._masses)) * dt
-        return (kin + vir) / (self.dimension * float(np.prod(self._box)) * dt)
+        if self.shear is None:
+            tensor -= np.outer(p, p) / float(np.sum(self._masses)) * dt
+            kin -= float(p @ p) / float(np.sum(self._masses)) * dt
+            scalar = (kin + vir) / (d * float(np.prod(self._box)) * dt)
+        tensor /= float(np.prod(self._box)) * dt
+        if self.shear is not None:
+            scalar = float(np.trace(tensor)) / d
+        return scalar, tensor
+
+    def _stress_sums(self):
+        """(kinetic integrals, collisional sums) of the pressure tensor since the last reset, each
+        (6,) in the order xx, yy, zz, xy, xz, yz; reset them."""
+        if self._built:
+            st = self._engine.stress[0]
+            k, w = st["k"].copy(), st["w"].copy()
+            st["k"] = 0.0
+            st["w"] = 0.0
+        else:
+            k, w = self._stress_window[:6].copy(), self._stress_window[6:].copy()
+        self._stress_window[:] = 0.0
+        return k, w
 
     def wall_impulse(self) -> np.ndarray:
         """Normal momentum (d, 2) delivered to the lower / upper wall of each axis since the
@@ -1149,6 +1297,26 @@ def _boundary(boundary, d):
     return b
 
 
+def _check_shear(boundary, shear, rule):
+    """Lees-Edwards boundaries: y (axis 1) marked "lees-edwards" exactly when there is a shear,
+    x periodic (the flow's axis); ConfigError otherwise."""
+    marked = [a for a, b in enumerate(boundary) if b == "lees-edwards"]
+    if shear is None:
+        if marked:
+            raise ConfigError(f"boundary = {list(boundary)}: \"lees-edwards\" needs a shear "
+                              f"(Simulation(..., shear=Shear(rate)))")
+        return
+    if marked != [1]:
+        raise ConfigError(f"boundary = {list(boundary)}: a shear flow needs \"lees-edwards\" on y (the "
+                          f"gradient axis) and on no other axis")
+    if boundary[0] != "periodic":
+        raise ConfigError(f"boundary = {list(boundary)}: the flow's axis x must be periodic under shear")
+    if rule.resolved:
+        raise ConfigError('shear: collisions that take time (duration = "resolved") are not available '
+                          'with Lees-Edwards boundaries')
+    if getattr(rule, "pairs", None) is not None:
+        raise ConfigError("shear: mixtures (a collision rule with a species table) are not available with "
+                          "Lees-Edwards boundaries")
 def _gravity(gravity, d):
     """The acceleration as a tuple of d finite floats, or None (ConfigError otherwise)."""
     if gravity is None:

@@ -650,7 +650,7 @@ MIN_WALL_AXIS_DIAMETERS = 4.15
 
 
 def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, masses=None,
-                 aspect=None, sweeps=None, rng=None, boundary=None, margins=None) -> State:
+                 aspect=None, sweeps=None, rng=None, boundary=None, shear=None, margins=None) -> State:
     """A random homogeneous initial state: box, positions, velocities (in this order from one generator).
 
     Parameters
@@ -681,7 +681,11 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
         shifted by R_max: no sphere overlaps a wall (every centre lies within
         [R_max, L - R_max]); the density next to the walls relaxes to its steady
         profile within a few collision times. A wall axis must be at least
-        ``MIN_WALL_AXIS_DIAMETERS`` largest diameters long.
+        ``MIN_WALL_AXIS_DIAMETERS`` largest diameters long. "lees-edwards" (the sheared
+        y axis) is placed as a periodic one.
+    shear : float, optional
+        Shear rate a: the velocities get the flow a (y - L_y/2) along x on top of the
+        Maxwellian (uniform shear flow, :class:`granulargas.engine.shear.Shear`).
     margins : array (d, 2), optional
         Room kept free at the lower and upper wall of each wall axis besides R_max (e.g.
         the sweep 2A of a vibrating wall, :attr:`granulargas.engine.walls.Wall.reach`):
@@ -719,5 +723,7 @@ def random_state(n, packing, dimension=3, temperature=1.0, seed=0, radii=0.5, ma
     for a in walls:
         pos[:, a] += rmax + margins[a, 0]
     vel = maxwell_velocities(masses, dimension, temperature, rng=rng)
+    if shear is not None:  # the flow a (y - L_y/2) along x on top of the peculiar velocities
+        vel[:, 0] += float(shear) * (pos[:, 1] - 0.5 * box[1])
     bnd = None if boundary is None else tuple(boundary)
     return State(pos, vel, radii, masses, box, boundary=bnd)

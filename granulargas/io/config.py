@@ -67,7 +67,7 @@ MAX_PACKING = {3: math.pi / (3.0 * math.sqrt(2.0)), 2: math.pi / (2.0 * math.sqr
 MODELS = ("elastic", "constant", "viscoelastic")
 CONTACT_ENDS = ("overlap", "force")
 DURATIONS = ("instantaneous", "resolved")
-BOUNDARIES = ("periodic", "wall")
+BOUNDARIES = ("periodic", "wall", "lees-edwards")
 DRIVING_MODELS = ("white_noise",)
 #: ``[walls]``: the sides of the wall axes, the kinds of wall and the waveforms of a vibrating one
 WALL_SIDES = ("x_low", "x_high", "y_low", "y_high", "z_low", "z_high")
@@ -121,6 +121,18 @@ class SystemConfig:
     def walls(self) -> bool:
         """Whether any axis has walls."""
         return "wall" in self.boundary
+
+
+@dataclass(frozen=True)
+class ShearConfig:
+    """``[shear]`` (optional): uniform shear flow, the flow a (y - L_y/2) along x with
+    Lees-Edwards boundaries on y (``system.boundary`` marks y ``"lees-edwards"``);
+    optionally a thermostat that rescales the peculiar velocities to
+    ``thermostat_temperature`` every ``thermostat_interval``."""
+
+    rate: float = 0.0
+    thermostat_temperature: float | None = None
+    thermostat_interval: float | None = None
 
 
 @dataclass(frozen=True)
@@ -394,6 +406,7 @@ class RunConfig:
     driving: DrivingConfig | None = None
     gravity: GravityConfig | None = None
     walls: WallsConfig | None = None
+    shear: ShearConfig | None = None
     species: tuple = ()
 
     @property
@@ -574,7 +587,8 @@ SCHEMA: tuple[Key, ...] = (
         "state on every machine.", default=1, low=0, high=2**63 - 1, reason="any TOML integer >= 0"),
     Key("system", "boundary", "list of strings",
         'One entry per axis (x, y, z): `"periodic"`, or `"wall"` for flat hard walls at 0 and L on '
-        "that axis (the packing fraction counts the whole box).",
+        'that axis (the packing fraction counts the whole box), or `"lees-edwards"` on y with `[shear]` '
+        "(sliding images: uniform shear flow).",
         default_text='"periodic" on every axis', choices=BOUNDARIES,
         run_check="a wall axis must be at least 4.15 largest diameters long"),
     # [particles]
@@ -797,6 +811,27 @@ SCHEMA: tuple[Key, ...] = (
         "the spins as random angular-velocity kicks (the splitting thermostat of Megías & Santos 2022); "
         "the power per particle is d/2 × `heating_rate`, so 0 heats the translation alone at "
         "`heating_rate`.", default_text="0", low=0.0, high=1.0, reason="a fraction of the power"),
+    # [shear]
+    Key("shear", "rate", "number",
+        "Uniform shear flow: the shear rate a of the flow a (y − L_y/2) along x, with Lees–Edwards "
+        'boundaries on y (`system.boundary = ["periodic", "lees-edwards", ...]`; x periodic, z periodic '
+        "or walls). Viscous heating balances the collisional loss of an inelastic gas; an elastic gas "
+        "needs the thermostat. Required whenever `[shear]` is given.",
+        unit="1 / reduced time", low=0.0, low_open=True, high=SCALE_RANGE[1], reason="a rate",
+        run_check="the gas must reach its steady state (theory: the Grad solution) within the run: "
+                  "a rate that drives it there more slowly, or past the clock's resolution, is refused"),
+    Key("shear", "thermostat_temperature", "number",
+        "A thermostat: the peculiar velocities (relative to the flow) are rescaled to this temperature "
+        "at regular intervals (a Gaussian thermostat applied at discrete times, as in the elastic "
+        "uniform shear flow of the literature). Leave it out for none.",
+        unit="T0", low=SCALE_RANGE[0], high=SCALE_RANGE[1], reason=_SPEED),
+    Key("shear", "thermostat_interval", "number",
+        "Time between the thermostat's rescalings (with `thermostat_temperature`).",
+        default_text="0.1 of the shorter of the mean free time at the thermostat temperature and "
+                     "1 / rate", unit="reduced time",
+        low=0.0, low_open=True, high=TIME_MAX, reason=_TIME,
+        run_check="rate × interval must not exceed 0.5 (the viscous heating would change the "
+                  "temperature by order one between two rescalings)"),
     # [run]
     Key("run", "end_time", "number",
         "Stop at this time (give `end_time`, `collisions_per_particle` or both; the first reached stops).",
@@ -850,10 +885,10 @@ SECTION_CLASSES = {
     "system": SystemConfig, "particles": ParticlesConfig, "initial": InitialConfig,
     "collision": CollisionConfig, "collision.material": MaterialConfig,
     "collision.tangential": TangentialConfig, "driving": DrivingConfig,
-    "gravity": GravityConfig, "walls": WallsConfig, "walls.<side>": WallConfig, "run": RunSection,
-    "output": OutputConfig, "species": SpeciesConfig,
+    "gravity": GravityConfig, "walls": WallsConfig, "walls.<side>": WallConfig, "shear": ShearConfig,
+    "run": RunSection, "output": OutputConfig, "species": SpeciesConfig,
 }
-SECTIONS = ("system", "particles", "initial", "collision", "driving", "gravity", "walls", "run", "output",
+SECTIONS = ("system", "particles", "initial", "collision", "driving", "gravity", "walls", "shear", "run", "output",
             "species")
 #: the array of tables of a mixture, one table per species
 ARRAY_SECTIONS = ("species",)
@@ -862,7 +897,7 @@ MATERIAL_CONSTANTS = ("young_modulus", "poisson_ratio", "dissipation_time")
 #: characters of a species name
 _NAME_CHARACTERS = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_")
 #: sections that may be left out as a whole (absent: None in RunConfig)
-OPTIONAL_SECTIONS = ("driving", "gravity", "walls")
+OPTIONAL_SECTIONS = ("driving", "gravity", "walls", "shear")
 #: the tables of ``[walls]``: each side's keys are the template keys of ``walls.<side>``
 SIDE_TABLES = {f"walls.{side}": "walls.<side>" for side in WALL_SIDES}
 #: keys whose value is a sub-table with its own section in SCHEMA
@@ -1250,6 +1285,49 @@ def _check_dsmc_supported(v: Values):
                                     'method = "dsmc" (a homogeneous DSMC gas shows no inelastic collapse)')
 
 
+def _check_shear(v: Values):
+    boundary = v.get("system.boundary")
+    marked = [a for a, b in enumerate(boundary or ()) if b == "lees-edwards"]
+    if not v.section_given("shear"):
+        if marked:
+            v.fail("system.boundary", '"lees-edwards" needs [shear] (the rate of the flow along x)')
+        return
+    if not v.has("shear.rate"):
+        v.fail("shear.rate", "missing; [shear] needs rate > 0 (the flow a (y - L_y/2) along x)")
+    if marked != [1] or boundary[0] != "periodic":
+        shown = boundary if boundary is not None else ("periodic",) * int(v.get("system.dimension"))
+        v.fail("system.boundary", 'a shear flow needs "lees-edwards" on y and a periodic x, e.g. '
+                                  f'{_show(["periodic", "lees-edwards"] + ["periodic"] * (len(shown) - 2))} '
+                                  "(walls only on z)", list(shown))
+    if v.get("collision.duration") == "resolved":
+        v.fail("collision.duration", '"resolved" is not available with [shear] (Lees-Edwards boundaries)')
+    if v.has("shear.thermostat_interval") and not v.has("shear.thermostat_temperature"):
+        v.fail("shear.thermostat_interval", "needs shear.thermostat_temperature")
+    if getattr(v, "species", None):
+        v.fail("shear.rate", "[shear] is not available with [[species]] (uniform shear flow of one kind of "
+                             "particle only)")
+    if v.has("collision.tangential"):
+        v.fail("collision.tangential", "rough particles are not available with [shear] (uniform shear flow of "
+                                       "smooth particles only)", _Shown("{...}"))
+    if v.section_given("driving"):
+        v.fail("driving.heating_rate", "[driving] is not available with [shear] (the shear's thermostat holds "
+                                       "the temperature of a sheared gas)")
+    if v.section_given("gravity"):
+        v.fail("gravity.acceleration", "[gravity] is not available with [shear] (uniform shear flow without an "
+                                       "external field)")
+    for side in WALL_SIDES:
+        if v.has(f"walls.{side}") and v.get(f"walls.{side}.kind") != "hard":
+            v.fail(f"walls.{side}", f'kind = "{v.get(f"walls.{side}.kind")}" is not available with [shear]: '
+                                    "Lees-Edwards boundaries take hard walls at rest only (on z)", _Shown("{...}"))
+    lo, hi = v.get("particles.diameter.min"), v.get("particles.diameter.max")
+    if v.get("run.method") == "dsmc" and lo is not None and hi is not None and lo < hi:
+        v.fail("particles.diameter", 'the DSMC of uniform shear flow takes identical particles: one diameter '
+                                     '(or method = "edmd")', v.raw.get("particles.diameter"))
+    if v.get("collision.model") == "elastic" and not v.has("shear.thermostat_temperature"):
+        v.fail("shear.rate", 'an elastic gas only heats under shear and never reaches a steady state: give '
+                             "shear.thermostat_temperature or an inelastic collision model")
+
+
 _ROUGH_KEYS = ("particles.inertia", "initial.rotational_temperature", "driving.rotational_fraction")
 
 
@@ -1549,6 +1627,11 @@ RULES: tuple[Rule, ...] = (
          'particles need `duration = "instantaneous"` and one kind of particle (no `[[species]]`), and take no '
          '`[gravity]` and only hard walls in `[walls]`.',
          _check_tangential),
+    Rule('`[shear]` needs `rate` and `boundary` with `"lees-edwards"` on y and a periodic x (walls only on '
+         'z), and `"lees-edwards"` needs `[shear]`; not with `duration = "resolved"`, `[driving]`, '
+         '`[gravity]`, thermal or vibrating `[walls]`, `[[species]]` nor `[collision.tangential]`; with '
+         '`method = "dsmc"` one diameter; an elastic gas needs the thermostat; `thermostat_interval` needs '
+         "`thermostat_temperature`.", _check_shear),
 )
 
 

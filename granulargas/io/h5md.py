@@ -7,6 +7,7 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
         creator/               attrs name = "granulargas", version
     particles/all/
         box/                   attrs dimension = d, boundary = "periodic" or "none" per axis
+                               (H5MD), kind = "periodic", "wall" or "lees-edwards" per axis
                                ("none": flat walls at 0 and the edge, H5MD 1.1)
             edges/             step, time -> hard links to position/step, time
                 value          (F, d) float64 box edge lengths
@@ -27,6 +28,9 @@ Layout written by :class:`H5MDWriter` (N particles, d dimensions, F frames)::
     observables/
         temperature, kinetic_energy, collisions, dissipated_energy, events,
         momentum (d,), pressure:        step (S,), time (S,) shared, value (S, ...)
+        pressure_tensor (d, d)          (event-driven runs of smooth particles without gravity or
+                                        thermal or vibrating walls, and sheared DSMC runs: kinetic +
+                                        collisional transfer, peculiar velocities)
         wall_collisions, wall_pressure  (runs with walls)
         potential_energy                (runs with gravity: -sum m g . r, unwrapped positions)
         wall_work, wall_impulse (d, 2)  (runs with thermal or vibrating walls, or gravity and walls: energy
@@ -108,13 +112,17 @@ CREATOR = "granulargas"
 _wall = _time.monotonic
 SCALAR_OBSERVABLES = ("temperature", "kinetic_energy", "collisions", "events", "dissipated_energy", "pressure",
                       "sonine_a2", "sonine_a3")
-#: observables a file may lack: Sonine coefficients (files written before they were sampled), pressure (DSMC)
-OPTIONAL_OBSERVABLES = ("sonine_a2", "sonine_a3", "pressure")
+#: observables a file may lack: Sonine coefficients (files written before they were sampled), pressure (DSMC),
+#: the pressure tensor (unsheared DSMC, files written before it was sampled)
+OPTIONAL_OBSERVABLES = ("sonine_a2", "sonine_a3", "pressure", "pressure_tensor")
 #: the DSMC random state stored with every frame of a DSMC run: name -> (trailing shape, dtype)
 DSMC_STATE = {"rng": ((5,), np.uint64), "candidates": ((), np.int64), "pending_pair": ((2,), np.int64),
               "pending_time": ((), np.float64), "frame_velocity": (("d",), np.float64)}
 #: observables of runs with walls / with driving (written only by such runs)
 WALL_OBSERVABLES = ("wall_collisions", "wall_pressure")
+#: the pressure tensor (d, d): event-driven runs of smooth particles without gravity or thermal or
+#: vibrating walls, and DSMC runs under shear
+TENSOR_OBSERVABLES = ("pressure_tensor",)
 DRIVING_OBSERVABLES = ("injected_energy", "kick_step")
 GRAVITY_OBSERVABLES = ("potential_energy",)
 #: observables of runs with thermal or vibrating walls, or with gravity and walls
@@ -139,8 +147,9 @@ CORE_FIELDS_DSMC = ("velocities",)
 OPTIONAL_FIELDS = tuple(x for x in PARTICLE_FIELDS if x.per_frame and x.name not in CORE_FIELDS)
 _INT_OBSERVABLES = ("collisions", "events", "wall_collisions", "kick_step", "three_body_contacts",
                     "species_collisions")
-#: H5MD box boundary of each axis kind
-_H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none"}
+#: H5MD box boundary of each axis kind (Lees-Edwards images are periodic with a shift: ``kind``
+#: keeps the axis kinds themselves)
+_H5MD_BOUNDARY = {"periodic": "periodic", "wall": "none", "lees-edwards": "periodic"}
 
 
 def _frame_chunks(n: int, tail: tuple) -> tuple:
@@ -221,7 +230,7 @@ class H5MDWriter:
     """
 
     def __init__(self, path, state: State, *, fields=(), parameters=None, overwrite=False, author=None,
-                 driven=False, gravity=False, wall_kinds=False, species: int = 0):
+                 driven=False, gravity=False, wall_kinds=False, tensor=None, species: int = 0):
         self.path = Path(path)
         self.d, self.n = state.dimension, state.n
         self.positions = state.positions is not None
@@ -244,6 +253,8 @@ class H5MDWriter:
         names = SCALAR_OBSERVABLES + ("momentum",) + extra
         if not self.positions:  # DSMC: no pair virial, no pressure
             names = tuple(x for x in names if x != "pressure")
+        if (self.positions if tensor is None else tensor):
+            names += TENSOR_OBSERVABLES
         try:
             self._create(state, parameters or {}, author, names)
         except BaseException:
@@ -334,6 +345,8 @@ class H5MDWriter:
         b.attrs["dimension"] = np.int32(d)
         b.attrs["boundary"] = np.array([_H5MD_BOUNDARY[x] for x in self.boundary],
                                        dtype=h5py.string_dtype("ascii", 8))
+        if "lees-edwards" in self.boundary:
+            b.attrs["kind"] = np.array(list(self.boundary), dtype=h5py.string_dtype("ascii", 16))
         if state.box is None:
             raise ValueError("H5MDWriter: the state has no box")
         self.box = state.box.copy()
@@ -381,7 +394,8 @@ class H5MDWriter:
         self._obs = {}
         step = time = None
         for name in names:
-            shape = (d,) if name == "momentum" else (d, 2) if name == "wall_impulse" else ()
+            shape = ((d,) if name == "momentum" else (d, d) if name == "pressure_tensor"
+                     else (d, 2) if name == "wall_impulse" else ())
             if name in SPECIES_OBSERVABLES:
                 shape = (self.species,) * (2 if name == "species_collisions" else 1)
             dtype = np.int64 if name in _INT_OBSERVABLES else np.float64
@@ -395,6 +409,11 @@ class H5MDWriter:
                              chunks=(1024,) + shape)
             self._obs[name] = g
         self._obs_clock = (step, time)
+        if "pressure_tensor" in obs:
+            obs["pressure_tensor"].attrs["description"] = (
+                "mean pressure tensor P_ab (kinetic sum m c_a c_b with the peculiar velocities, relative to "
+                "the shear flow if any, plus collisional transfer r_ij,a Delta p_i,b) per volume over the "
+                "sampling interval ending at time; NaN at the first sample of a run")
         if "pressure" in obs:
             obs["pressure"].attrs["description"] = (
                 "mean pressure (kinetic + collisional virial) over the sampling interval ending at time; "
@@ -483,8 +502,8 @@ class H5MDWriter:
             step_ds, time_ds = self._obs_clock
             k, m = step_ds.shape[0], len(self._pending)
             for name, g in self._obs.items():
-                fill = -1 if name in _INT_OBSERVABLES else np.nan
                 v = g["value"]
+                fill = -1 if name in _INT_OBSERVABLES else np.full(v.shape[1:], np.nan)
                 block = np.array([p[2].get(name, fill) for p in self._pending], dtype=v.dtype)
                 v.resize(k + m, axis=0)
                 v[k:k + m] = block
@@ -826,6 +845,11 @@ def read_boundary(f) -> tuple:
     if raw is None:
         return ("periodic",) * d
     names = [x.decode() if isinstance(x, bytes) else str(x) for x in np.atleast_1d(raw)]
+    kind = box.attrs.get("kind", None)
+    if kind is not None:  # our own axis kinds (Lees-Edwards)
+        kinds = tuple(x.decode() if isinstance(x, bytes) else str(x) for x in np.atleast_1d(kind))
+        if len(kinds) == len(names) and all(k in _H5MD_BOUNDARY for k in kinds):
+            return kinds
     return tuple("wall" if x == "none" else "periodic" for x in names)
 
 
@@ -938,7 +962,8 @@ def read_observables(path) -> dict:
                 if any(g[p].dtype.kind not in "fiu" for p in ("step", "time", "value")):
                     raise InputFileError(f"{path}: damaged H5MD file: observables/{name} holds values that are "
                                          "not numbers")
-                want = 1 if name in SCALAR_OBSERVABLES else 2 if name == "momentum" else g["value"].ndim
+                want = (1 if name in SCALAR_OBSERVABLES else 2 if name == "momentum" else 3 if name == "pressure_tensor"
+                        else g["value"].ndim)
                 if g["step"].ndim != 1 or g["time"].ndim != 1 or g["value"].ndim != max(want, 1):
                     raise InputFileError(f"{path}: damaged H5MD file: observables/{name} has step/time/value "
                                          f"of shapes {g['step'].shape}, {g['time'].shape}, {g['value'].shape}")

@@ -15,8 +15,10 @@ A scene is a handful of orthogonal fields:
 * ``model``: the collision law, ``"elastic"``, ``"constant"``, ``"viscoelastic"``, or
   ``"unknown"`` (a file that does not record it);
 * ``kind``: how the energy goes, ``"cooling"`` (dissipative, no driving), ``"driven"``
-  (white-noise driving), ``"vibrated"`` (gravity, or thermal or vibrating walls: the walls
-  put energy in, or the gas settles on a floor), ``"elastic"`` (conserved) or ``"unknown"``;
+  (white-noise driving), ``"shear"`` (uniform shear flow: viscous heating against the
+  collisional loss, or a thermostat), ``"vibrated"`` (gravity, or thermal or vibrating walls:
+  the walls put energy in, or the gas settles on a floor), ``"elastic"`` (conserved) or
+  ``"unknown"``;
 * ``walls``, ``gravity``, ``resolved`` (collisions that take time), ``polydisperse``, ``tc_model``
   (the TC model's elastic collisions), ``material`` (the material route: the contact
   stiffness and so the contact time is known), ``rough`` (rough particles: spins and a
@@ -42,7 +44,7 @@ __all__ = ["Scene", "Statement", "STATEMENTS", "MODELS", "KINDS"]
 #: collision models the theory knows
 MODELS = ("elastic", "constant", "viscoelastic")
 #: how a run's energy goes
-KINDS = ("cooling", "driven", "vibrated", "elastic", "unknown")
+KINDS = ("cooling", "driven", "shear", "vibrated", "elastic", "unknown")
 
 
 @dataclass(frozen=True)
@@ -85,7 +87,8 @@ class Scene:
         return cls(
             method=config.run.method, dimension=s.dimension, model=c.model,
             kind="vibrated" if vibrated else _kind(c.model, eps, damping if c.material is None else 1.0,
-                                                    driving is not None and driving.heating_rate > 0.0),
+                                                    driving is not None and driving.heating_rate > 0.0,
+                                                    getattr(config, "shear", None) is not None),
             walls="wall" in s.boundary, gravity=gravity, resolved=c.duration == "resolved",
             polydisperse=bool(not mixture and p.polydisperse and p.diameter_max > p.diameter_min),
             tc_model=c.tc_time is not None,
@@ -105,6 +108,7 @@ class Scene:
             model = "unknown"
         drv = parameters.get("driving")
         driven = isinstance(drv, dict) and _float(drv.get("heating_rate"), 0.0) > 0.0
+        sheared = isinstance(parameters.get("shear"), dict)
         material = isinstance(parameters.get("units_si"), dict)
         grav = parameters.get("gravity")
         gravity = isinstance(grav, dict) and bool(np.any(np.asarray(grav.get("acceleration", 1.0), float) != 0.0))
@@ -119,7 +123,8 @@ class Scene:
         return cls(
             method=str(parameters.get("method", "edmd")), dimension=int(dimension), model=model,
             kind="vibrated" if (gravity or moving) and model != "unknown" else
-            _kind(model, _float(coll.get("restitution"), None), _float(coll.get("prefactor"), None), driven),
+            _kind(model, _float(coll.get("restitution"), None), _float(coll.get("prefactor"), None), driven,
+                  sheared),
             walls="wall" in tuple(boundary), gravity=gravity,
             resolved=bool(contacts) or coll.get("duration") == "resolved",
             polydisperse=poly, tc_model=_float(coll.get("tc_time"), None) is not None, material=material,
@@ -139,7 +144,7 @@ class Scene:
                "unknown": "collision model not recorded"}[self.model]
         parts = ["DSMC (no space)" if self.method == "dsmc" else "EDMD", f"{self.dimension}D"]
         if self.kind not in ("elastic", "unknown"):
-            parts.append(self.kind)
+            parts.append("uniform shear flow" if self.kind == "shear" else self.kind)
         parts.append(law)
         parts += [name for name, on in (("walls", self.walls), ("gravity", self.gravity),
                                         ("collisions that take time", self.resolved),
@@ -160,10 +165,12 @@ def _float(value, default):
         return default
 
 
-def _kind(model: str, restitution, damping, driven: bool) -> str:
-    """How the energy of a run goes: "driven", "cooling", "elastic" or "unknown"."""
+def _kind(model: str, restitution, damping, driven: bool, sheared: bool = False) -> str:
+    """How the energy of a run goes: "shear", "driven", "cooling", "elastic" or "unknown"."""
     if model == "unknown":
         return "unknown"
+    if sheared:
+        return "shear"
     if driven:
         return "driven"
     if model == "constant":
@@ -191,11 +198,14 @@ STATEMENTS = {
         "T(t) of the homogeneous cooling state (kinetic theory)", _cools),
     "driven_state": Statement(
         "relaxation to the steady temperature of the white-noise driving", lambda s: s.kind == "driven"),
+    "shear_state": Statement(
+        "uniform shear flow: the steady state of viscous heating against the collisional loss (or the "
+        "thermostat's), a*, eta*, the normal stresses (Grad solution)", lambda s: s.kind == "shear"),
     "conserved_energy": Statement(
         "elastic collisions: T stays at T0 (energy drift, equation of state)", lambda s: s.kind == "elastic"),
     "eps_spread": Statement(
         "the spread of eps over thermal impacts between the run's hottest and coldest moments",
-        lambda s: s.model == "viscoelastic" and s.kind in ("cooling", "driven")),
+        lambda s: s.model == "viscoelastic" and s.kind in ("cooling", "driven", "shear")),
     "constant_or_viscoelastic": Statement(
         "best constant eps against the viscoelastic T(t), or the damping of the same initial cooling rate "
         "(compares cooling curves of smooth particles of one kind)",
@@ -211,7 +221,7 @@ STATEMENTS = {
         lambda s: not s.space and _cools(s)),
     "collapse": Statement(
         "inelastic collapse of a constant eps without the TC model (dense regions in space)",
-        lambda s: s.space and s.model == "constant" and not s.tc_model and s.kind in ("cooling", "driven")),
+        lambda s: s.space and s.model == "constant" and not s.tc_model and s.kind in ("cooling", "driven", "shear")),
     "pressure": Statement(
         "the pressure (collisional virial) and Z = P/(nT)", lambda s: s.space and not s.gravity),
     "wall_pressure": Statement(

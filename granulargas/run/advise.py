@@ -99,7 +99,7 @@ from granulargas.theory.rough import smooth_deviation
 __all__ = ["DEFAULT_TOLERANCE", "Advice", "advise", "summary_line", "constant_error", "best_constant",
            "choose_method", "dsmc_speedup", "DSMC_MAX_PACKING", "method_line", "choose_duration",
            "duration_error", "dem_cost", "fastest_impact_bounds", "RESOLVED_LAMMPS_MEASURED", "RESOLVED_COST",
-           "RESOLVED_THREE_BODY_CHECKED"]
+           "RESOLVED_THREE_BODY_CHECKED", "shear_prediction"]
 
 #: default tolerance on the relative error of T(t)
 DEFAULT_TOLERANCE = 0.02
@@ -347,6 +347,8 @@ class Advice:
     validity: tuple = ()
     species: tuple = ()
     notes: tuple = ()
+    steady: str = ""
+    shear: dict | None = None
     #: a vibrated scene's lines (:func:`granulargas.run.vibrated.scene_lines`), in place of the cooling advice
     vibrated: tuple = ()
     #: a vibrated scene's numbers (:func:`granulargas.run.vibrated.scene`), for JSON
@@ -370,6 +372,9 @@ class Advice:
                     "(Enskog theory, first Sonine)")
         if sc.kind == "driven":
             return f"{head} (elastic collisions heated by the driving: T0 + H t, no steady state)"
+        if sc.kind == "shear":
+            return (f"{head}, uniform shear flow: steady T_s = {self.T_steady:.4g} T0 ({self.steady}); T is the "
+                    "peculiar temperature")
         if sc.kind == "elastic":
             return f"{head} (elastic collisions conserve the energy)"
         return f"{head} (homogeneous cooling, kinetic theory)"
@@ -393,9 +398,16 @@ class Advice:
                       f"them (t = {relaxed:.4g})")
             out.append(f"steady state relaxation time 1/zeta(T_ss) = {self.relaxation_time:.4g}; the run lasts "
                        f"{n:.3g} of them{enough}")
+        if sc.shows("shear_state") and self.shear is not None:
+            g = self.shear
+            ns = "; eta*_NS = {:.4g} (Navier-Stokes, Garzó & Dufty 1999)".format(g["eta_navier_stokes"]) \
+                if g.get("eta_navier_stokes") is not None else ""
+            out.append(f"shear flow   a* = a/nu0 = {g['a_star']:.4g} at T_s, Grad solution eta* = {g['eta_star']:.4g}, "
+                       f"P_xx/p = {g['pxx']:.4g}, P_yy/p = {g['pyy']:.4g}{ns}; granulargas analyze compares the steady "
+                       "state with these")
         if self.spread is not None and sc.shows("eps_spread"):
             sp = self.spread
-            span = "from T0 to the steady state" if sc.kind == "driven" else "start to end"
+            span = "from T0 to the steady state" if sc.kind in ("driven", "shear") else "start to end"
             out.append(f"eps spread   {sp['eps_min']:.4f} .. {sp['eps_max']:.4f} (beta {sp['beta_max']:.3g} .. "
                        f"{sp['beta_min']:.3g}) over thermal impacts, {span}")
         if sc.shows("constant_or_viscoelastic"):
@@ -444,6 +456,7 @@ class Advice:
             "temperature_end_ratio": self.T_end,
             "temperature_steady": self.T_steady * self.T0,
             "relaxation_time": self.relaxation_time,
+            "shear": self.shear,
             "eps_min": sp.get("eps_min"),
             "eps_max": sp.get("eps_max"),
             "eps_best": self.eps_best if self.scene.shows("constant_or_viscoelastic") else None,
@@ -463,6 +476,29 @@ class Advice:
             "vibrated": self.vibrated_numbers or None,
         }
         return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+
+
+def shear_prediction(config, gas: V.Gas, T_s: float) -> dict:
+    """The Grad solution of a sheared config at its steady (or thermostat) temperature ``T_s``
+    (:func:`granulargas.theory.shear.grad_usf`): a* = a/nu0(T_s), eta*, P_xx/p, P_yy/p, and the
+    Navier-Stokes eta* (:func:`granulargas.theory.shear.navier_stokes_viscosity_reduced`) of a
+    constant or elastic rule."""
+    from granulargas.theory import shear as usf
+
+    d, n, sigma, m = gas.dimension, gas.density, gas.sigma, gas.mass
+    sh = config.shear
+    a_star = sh.rate / float(usf.reference_frequency(n, T_s, d, sigma, m))
+    if gas.model == "elastic":
+        eps = 1.0
+    elif gas.model == "constant":
+        eps = gas.restitution
+    else:
+        eps = float(theory.effective_restitution(gas.prefactor, T_s, d, sigma, m, gas.end))
+    thermostat = sh.thermostat_temperature is not None
+    st = usf.grad_usf(eps, d, gas.packing_fraction, a_star=a_star if thermostat or eps >= 1.0 else None)
+    return {"a_star": float(st.a_star), "eta_star": float(st.eta_star), "pxx": float(st.pressure[0, 0]),
+            "pyy": float(st.pressure[1, 1]), "eps": float(eps), "thermostat": thermostat,
+            "eta_navier_stokes": float(usf.navier_stokes_viscosity_reduced(eps, d, gas.packing_fraction))}
 
 
 def _haff(gas: V.Gas, eps: float, t):
@@ -587,6 +623,11 @@ def advise(config, tolerance: float = DEFAULT_TOLERANCE) -> Advice:
         adv.T_steady = rv.T_steady / T0
         if math.isfinite(rv.T_steady):
             adv.relaxation_time = rv.T_steady / config.driving.heating_rate  # 1/zeta(T_ss) = T_ss / H
+    if scene.kind == "shear":
+        adv.T_steady = rv.T_steady / T0
+        adv.steady = rv.steady or ""
+        if math.isfinite(rv.T_steady) and not rv.errors:
+            adv.shear = shear_prediction(config, gas, rv.T_steady)
     if scene.shows("instability") or scene.shows("homogeneous_by_construction"):
         with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
             adv.instability_length = gas.instability_length()

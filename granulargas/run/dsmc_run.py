@@ -37,18 +37,24 @@ class DSMCRun(DSMC):
 
     @property
     def boundary(self) -> tuple:
-        return ("periodic",) * self.dimension
+        return self._boundary
 
     def synchronise(self):
-        """Nothing to do: velocities and time are always the state at :attr:`time`."""
+        """Nothing to do without shear (velocities and time are always the state at :attr:`time`);
+        under shear the stored velocities are brought to :attr:`time` (:meth:`DSMC.synchronise`)."""
+        DSMC.synchronise(self)
 
     def observables(self) -> dict:
         """One observables sample (:mod:`granulargas.io.h5md`): no pressure; ``events`` is the
         count of candidate pairs drawn."""
         t, a2, a3 = self._moments()
-        ke, *p = kinetic_energy_momentum(self._rec, self.dimension, self._mass_arg)
+        ke, *p = kinetic_energy_momentum(self._current_rec(), self.dimension, self._mass_arg)
         driven = {} if self.driving is None else {"injected_energy": float(self.injected_energy),
                                                    "kick_step": int(self.kick_step)}
+        if self.shear is not None:
+            if self.shear.thermostat:
+                driven = {"injected_energy": float(self.injected_energy), "kick_step": 0}
+            driven["pressure_tensor"] = self.pressure_tensor_window()
         return {**driven, **self.species_observables(),
             "temperature": float(t),
             "kinetic_energy": float(ke),
@@ -79,4 +85,4 @@ def make_dsmc(config, setup) -> DSMCRun:
     dsmc = setup.parameters["dsmc"]
     chi = dsmc.get("chi_pairs", dsmc["chi"])
     return DSMCRun(setup.state, setup.rule, chi=chi, seed=config.system.seed, driving=setup.driving,
-                   tangential=setup.tangential)
+                   shear=setup.shear, tangential=setup.tangential)

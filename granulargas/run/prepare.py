@@ -43,6 +43,7 @@ from granulargas.contact.oblique import DELTA_MAX, compression_prefactor
 from granulargas.contact.oblique_grid import BETA_MAX as OBLIQUE_BETA_MAX
 from granulargas import theory
 from granulargas.engine import CollisionRule, TangentialRule, Wall, Walls, WhiteNoise
+from granulargas.engine.shear import Shear
 from granulargas.engine.simulation import MIN_BOX_DIAMETERS
 from granulargas.errors import ConfigError, InputFileError
 from granulargas.initial import box_for_packing, maxwell_spins, random_state
@@ -75,6 +76,8 @@ class Setup:
     #: the uniform acceleration (tuple) or None; the wall kinds (engine.walls.Walls) or None
     gravity: tuple | None = None
     walls: object = None
+    #: uniform shear flow (``[shear]``: :class:`granulargas.engine.shear.Shear`), or None
+    shear: object = None
     #: rough particles: the tangential rule (None: smooth)
     tangential: object = None
 
@@ -163,7 +166,8 @@ def fresh_state(config: RunConfig) -> State:
         check_wall_room(config, walls, box, dmax)
     try:
         state = random_state(s.particles, s.packing_fraction, s.dimension, config.initial.temperature,
-                             radii=radii, masses=masses, rng=rng, boundary=s.boundary, margins=margins)
+                             radii=radii, masses=masses, rng=rng, boundary=s.boundary, margins=margins,
+                             shear=None if config.shear is None else config.shear.rate)
         return state if not config.species else state.replace(species=species_indices(config))
     except ConfigError as exc:
         limit = RANDOM_PLACEMENT_MAX[s.dimension]
@@ -396,6 +400,53 @@ def driven_energy_bound(config: RunConfig, prefactor: float, state: State) -> fl
     return 2.0 * max(e0, 0.5 * s.dimension * len(state.masses) * t_ss)
 
 
+def sheared_energy_bound(config: RunConfig, prefactor: float, state: State) -> float:
+    """The peculiar kinetic energy the restitution table of a sheared viscoelastic run must cover
+    (as :func:`driven_energy_bound`): twice the larger of the initial peculiar energy and
+    N d T / 2 at the steady or thermostat temperature (:func:`granulargas.theory.shear.steady_temperature`),
+    with the relative speed a sigma the flow adds over a contact folded into the temperature."""
+    s, sh = config.system, config.shear
+    sigma, m = mean_particle(config)
+    n = float(len(state.radii)) / float(np.prod(state.box))
+    if sh.thermostat_temperature is not None:
+        t_ss = sh.thermostat_temperature
+    else:
+        end = config.collision.contact_end
+        t_ss = theory.shear.steady_temperature(
+            sh.rate, lambda T: float(theory.effective_restitution(prefactor, T, s.dimension, sigma, m, end)), n,
+            s.dimension, sigma, m, s.packing_fraction)
+    t_ss = (math.sqrt(t_ss) + sh.rate * 2.0 * float(state.radii.max()) * math.sqrt(m)) ** 2
+    c = state.velocities.copy()
+    if state.positions is not None:
+        c[:, 0] -= sh.rate * (state.positions[:, 1] - 0.5 * state.box[1])
+    e0 = 0.5 * float((state.masses[:, None] * c**2).sum())
+    return 2.0 * max(e0, 0.5 * s.dimension * len(state.masses) * t_ss)
+
+
+def make_shear(config: RunConfig, state: State):
+    """(Shear or None, parameters) of the config's ``[shear]``: the thermostat's interval,
+    unless given, 0.1 of the shorter of the mean free time at its temperature and the
+    shear time 1/rate (so that neither collisions nor the viscous heating change the
+    temperature much between two rescalings)."""
+    sh = config.shear
+    if sh is None:
+        return None, None
+    params = {"rate": sh.rate, "flow": "x", "gradient": "y",
+              "description": "uniform shear flow u = rate (y - L_y/2) along x; Lees-Edwards boundaries on y "
+                             "(engine), homogeneous shear flow in the Lagrangian frame (DSMC)"}
+    if sh.thermostat_temperature is None:
+        return Shear(sh.rate), params
+    interval = sh.thermostat_interval
+    if interval is None:
+        sigma, m = mean_particle(config)
+        n = float(len(state.radii)) / float(np.prod(state.box))
+        omega = float(theory.collision_frequency(n, sh.thermostat_temperature, config.system.dimension, sigma, m))
+        interval = 0.1 / max(omega, sh.rate)
+    params.update(thermostat_temperature=sh.thermostat_temperature, thermostat_interval=interval,
+                  thermostat="the peculiar velocities rescaled to thermostat_temperature at (k + 1/2) interval")
+    return Shear(sh.rate, sh.thermostat_temperature, interval), params
+
+
 def scene_energy_bound(config: RunConfig, state: State) -> float:
     """Total kinetic energy the restitution table of a run under gravity or with thermal or
     vibrating walls must cover: twice the initial energy plus, per particle, the largest
@@ -451,6 +502,8 @@ def make_rule(config: RunConfig, state: State):
     k_bound = float(pairs.max()) if mixture else k
     driven = config.driving is not None and config.driving.heating_rate > 0.0
     energy = driven_energy_bound(config, k_bound, state) if driven else None
+    if config.shear is not None:
+        energy = sheared_energy_bound(config, k_bound, state)
     if config.gravity is not None or (config.walls is not None and config.walls.moving):
         energy = max(energy or 0.0, scene_energy_bound(config, state))
     bmax = beta_bound(k_bound, state, energy)
@@ -698,6 +751,7 @@ def prepare(config: RunConfig) -> Setup:
     source = str(Path(config.initial.from_file)) if config.initial.from_file else None
     rule, name, k, table, warns, rule_params = make_rule(config, state)
     driving, driving_params = make_driving(config, k, state)
+    shear, shear_params = make_shear(config, state)
     gravity, walls, scene_params = make_scene(config, state)
     tangential, tangential_params = make_tangential(config)
     s = config.system
@@ -720,6 +774,8 @@ def prepare(config: RunConfig) -> Setup:
     }
     if driving_params is not None:
         parameters["driving"] = driving_params
+    if shear_params is not None:
+        parameters["shear"] = shear_params
     parameters.update(scene_params)
     if config.run.method == "dsmc":
         parameters["dsmc"] = {
@@ -746,4 +802,5 @@ def prepare(config: RunConfig) -> Setup:
                                  "collisions": state.collisions}
     if tangential_params is not None:
         parameters["tangential"] = tangential_params
-    return Setup(rule, name, state, k, table, parameters, warns, driving, source, gravity, walls, tangential)
+    return Setup(rule, name, state, k, table, parameters, warns, driving, source, gravity, walls, shear=shear,
+                 tangential=tangential)

@@ -42,7 +42,7 @@ from granulargas.observables import sonine_coefficients, species_moments
 from granulargas.run.rough import rotational_observables
 from granulargas.state import State
 
-__all__ = ["RunWriter", "run_parameters", "rule_parameters", "observables"]
+__all__ = ["RunWriter", "run_parameters", "rule_parameters", "shear_parameters", "observables"]
 
 #: ``parameters/units`` of a run in reduced units
 UNITS = ("length: reference particle diameter; mass: reference particle mass; energy: initial temperature T0 "
@@ -135,6 +135,8 @@ def run_parameters(sim) -> dict:
     if tg is not None:  # rough particles: the tangential law and kappa (analysis.rough reads it)
         kappa = np.asarray(sim.inertia)
         out["tangential"] = {**tg.parameters(), "inertia": float(kappa.mean())}
+    if getattr(sim, "shear", None) is not None:
+        out["shear"] = shear_parameters(sim.shear)
     if _is_dsmc(sim):
         out["dsmc"] = {"chi": float(sim.chi), "number_density": float(radii.shape[0] / float(sim.volume))}
         if sim.chi_pairs is not None:
@@ -147,6 +149,17 @@ def run_parameters(sim) -> dict:
                         for name, w in ((n, getattr(sim.walls, n)) for n in WALL_SIDES) if w is not None}
     if sim.rule.species:
         out["species"] = species_parameters(sim, d)
+    return out
+
+
+def shear_parameters(shear) -> dict:
+    """``parameters/shear`` of a :class:`granulargas.engine.shear.Shear` (as ``granulargas run``
+    records a config's ``[shear]``)."""
+    out = {"rate": float(shear.rate), "flow": "x", "gradient": "y",
+           "description": "uniform shear flow u = rate (y - L_y/2) along x; Lees-Edwards boundaries on y "
+                          "(engine), homogeneous shear flow in the Lagrangian frame (DSMC)"}
+    if shear.thermostat:
+        out.update(thermostat_temperature=float(shear.temperature), thermostat_interval=float(shear.interval))
     return out
 
 
@@ -171,11 +184,16 @@ def observables(sim, pressure: bool) -> dict:
     NaN); a DSMC has none."""
     if hasattr(sim, "observables"):  # a config's DSMC run (run.dsmc_run.DSMCRun)
         return sim.observables()
+    thermostat = getattr(sim, "shear", None) is not None and sim.shear.thermostat
     rough = {} if getattr(sim, "tangential", None) is None else rotational_observables(sim)
     if _is_dsmc(sim):
         a2, a3 = sim.sonine_a2, sim.sonine_a3
         driven = {} if sim.driving is None else {"injected_energy": float(sim.injected_energy),
                                                   "kick_step": int(sim.kick_step)}
+        if sim.shear is not None:
+            if thermostat:  # the heat the thermostat took out (< 0)
+                driven = {"injected_energy": float(sim.injected_energy), "kick_step": 0}
+            driven["pressure_tensor"] = sim.pressure_tensor_window()
         return {**driven, **species_observables(sim),
                 "temperature": float(sim.temperature), "kinetic_energy": float(sim.kinetic_energy),
                 "collisions": int(sim.collisions), "events": int(sim.candidates),
@@ -190,10 +208,17 @@ def observables(sim, pressure: bool) -> dict:
         "events": int(sim.events),
         "dissipated_energy": float(sim.dissipated_energy),
         "momentum": np.asarray(sim.momentum, dtype=np.float64),
-        "pressure": float(sim.pressure_window()) if pressure else math.nan,
         "sonine_a2": float(a2),
         "sonine_a3": float(a3),
     }
+    d = sim.dimension
+    if pressure:
+        p, tensor = sim.pressure_windows()
+    else:
+        p, tensor = math.nan, (np.full((d, d), math.nan) if sim.stress else None)
+    out["pressure"] = float(p)
+    if tensor is not None:
+        out["pressure_tensor"] = np.asarray(tensor, dtype=np.float64)
     gravity = getattr(sim, "gravity", None)
     walls = getattr(sim, "walls", None)
     if gravity is not None:
@@ -205,8 +230,8 @@ def observables(sim, pressure: bool) -> dict:
             # the momentum per wall over the interval (read before the wall pressure resets it)
             out["wall_impulse"] = sim.wall_impulse() if pressure else np.full((sim.dimension, 2), math.nan)
         out["wall_pressure"] = float(sim.wall_pressure_window()) if pressure else math.nan
-    if sim.driving is not None:
-        out["injected_energy"] = float(sim.injected_energy)
+    if sim.driving is not None or thermostat:
+        out["injected_energy"] = float(sim.injected_energy)  # a thermostat's: the heat taken out, < 0
         out["kick_step"] = int(sim.kick_step)
     if sim.rule.resolved:
         out["three_body_contacts"] = int(sim.three_body_contacts)
@@ -247,10 +272,13 @@ class RunWriter:
         self.sim = sim
         self.dsmc = _is_dsmc(sim)
         params = {**run_parameters(sim), **(parameters or {})}
+        sheared = getattr(sim, "shear", None) is not None
         walls = getattr(sim, "walls", None)
         self.writer = H5MDWriter(path, _state(sim), fields=_fields(sim), parameters=params, overwrite=overwrite,
-                                 driven=sim.driving is not None, gravity=getattr(sim, "gravity", None) is not None,
-                                 wall_kinds=walls is not None and walls.moving, species=sim.rule.species)
+                                 driven=sim.driving is not None or (sheared and sim.shear.thermostat),
+                                 gravity=getattr(sim, "gravity", None) is not None,
+                                 wall_kinds=walls is not None and walls.moving,
+                                 tensor=(not self.dsmc and sim.stress) or sheared, species=sim.rule.species)
         self.path = self.writer.path
         self._last_sample = None
         try:

@@ -530,7 +530,8 @@ def _build_simulation(config: RunConfig, setup, st, what):
         sim = make_dsmc(config, setup)
     else:
         sim = Simulation(st, setup.rule, driving=setup.driving, neighbours=config.run.neighbours,
-                         gravity=setup.gravity, walls=setup.walls, tangential=setup.tangential)
+                         shear=setup.shear, stress=_stress(setup), gravity=setup.gravity, walls=setup.walls,
+                         tangential=setup.tangential)
         what[0] = describe([v for v in variants_for(config, sim.neighbours) if v.announced])
     sim.run(until=sim.time)
     return sim
@@ -545,8 +546,11 @@ def _open_writer(config: RunConfig, setup, st, sim, path, append: bool, overwrit
         writer.set_parameters(_continuation_record(writer, config, setup, st))
     else:
         writer = H5MDWriter(path, st, fields=fields, parameters=setup.parameters, overwrite=overwrite,
-                            driven=sim.driving is not None, gravity=setup.gravity is not None,
-                            wall_kinds=setup.walls is not None and setup.walls.moving, species=setup.rule.species)
+                            driven=sim.driving is not None or (setup.shear is not None and setup.shear.thermostat),
+                            gravity=setup.gravity is not None,
+                            wall_kinds=setup.walls is not None and setup.walls.moving,
+                            tensor=(config.run.method != "dsmc" and _stress(setup)) or setup.shear is not None,
+                            species=setup.rule.species)
     try:
         if stop is not None:
             stop.arm()
@@ -629,6 +633,14 @@ def _close_finished(writer, bar, summary: RunSummary) -> None:
     writer.close()
     if bar is not None:
         bar.close()
+
+
+def _stress(setup) -> bool:
+    """Whether a config run keeps the pressure tensor's sums: smooth particles, no gravity and
+    no thermal or vibrating walls (the engine's stress sums follow straight flights and hard
+    walls only)."""
+    return (setup.tangential is None and setup.gravity is None
+            and not (setup.walls is not None and setup.walls.moving))
 
 
 def _continuation_record(writer, config: RunConfig, setup, st) -> dict:

@@ -71,6 +71,21 @@ The engine and DSMC both remove the centre-of-mass velocity that round-off leave
 (:meth:`granulargas.engine.Simulation.run`, :class:`granulargas.dsmc.DSMC`), so a
 gas cooling by many decades needs no restart for it.
 
+Shear flow
+----------
+A sheared gas ([shear]) heads for the steady state where viscous heating balances the
+collisional loss (:mod:`granulargas.theory.shear`: the Grad solution, ``T_s`` of
+:func:`granulargas.theory.shear.steady_temperature`, a viscoelastic gas at its effective
+restitution), or is held at the thermostat's temperature. A run is refused when its
+shear rate drives the gas there more slowly than the run lasts: the dilute Grad moment
+equations (collision rates times chi) from T0 do not bring T within a factor 1.25 of
+``T_s`` by ``end_time`` or within ``collisions_per_particle``
+(:func:`granulargas.theory.shear.grad_transient`); and, as any run, when the clock at
+the end cannot resolve the events at ``T_s``. A thermostat holds the temperature only
+if the viscous heating changes it little between two rescalings: an interval with
+rate x interval above ``THERMOSTAT_STRAIN_MAX`` is refused (the default interval is
+0.1 of the shorter of the mean free time and 1/rate).
+
 Runner API (one line each, for the run summary)
 -----------------------------------------------
 * :func:`check_run` ``(config) -> RunValidity``: all the numbers;
@@ -140,6 +155,10 @@ TC_RATIO_WARN = 0.01
 UNDERFLOW_T = 1e-250
 #: the float64 clock must resolve this fraction of the time between a particle's events
 CLOCK_RESOLUTION = 1e-6
+#: largest shear strain a x thermostat_interval between two rescalings of a thermostatted
+#: shear flow (the viscous heating's relative change of T over one interval is at most
+#: (2/d) a dt |P_xy|/p, and |P_xy| <= p)
+THERMOSTAT_STRAIN_MAX = 0.5
 #: beta above which the viscoelastic force is questionable (contact.material.BETA_VALID_MAX)
 BETA_VALID = 1.0
 
@@ -307,6 +326,8 @@ class RunValidity:
     T_steady: float = math.nan
     instability_warning: str | None = None
     T_stable: float = math.nan
+    #: what holds the steady state of a sheared run (None: not sheared)
+    steady: str | None = None
     #: a vibrated scene's lines (gravity, thermal or vibrating walls: :mod:`granulargas.run.vibrated`),
     #: in place of the homogeneous gas's temperature range
     vibrated: list = field(default_factory=list)
@@ -328,7 +349,9 @@ class RunValidity:
             out += [f"error: {e}" for e in self.errors]
             return out
         theory_name = "two-temperature theory" if self.scene.rough else "Enskog theory"
-        if self.driven and math.isfinite(self.T_steady):
+        if self.steady is not None:
+            out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} (steady shear flow: {self.steady})"]
+        elif self.driven and math.isfinite(self.T_steady):
             at = f"at t = {self.t_end:.4g}; " if math.isfinite(self.t_end) else ""
             out = [f"validity     T {self.T_start:.3g} -> {self.T_end:.3g} ({at}steady state of the driving "
                    f"{self.T_steady:.4g}, {theory_name})"]
@@ -449,6 +472,69 @@ def _check_driven(config, gas, scene) -> RunValidity:
     return rv
 
 
+def _check_sheared(config, gas, scene) -> RunValidity:
+    """Checks of a sheared run (module doc, "Shear flow")."""
+    sh = config.shear
+    src = gas.source
+    d, n, sigma, m = gas.dimension, gas.density, gas.sigma, gas.mass
+    chi = float(theory.contact_value(gas.packing_fraction, d))
+    if sh.thermostat_temperature is not None:
+        rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, sh.thermostat_temperature,
+                         scene=scene, T_steady=float(sh.thermostat_temperature))
+        rv.steady = "the thermostat"
+        dt = sh.thermostat_interval
+        if dt is not None and sh.rate * dt > THERMOSTAT_STRAIN_MAX:
+            rv.errors.append(f"{src}: shear.thermostat_interval = {dt:g}: rate x interval = {sh.rate * dt:.3g} > "
+                             f"{THERMOSTAT_STRAIN_MAX:g}: the viscous heating changes the temperature by order one "
+                             f"between two rescalings, so the thermostat does not hold it; give an interval "
+                             f"below {THERMOSTAT_STRAIN_MAX / sh.rate:.3g} (or leave it out) or a lower shear.rate")
+            return rv
+        t_end = gas.end_time if gas.end_time is not None else math.nan
+        clock = _clock_error(gas, t_end, math.log(sh.thermostat_temperature), "run.end_time")
+        if clock:
+            rv.errors.append(clock)
+        return rv
+    if gas.model == "constant":
+        eps = gas.restitution
+    else:
+        prefactor = gas.prefactor
+
+        def eps(T):
+            return float(theory.effective_restitution(prefactor, T, d, sigma, m, gas.end))
+    T_s = theory.shear.steady_temperature(sh.rate, eps, n, d, sigma, m, gas.packing_fraction)
+    rv = RunValidity(gas, float(gas.end_time or math.nan), gas.temperature, float(T_s), scene=scene,
+                     T_steady=float(T_s))
+    rv.steady = "viscous heating = collisional loss, Grad solution"
+    if not (UNDERFLOW_T < T_s / m < 1e100):
+        rv.errors.append(f"{src}: shear.rate = {sh.rate:g}: the steady temperature would be T = {T_s:.3g} (Grad "
+                         "solution), out of float64's range for squared speeds; choose a rate near the steady "
+                         f"one at T0 ({sh.rate * math.sqrt(gas.temperature / T_s):.4g})")
+        return rv
+    horizon = gas.end_time if gas.end_time is not None else math.inf
+    t_reach, s_reach = theory.shear.grad_transient(sh.rate, eps, n, gas.temperature, d, sigma, m, chi,
+                                                   t_end=horizon if math.isfinite(horizon) else math.inf)
+    short_t = gas.end_time is not None and not t_reach <= gas.end_time
+    short_s = gas.collisions_per_particle is not None and not s_reach <= gas.collisions_per_particle
+    if short_t or short_s:
+        key = "run.end_time" if short_t else "run.collisions_per_particle"
+        value = gas.end_time if short_t else gas.collisions_per_particle
+        need = (f"t = {t_reach:.3g}" if short_t else f"{s_reach:.3g} collisions per particle")
+        if not math.isfinite(t_reach):
+            need = "longer than the run"
+        a_near = sh.rate * math.sqrt(gas.temperature / T_s)
+        rv.errors.append(f"{src}: shear.rate = {sh.rate:g}: the gas would move from T0 = {gas.temperature:g} to its "
+                         f"steady T = {T_s:.3g} (Grad solution) in {need}, beyond {key} = {value:g}: the run would "
+                         f"end far from the steady state; lengthen the run or choose a rate near {a_near:.4g} "
+                         "(steady at T0)")
+        return rv
+    t_end = gas.end_time if gas.end_time is not None else t_reach
+    clock = _clock_error(gas, float(t_end), math.log(T_s), "run.end_time" if gas.end_time is not None
+                         else "run.collisions_per_particle")
+    if clock:
+        rv.errors.append(clock)
+    return rv
+
+
 def _warn_contact(rv: RunValidity, gas: RunGas, spread) -> None:
     """Warnings of contacts the event-driven model misstates: contact durations that are not
     short against the mean free time, and damping beyond the quasi-static force's range."""
@@ -504,6 +590,8 @@ def check_run(config) -> RunValidity:
         rv = RunValidity(gas, math.nan, gas.temperature, math.nan, scene=scene)
         rv.errors.append(table)
         return rv
+    if scene.kind == "shear":
+        return _check_sheared(config, gas, scene)
     if scene.kind == "driven":
         return _check_driven(config, gas, scene)
     if scene.kind == "vibrated" and isinstance(config, RunConfig):

@@ -14,6 +14,9 @@ import theory; theory.haff_tau0(...)``):
   a config's gas (:class:`~granulargas.theory.gas.Gas`; import it from there);
 * :mod:`~granulargas.theory.driven` -- the white-noise driven steady state
   (temperature, a2, kick interval; viscoelastic: effective restitution);
+* :mod:`~granulargas.theory.shear` -- uniform shear flow: the Grad solution (dilute
+  and Enskog, with or without a thermostat) and the Navier-Stokes shear viscosity of
+  a granular gas (import it from there).
 * :mod:`~granulargas.theory.vibrated` -- gases under gravity and on vibrating walls:
   hydrostatic and barometric profiles, the bouncing ball, the dilute vibrofluidized bed;
 * :mod:`~granulargas.theory.rough` -- rough grains: the two-temperature (translation,
@@ -24,7 +27,7 @@ import theory; theory.haff_tau0(...)``):
   (Garzó & Dufty 1999), contact values of a mixture (import it from there).
 """
 
-from granulargas.theory import driven, enskog, gas, mixture, rough, vibrated, viscoelastic  # noqa: F401
+from granulargas.theory import driven, enskog, gas, mixture, rough, shear, vibrated, viscoelastic  # noqa: F401
 from granulargas.theory.driven import *  # noqa: F401,F403
 from granulargas.theory.enskog import *  # noqa: F401,F403
 from granulargas.theory.vibrated import *  # noqa: F401,F403

@@ -73,7 +73,8 @@ def driven_temperature(heating_rate, eps, n, dim=3, sigma=1.0, m=1.0, chi=None, 
     """Steady temperature of a white-noise driven gas, ``zeta(T) T = H`` (constant eps).
 
     With the Enskog cooling rate ``zeta = Z0 sqrt(T)``: ``T = (H / Z0)^(2/3)``.
-    ``heating_rate`` H is dT/dt of the driving alone.
+    ``heating_rate`` H is dT/dt of the driving alone. Infinite where the gas does not
+    cool (``Z0 = 0``: elastic, or a density that underflows).
 
     Parameters
     ----------
@@ -83,7 +84,8 @@ def driven_temperature(heating_rate, eps, n, dim=3, sigma=1.0, m=1.0, chi=None, 
     if a2 is None:
         a2 = driven_sonine_a2(eps, dim)
     z0 = enskog_cooling_rate(eps, n, 1.0, dim, sigma, m, chi, a2)
-    return (np.asarray(heating_rate, dtype=float) / z0) ** (2.0 / 3.0)
+    with np.errstate(divide="ignore"):  # a gas that does not cool (z0 = 0) has no steady state: inf
+        return (np.asarray(heating_rate, dtype=float) / z0) ** (2.0 / 3.0)
 
 
 def driving_interval(cooling_rate, fraction=0.02):

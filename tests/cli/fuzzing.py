@@ -74,6 +74,22 @@ BASES = {
         "run": {"end_time": 1.0},
         "output": dict(_OUTPUT),
     },
+    "shear-3d": {
+        "system": {"dimension": 3, "particles": 64, "packing_fraction": 0.1, "seed": 6,
+                   "boundary": ["periodic", "lees-edwards", "periodic"]},
+        "collision": {"model": "constant", "restitution": 0.9},
+        "shear": {"rate": 0.4},
+        "run": {"end_time": 1.0},
+        "output": {"file": "out.h5", "snapshots": 2},
+    },
+    "shear-thermostat-2d": {
+        "system": {"dimension": 2, "particles": 100, "packing_fraction": 0.1, "seed": 7,
+                   "boundary": ["periodic", "lees-edwards"]},
+        "collision": {"model": "elastic"},
+        "shear": {"rate": 0.1, "thermostat_temperature": 1.0, "thermostat_interval": 0.05},
+        "run": {"end_time": 1.0, "method": "dsmc"},
+        "output": {"file": "out.h5", "snapshots": 2},
+    },
     "rough-2d": {
         "system": {"dimension": 2, "particles": 64, "packing_fraction": 0.1, "seed": 6},
         "particles": {"inertia": 0.5},
@@ -118,6 +134,11 @@ BASES = {
         "output": {"file": "out.h5", "snapshots": 3},
     },
 }
+
+#: the bases of the scenes every fuzz test mutates (default of :func:`mutated_config`); the sheared
+#: bases (:data:`SHEAR_BASES`) have tests of their own
+SHEAR_BASES = tuple(name for name in BASES if name.startswith("shear"))
+GENERAL_BASES = tuple(name for name in BASES if name not in SHEAR_BASES)
 
 #: values the brief of the fuzz tests names, and neighbours of them
 SPECIAL = [0, -0.0, 0.0, -1, -1.5, 1e-300, 5e-324, 1e308, -1e308, math.inf, -math.inf, math.nan,
@@ -214,9 +235,9 @@ class MutatedConfig:
 
 
 @st.composite
-def mutated_config(draw, bases=tuple(BASES)):
+def mutated_config(draw, bases=None):
     """A valid base config with 1 to 3 mutations (see the module docstring)."""
-    name = draw(st.sampled_from(bases))
+    name = draw(st.sampled_from(GENERAL_BASES if bases is None else bases))
     doc = copy.deepcopy(BASES[name])
     overrides, done = [], []
     # half of the examples change values only within what the schema allows (legal runs of
@@ -500,7 +521,7 @@ def invoke(argv, cwd: Path, *, bound: float = 30.0, subprocess_run: bool = False
 
 #: what names a key or a file in a one-line error: a dotted key of a known section, a [section], a
 #: file name, or the key of a ``--set`` override as given (``override: sytem.particle = 0: ...``)
-KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|gravity|walls|run|output|species)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]"
+KEY_RE = re.compile(r"\b(system|particles|initial|collision|driving|gravity|walls|shear|run|output|species)(\.[A-Za-z_0-9]+)+|\[[^\]]+\]"
                     r"|\.(toml|h5|png|gsd)\b|^error: override: [^ ]+ = ")
 
 

@@ -29,6 +29,7 @@ from hypothesis import strategies as st
 from tests.cli.fuzzing import (
     BASES,
     EXTREMES,
+    SHEAR_BASES,
     MutatedConfig,
     Mutation,
     _apply,
@@ -185,6 +186,30 @@ def test_run_any_config_long(mc):
     _property_run(mc)
 
 
+@pytest.fixture(scope="module")
+def sheared_kernels_compiled():
+    """The sheared engine and DSMC compiled (or loaded) before the bounded examples: a first
+    compile of them can take longer than :data:`BOUND` on a loaded machine, and the bound's
+    SIGINT would then land inside numba's compiler."""
+    variants = [("shear-3d", []), ("shear-3d", ["run.neighbours=\"lists\""]),
+                ("shear-3d", ["run.neighbours=\"cells\""]), ("shear-3d", ["system.dimension=2"]),
+                ("shear-3d", ["system.dimension=2", "run.neighbours=\"lists\""]), ("shear-thermostat-2d", []),
+                ("shear-thermostat-2d", ["system.dimension=3"])]
+    for base, sets in variants:
+        with tempfile.TemporaryDirectory() as tmp:
+            d = Path(tmp)
+            (d / "c.toml").write_text(to_toml(BASES[base]))
+            argv = ["run", "c.toml", "--quiet"] + [a for o in sets for a in ("--set", o)]
+            invoke(argv, d, bound=3600.0)
+
+
+@settings(parent=FAST, max_examples=60)
+@given(mc=mutated_config(bases=SHEAR_BASES))
+@example(mc=case("shear-thermostat-2d", ("shear.rate", 2147483647)))  # hang: windows of 1e-10, no chunk boundary
+def test_run_any_sheared_config(sheared_kernels_compiled, mc):
+    _property_run(mc)
+
+
 def _property_advise(mc):
     o, _, _ = _run_command(mc, ["advise", "c.toml"], output_made=False)
     assert o.code in (0, 2), o.stderr
@@ -196,6 +221,12 @@ def _property_advise(mc):
 @example(case("constant-3d", ("particles.mass", 6.666666666666668e49)))  # ValueError in the bracket
 @example(case("viscoelastic-2d", ("collision.damping!", 26.484131033112767)))  # the theory's nodes beyond the table
 def test_advise_any_config(mc):
+    _property_advise(mc)
+
+
+@settings(parent=FAST, max_examples=40)
+@given(mutated_config(bases=SHEAR_BASES))
+def test_advise_any_sheared_config(mc):
     _property_advise(mc)
 
 

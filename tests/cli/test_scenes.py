@@ -29,6 +29,10 @@ CONFIGS = Path(__file__).resolve().parents[2] / "configs"
 TOLERANCE = 0.05
 #: ... for a polydisperse mix, compared with the theory of identical particles of the mean diameter
 POLYDISPERSE_TOLERANCE = 0.10
+#: ... for a sheared inelastic gas, compared with the steady temperature of the Grad solution: the
+#: engine and DSMC agree with each other and find a* = a/nu0 about 3.5 % above Grad's at eps = 0.8
+#: (tests/dsmc/test_dsmc_shear.py), and T goes as a*^-2 at a given rate
+SHEAR_TOLERANCE = 0.10
 
 #: config -> overrides that keep it small and short; (method, kind) of its scene
 EXAMPLES = {
@@ -52,6 +56,11 @@ EXAMPLES = {
                         ("edmd", "driven")),
     "rough_mpemba_hot": ({"system.particles": 1000}, ("edmd", "driven")),
     "rough_mpemba_cold": ({"system.particles": 1000}, ("edmd", "driven")),
+    "shear_3d": ({"system.particles": 1000, "run.end_time": 600.0}, ("edmd", "shear")),
+    "shear_2d": ({"system.particles": 400, "run.end_time": 300.0}, ("edmd", "shear")),
+    "shear_dsmc_3d": ({"system.particles": 10000, "run.end_time": 300.0}, ("dsmc", "shear")),
+    "shear_elastic_3d": ({"system.particles": 500, "run.end_time": 60.0}, ("edmd", "shear")),
+    "shear_elastic_2d": ({"system.particles": 400, "run.end_time": 100.0}, ("edmd", "shear")),
 }
 
 #: vibrated scenes (gravity, thermal or vibrating walls): no free cooling to predict, so no
@@ -77,6 +86,7 @@ def _call(args):
 
 #: advise's line labels and the statement (Scene.shows) each belongs to
 LABELS = {"clustering": "instability", "homogeneous": "homogeneous_by_construction", "steady state": "driven_state",
+          "shear flow": "shear_state",
           "eps spread": "eps_spread", "best const.": "constant_or_viscoelastic",
           "equivalent": "constant_or_viscoelastic", "duration": "duration"}
 
@@ -100,6 +110,8 @@ def test_advise_run_and_analyze_agree_and_speak_of_the_scene(name, tmp_path):
         assert "Haff" not in text and "cooling)" not in text and "clustering" not in labels
     if kind == "driven":
         assert "steady state" in labels
+    if kind == "shear":
+        assert "shear flow" in labels and "uniform shear flow" in text
     if method == "dsmc":
         assert "clustering" not in labels and "box" not in text.split("homogeneous", 1)[0]
 
@@ -120,10 +132,11 @@ def test_advise_run_and_analyze_agree_and_speak_of_the_scene(name, tmp_path):
     if method == "dsmc":
         assert "box length" not in report and "L_c" not in report
     # a driven run still on its way (no relaxed part, e.g. the Mpemba gases): the temperature at the end
-    measured = result["T_steady"] if kind == "driven" and result.get("T_steady") is not None else result["T_final"]
+    measured = result["T_steady"] if kind in ("driven", "shear") and result.get("T_steady") is not None else result["T_final"]
     ratio = measured / adv["temperature_end"]
     if not unstable:
-        tol = POLYDISPERSE_TOLERANCE if scene.polydisperse else TOLERANCE
+        tol = (POLYDISPERSE_TOLERANCE if scene.polydisperse else
+               SHEAR_TOLERANCE if kind == "shear" and scene.model != "elastic" else TOLERANCE)
         assert abs(ratio - 1.0) < tol, (name, measured, adv["temperature_end"])
 
 

@@ -91,7 +91,7 @@ def test_overrides_are_validated_like_file_values():
         parse_config(FULL, "x.toml", overrides={"system.temperature": 3})
 
 
-SECTIONS_ALLOWED = "(allowed: system, particles, initial, collision, driving, gravity, walls, run, output, species)"
+SECTIONS_ALLOWED = "(allowed: system, particles, initial, collision, driving, gravity, walls, shear, run, output, species)"
 
 
 @pytest.mark.parametrize("dotted, nearest", [
@@ -111,7 +111,7 @@ def test_override_of_an_unknown_section_names_the_key_and_the_nearest(dotted, ne
 
 @pytest.mark.parametrize("dotted, message", [
     ("system", "override: system = 0: key must be section.key with section one of system, particles, "
-               "initial, collision, driving, gravity, walls, run, output, species"),
+               "initial, collision, driving, gravity, walls, shear, run, output, species"),
     ("system.particles.x", "override: system.particles.x = 0: particles is not a table"),
 ])
 def test_override_that_is_no_section_key(dotted, message):
@@ -134,7 +134,7 @@ BAD = [
     ("[system]\ndimension = 2\npacking_fraction = 0.95", "system.packing_fraction = 0.95: must be a number in (0, 0.9069) (below the densest packing of spheres / disks in 2D)"),
     ("[system]\npacking_fraction = 0", "system.packing_fraction = 0: must be a number in (0,"),
     ("[system]\nsede = 1", "system.sede = 1: unknown key; did you mean `seed`?"),
-    ("[sytem]\nseed = 1", "[sytem]: unknown section (allowed: [system], [particles], [initial], [collision], [driving], [gravity], [walls], [run], [output], [[species]]); did you mean [system]?"),
+    ("[sytem]\nseed = 1", "[sytem]: unknown section (allowed: [system], [particles], [initial], [collision], [driving], [gravity], [walls], [shear], [run], [output], [[species]]); did you mean [system]?"),
     ('[collision]\nmodel = "hertz"', 'collision.model = "hertz": must be one of "elastic", "constant", "viscoelastic"'),
     ('[collision]\nmodel = "constant"\nrestitution = 1.2', "collision.restitution = 1.2: must be a number in (0, 1]"),
     ('[collision]\nmodel = "constant"\nrestitution = 0', "collision.restitution = 0: must be a number in (0, 1]"),

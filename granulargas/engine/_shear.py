@@ -1,0 +1,924 @@
+"""Lees-Edwards boundaries: uniform shear flow in the event-driven engine (numba leaf module).
+
+The flow is along x (axis 0), the gradient along y (axis 1), at the rate a > 0
+(Lees & Edwards 1972). The box's images are periodic along x and z; the image k boxes
+up (k = +-1) sits at x + k delta(t) and moves with v_x + k a L_y,
+
+    delta(t) = a L_y t  (mod L_x),                                                 (1)
+
+so that a particle that leaves through y = L_y re-enters at y - L_y with
+x - delta(t) and v_x - a L_y (and the reverse at y = 0): :func:`le_wrap`. Particles
+fly on straight lines in the laboratory frame, whose streaming velocity
+u(y) = a (y - L_y/2) the images carry; the peculiar velocity is c = v - u(y) x.
+A pair's nearest image (:func:`le_pair_delay`, :func:`le_separation`): k =
+round((y_i - y_j)/L_y), dy -= k L_y, dx -= k delta(t), du_x -= k a L_y, then the x
+minimum image; the pair's relative motion in that image is straight, so its collision
+time is the engine's root (:func:`granulargas.engine._geometry.collision_delay`).
+
+Space holds the sheared axis with period inf (the plain streaming and minimum image
+leave y alone: :func:`granulargas.engine._loop.stream`); this module wraps y where a
+neighbour search needs the particle inside the box: at a list expiry and at a cell
+crossing through the sheared boundary, and in :func:`synchronised_le`. Inside the
+compiled state y is stored shifted by + L_y (the box spans [L_y, 2 L_y)), so that a
+particle that has left the box, and is not yet wrapped, never has a negative
+coordinate (which the plain streaming would wrap by the period).
+
+Image counters: the unwrapped position of a particle is
+``x + img_x L_x + img_y a L_y t`` along x (the image shift of (1) without the
+reduction mod L_x), ``y + img_y L_y``, ``z + img_z L_z``: :func:`le_wrap` keeps it
+continuous.
+
+Neighbour search: sliding rows
+------------------------------
+A cell grid fixed in the laboratory would see every particle stream through it at
+u(y), up to a L_y / 2: the events would grow with the box. Instead each row of cells
+(the cells with the same y index r, height w_y) slides along x with the streaming
+velocity of its middle,
+
+    u_r = a ((r + 1/2) w_y - L_y/2),    s_r(t) = u_r t (mod L_x),                   (2)
+
+and a particle's x cell is counted in its row's frame, x - s_r(t). Rows r and r + 1
+slide past each other at a w_y, also across the sheared boundary: the image of row 0
+one box up is the row r = n_y with s_(n_y) = s_0 + a L_y t, eq. (1). Within a row the
+particles move at their peculiar velocity plus at most a w_y / 2.
+
+*Neighbour lists* (:func:`rebuild_list_le`, :func:`predict_expiry_le`). A particle's
+list centre moves with its row: it is stored as (x - s_r(t_b), y, z) in float32, r the
+row of y, t_b the time of the list's build (``ShearGeometry.built``). Two centres in the
+same row keep their distance; in adjacent rows it changes at most at a w_y; rows two
+apart are farther than w_y >= R_i + R_j + shell. A list built at t_b lists every j whose
+centre (its image through the sheared boundary included) is within R_i + R_j + shell of
+c_i at t_b, and i's list expires when
+
+    |r_i(t) - c_i(t)| + kappa (t - t_b) = shell/2,    kappa = a w_y / 2            (3)
+
+(a quadratic in t: :func:`budget_delay`). Why no collision is missed: let i and j not
+be in each other's lists; the later of their two builds, at t*, found the centres
+apart by at least R_i + R_j + shell. Until either list expires,
+|r_i - r_j| >= |c_i - c_j| - |r_i - c_i| - |r_j - c_j|
+>= R_i + R_j + shell - a w_y (t - t*) - (shell/2 - kappa (t - t_i)) - (shell/2 - kappa (t - t_j))
+>= R_i + R_j, since t_i, t_j <= t* and 2 kappa = a w_y. Listed pairs are predicted
+exactly, and every velocity change re-predicts against the whole list, as without shear.
+
+*Cell crossings* (:func:`predict_pair_cells_le`, :func:`cross_le`,
+:func:`slide_scan`). Cells are at least 2 R_max (1 + 1e-6) wide, every particle sits
+in the cell of its position in its row's frame, and a crossing of an x face (relative
+velocity v_x - u_r), of a y face (into the next row, or through the sheared boundary,
+re-counted in that row's frame) or of a z face is an event. Let phi = a w_y t mod L_x
+= m w_x + f (0 <= f < w_x): the x offset of row r + 1 against row r. A point within
+w_x of cell x of row r lies, in row r + 1's frame, in the 4 cells x - 2 - m .. x + 1 - m,
+and in row r - 1's frame in x - 1 + m .. x + 2 + m, for every f in [0, w_x): so each
+particle's neighbourhood is 3 cells of its own row and 4 of each adjacent row (times 3
+along z), fixed while m is. m steps at the *slides*, t_k = k w_x / (a w_y), global
+events (:func:`slide_scan`): each particle scans the one new column of its upper
+window, and keeps the earlier of what it finds and its event (and its stored best pair,
+if current). The two windows are mirror images (j in the upper window of i iff i is in
+the lower window of j), so the lower particle of every pair that a slide makes adjacent
+scans it. The completeness argument of :mod:`granulargas.engine._crossing` then holds
+as it is, with "the last prediction of either" ranging over full scans, crossings (new
+layers: an x crossing 1 column in each of the three rows; a y crossing both adjacent
+rows' windows; a z crossing the new layer of 11 columns) and slides.
+"""
+
+import math
+from collections import namedtuple
+
+import numpy as np
+
+from granulargas._numba import inlined, kernel
+from granulargas.engine._calendar import cal_update
+from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, slot_insert, slot_remove
+from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, face_gap, grid_insert, grid_remove
+from granulargas.engine._geometry import collision_delay, min_image
+
+#: The sheared geometry and its mutable scalars (``Space.shear``; None without shear):
+#: ``rate`` a > 0, box sides ``lx``, ``ly``, cell sides ``wx``, ``wy`` and counts ``nx``,
+#: ``ny`` (the list-centre grid in the list mode, the crossing grid in the cell mode),
+#: ``speed`` = a L_y (the image velocity), ``kappa`` = a w_y / 2 (eq. 3), ``slide_time``
+#: = w_x / (a w_y) (cell mode: time between slides), ``slide`` (1,) i8 the index k of the
+#: last slide (m = k mod n_x), ``built`` (N,) f8 the build time of each particle's list
+#: (list mode; (1,) otherwise), ``thermostat`` (2,) f8: interval and temperature of the
+#: velocity rescaling (interval inf: none), ``rescales`` (1,) i8 the index of the next one.
+ShearGeometry = namedtuple("ShearGeometry", ["rate", "lx", "ly", "wx", "wy", "nx", "ny", "speed", "kappa",
+                                             "slide_time", "slide", "built", "thermostat", "rescales"])
+
+#: Pressure-tensor accumulators (a (1,) record, ``Engine.stress``; None when not asked for):
+#: ``s`` the kinetic sums sum m c_a c_b now (xx, yy, zz, xy, xz, yz), ``k`` their time
+#: integrals and ``w`` the collisional sums sum r_ij,a Delta p_i,b, both since the last reset.
+STRESS = np.dtype([("s", "f8", (6,)), ("k", "f8", (6,)), ("w", "f8", (6,))], align=True)
+
+XX, YY, ZZ, XY, XZ, YZ = 0, 1, 2, 3, 4, 5
+
+
+def shear_geometry(rate, box3, ncell, n, thermostat_interval=math.inf, thermostat_temperature=1.0,
+                   slide=0, rescales=0, lists=True):
+    """A :class:`ShearGeometry` with the dtypes the kernels are compiled for."""
+    lx, ly = float(box3[0]), float(box3[1])
+    nx, ny = int(ncell[0]), int(ncell[1])
+    wx, wy = lx / nx, ly / ny
+    a = float(rate)
+    return ShearGeometry(a, lx, ly, wx, wy, nx, ny, a * ly, 0.5 * a * wy, wx / (a * wy),
+                         np.array([slide], dtype=np.int64),
+                         np.zeros(n if lists else 1), np.array([thermostat_interval, thermostat_temperature]),
+                         np.array([rescales], dtype=np.int64))
+
+
+# ------------------------------------------------------------------ frames and images
+@inlined
+def _reduce(x, length):
+    """x mod length in [0, length)."""
+    r = x - length * math.floor(x / length)
+    return r if r < length else 0.0
+
+
+@inlined
+def image_offset(t, sh):
+    """delta(t) of eq. (1), reduced into [-L_x/2, L_x/2) (a single minimum-image step
+    then suffices for near pairs)."""
+    d = _reduce(sh.speed * t, sh.lx)
+    return d - sh.lx if d >= 0.5 * sh.lx else d
+
+
+@inlined
+def row_speed(rho, sh):
+    """u_rho of eq. (2) (rho may be -1 or n_y: the images of the boundary rows)."""
+    return sh.rate * ((rho + 0.5) * sh.wy - 0.5 * sh.ly)
+
+
+@inlined
+def row_offset(rho, t, sh):
+    """s_rho(t) of eq. (2), in [0, L_x)."""
+    return _reduce(row_speed(rho, sh) * t, sh.lx)
+
+
+@inlined
+def row_of(y, sh):
+    r = int(y * (sh.ny / sh.ly))
+    if r >= sh.ny:
+        return sh.ny - 1
+    if r < 0:
+        return 0
+    return r
+
+
+@inlined
+def col_of(xi, sh):
+    c = int(xi * (sh.nx / sh.lx))
+    if c >= sh.nx:
+        return sh.nx - 1
+    if c < 0:
+        return 0
+    return c
+
+
+@inlined
+def _wrap(c, n):
+    if c < 0:
+        return c + n
+    if c >= n:
+        return c - n
+    return c
+
+
+@inlined
+def le_shift(i, t, rec, img, sh, up):
+    """Move particle i (at time t) one image down (``up``: it left through y = L_y) or up
+    (it left through y = 0): y -+ L_y, x -+ delta(t), v_x -+ a L_y, eq. (1); the image
+    counters keep the unwrapped position continuous. Returns the change of v^2."""
+    shift = sh.speed * t
+    q = np.int32(math.floor(shift / sh.lx))
+    d = shift - q * sh.lx
+    v0 = rec[i, 3]
+    if up:
+        y = rec[i, 1] - sh.ly
+        x = rec[i, 0] - d
+        img[i, 0] -= q
+        img[i, 1] += 1
+        rec[i, 3] = v0 - sh.speed
+    else:
+        y = rec[i, 1] + sh.ly
+        x = rec[i, 0] + d
+        img[i, 0] += q
+        img[i, 1] -= 1
+        rec[i, 3] = v0 + sh.speed
+    if x >= sh.lx:
+        x -= sh.lx
+        img[i, 0] += 1
+    elif x < 0.0:
+        x += sh.lx
+        img[i, 0] -= 1
+        if x >= sh.lx:  # -tiny + L rounds to L
+            x = 0.0
+            img[i, 0] += 1
+    rec[i, 0] = x
+    rec[i, 1] = y
+    return rec[i, 3] * rec[i, 3] - v0 * v0
+
+
+@inlined
+def le_wrap(i, t, rec, img, sh):
+    """Particle i (at time t) into [0, L_y) through the sheared boundary (:func:`le_shift`),
+    if it is outside. Returns the change of v^2."""
+    y = rec[i, 1]  # stored + L_y
+    if y >= 2.0 * sh.ly:
+        return le_shift(i, t, rec, img, sh, True)
+    if y < sh.ly:
+        dv2 = le_shift(i, t, rec, img, sh, False)
+        if rec[i, 1] >= 2.0 * sh.ly:  # -tiny + L rounds to L
+            rec[i, 1] = sh.ly
+        return dv2
+    return 0.0
+
+
+@inlined
+def le_pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period, sh, dlt):
+    """Time from t until particle i (centre (xi, yi, zi) at t, velocity v, radius ri) touches
+    particle j through j's nearest Lees-Edwards image (``dlt`` = :func:`image_offset` at t)."""
+    dtj = t - rec[j, 6]
+    dy = yi - (rec[j, 1] + rec[j, 4] * dtj)
+    half = 0.5 * sh.ly
+    k = (1.0 if dy > half else 0.0) - (1.0 if dy < -half else 0.0)
+    return collision_delay(min_image(xi - (rec[j, 0] + rec[j, 3] * dtj) - k * dlt, period[0]),
+                           dy - k * sh.ly,
+                           min_image(zi - (rec[j, 2] + rec[j, 5] * dtj), period[2]),
+                           vx - rec[j, 3] - k * sh.speed, vy - rec[j, 4], vz - rec[j, 5], ri + rec[j, 7])
+
+
+@inlined
+def le_separation(i, j, t, rec, period, sh):
+    """(dx, dy, dz, ux, uy, uz): r_i - r_j and v_i - v_j through j's nearest image at t
+    (both particles at t)."""
+    dlt = image_offset(t, sh)
+    dy = rec[i, 1] - rec[j, 1]
+    half = 0.5 * sh.ly
+    k = (1.0 if dy > half else 0.0) - (1.0 if dy < -half else 0.0)
+    return (min_image(rec[i, 0] - rec[j, 0] - k * dlt, period[0]), dy - k * sh.ly,
+            min_image(rec[i, 2] - rec[j, 2], period[2]),
+            rec[i, 3] - rec[j, 3] - k * sh.speed, rec[i, 4] - rec[j, 4], rec[i, 5] - rec[j, 5])
+
+
+# ------------------------------------------------------------------ neighbour lists
+@inlined
+def budget_delay(dx, dy, dz, wx, wy, wz, h, kappa):
+    """Smallest s >= 0 with |d + w s| + kappa s = h (eq. 3 with h = shell/2 - kappa (t - t_b)):
+    0 if |d| >= h. Squared: (w^2 - kappa^2) s^2 + 2 (d.w + h kappa) s + (d^2 - h^2) = 0,
+    whose root of interest is -C / (B + sqrt(B^2 - A C)) (C < 0, B > 0 whenever
+    |w| < kappa; the cancellation-free form)."""
+    d2 = dx * dx + dy * dy + dz * dz
+    if h <= 0.0 or d2 >= h * h:
+        return 0.0
+    a = wx * wx + wy * wy + wz * wz - kappa * kappa
+    b = dx * wx + dy * wy + dz * wz + h * kappa
+    c = d2 - h * h
+    disc = b * b - a * c
+    root = math.sqrt(disc if disc > 0.0 else 0.0)
+    den = b + root
+    if den <= 0.0:
+        return math.inf if a >= 0.0 and b <= 0.0 and kappa == 0.0 else 0.0
+    return -c / den
+
+
+@inlined
+def predict_expiry_le(i, t, rec, centre, period, half_shell, sh):
+    """Time of i's list expiry, eq. (3) (i streamed to t; its y not wrapped since the build)."""
+    r = row_of(np.float64(centre[i, 1]), sh)
+    xc = np.float64(centre[i, 0]) + row_offset(r, t, sh)
+    xc = xc - sh.lx if xc >= sh.lx else xc
+    h = half_shell - sh.kappa * (t - sh.built[i])
+    return t + budget_delay(min_image(rec[i, 0] - xc, period[0]), rec[i, 1] - sh.ly - np.float64(centre[i, 1]),
+                            min_image(rec[i, 2] - np.float64(centre[i, 2]), period[2]),
+                            rec[i, 3] - row_speed(r, sh), rec[i, 4], rec[i, 5], h, sh.kappa)
+
+
+@inlined
+def predict_pair_le(i, t, before, rec, nbl, nbn, period, sh):
+    """:func:`granulargas.engine._loop.predict_pair` through the Lees-Edwards images."""
+    xi = rec[i, 0]
+    yi = rec[i, 1]
+    zi = rec[i, 2]
+    vx = rec[i, 3]
+    vy = rec[i, 4]
+    vz = rec[i, 5]
+    ri = rec[i, 7]
+    dlt = image_offset(t, sh)
+    best = before
+    p = -1
+    for k in range(nbn[i]):
+        j = nbl[i, k]
+        tc = t + le_pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period, sh, dlt)
+        better = tc < best
+        best = tc if better else best
+        p = j if better else p
+    return best, p
+
+
+@inlined
+def _centre_cell(centre, i, sh, ncell, box):
+    """Flat cell of the stored centre of i: (x in its row's frame, row, z)."""
+    cz = int(np.float64(centre[i, 2]) * (ncell[2] / box[2]))
+    cz = min(max(cz, 0), ncell[2] - 1)
+    return col_of(np.float64(centre[i, 0]), sh) + ncell[0] * (row_of(np.float64(centre[i, 1]), sh)
+                                                            + ncell[1] * cz)
+
+
+@kernel(python=False)
+def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space, sh):
+    """Particles j != i whose centre (at t, through the sheared images) is within
+    R_i + R_j + shell of the query point (laboratory (xq, yq, zq) at t, in row r), into
+    ``lists.scratch``: the 3 x 3 x 3 cells around it in the frames of rows r - 1, r, r + 1
+    (none beyond a wall on z). Returns the number, or -1 if more than m or the scratch
+    is short."""
+    scratch = lists.scratch
+    centre = lists.centre
+    cell_ids = cells.ids
+    cell_n = cells.n
+    ncell = space.ncell
+    box = space.box
+    period = space.period
+    cap = scratch.shape[0]
+    cut_max = ri + rmax + shell
+    cut_max2 = cut_max * cut_max
+    cz = int(zq * (ncell[2] / box[2]))
+    cz = min(max(cz, 0), ncell[2] - 1)
+    zr = 1 if ncell[2] >= 3 else 0
+    count = 0
+    for o in range(-1, 2):
+        rho = r + o
+        g = _wrap(rho, sh.ny)
+        ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
+        xi = _reduce(xq - row_offset(rho, t, sh), sh.lx)
+        c0 = col_of(xi, sh)
+        for oz in range(-zr, zr + 1):
+            kz = cz + oz
+            if kz < 0 or kz >= ncell[2]:
+                if period[2] == math.inf:
+                    continue
+                kz = _wrap(kz, ncell[2])
+            for ox in range(-1, 2):
+                c = _wrap(c0 + ox, sh.nx) + ncell[0] * (g + ncell[1] * kz)
+                nq = cell_n[c]
+                if count + nq > cap:
+                    return -1
+                for q in range(nq):
+                    j = cell_ids[c, q]
+                    dx = min_image(xi - centre[j, 0], sh.lx)
+                    dy = ys - centre[j, 1]
+                    dz = min_image(zq - centre[j, 2], period[2])
+                    scratch[count] = j
+                    count += (dx * dx + dy * dy + dz * dz < cut_max2) & (j != i)
+    found = 0
+    for k in range(count):
+        j = scratch[k]
+        cut = ri + rec[j, 7] + shell
+        if cut < cut_max:
+            # the exact cut-off: the same distance again through the images
+            g = row_of(np.float64(centre[j, 1]), sh)
+            best = math.inf
+            for o in range(-1, 2):
+                rho = r + o
+                if _wrap(rho, sh.ny) != g:
+                    continue
+                ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
+                xi = _reduce(xq - row_offset(rho, t, sh), sh.lx)
+                dx = min_image(xi - centre[j, 0], sh.lx)
+                dy = ys - centre[j, 1]
+                dz = min_image(zq - centre[j, 2], period[2])
+                best = min(best, dx * dx + dy * dy + dz * dz)
+            if best >= cut * cut:
+                continue
+        if found >= m:
+            return -1
+        scratch[found] = j
+        found += 1
+    return found
+
+
+@kernel(python=False)
+def rebuild_list_le(i, t, rec, lists, cells, space, rmax, shell, sh):
+    """:func:`granulargas.engine._cells.rebuild_list` with list centres that move with their
+    rows (i at time t, inside [0, L_y)): new centre (x - s_r(t), y, z) in float32, its
+    build time t, and the lists of the neighbours that join or leave. Returns 0, OVERFLOW
+    or CELL_OVERFLOW (nothing changed)."""
+    centre = lists.centre
+    nbl = lists.nbl
+    nbn = lists.nbn
+    scratch = lists.scratch
+    mark = lists.mark
+    cell_ids = cells.ids
+    cell_n = cells.n
+    ncell = space.ncell
+    was = _centre_cell(centre, i, sh, ncell, space.box)
+    yq = np.float64(np.float32(rec[i, 1] - sh.ly))
+    zq = np.float64(np.float32(rec[i, 2]))
+    r = row_of(yq, sh)
+    xi32 = np.float32(_reduce(rec[i, 0] - row_offset(r, t, sh), sh.lx))
+    xi = np.float64(xi32)
+    if xi >= sh.lx:
+        xi = 0.0
+        xi32 = np.float32(0.0)
+    xq = _reduce(xi + row_offset(r, t, sh), sh.lx)
+    cz = int(zq * (ncell[2] / space.box[2]))
+    cz = min(max(cz, 0), ncell[2] - 1)
+    c = col_of(xi, sh) + ncell[0] * (r + ncell[1] * cz)
+    if c != was and cell_n[c] >= cell_ids.shape[1]:
+        return CELL_OVERFLOW
+    m = nbl.shape[1]
+    count = collect_le(i, t, xq, yq, zq, r, rec[i, 7], rmax, m, shell, rec, lists, cells, space, sh)
+    if count < 0:
+        return OVERFLOW
+    nold = nbn[i]
+    for k in range(nold):
+        mark[nbl[i, k]] = 1
+    full = False
+    for k in range(count):
+        j = scratch[k]
+        if mark[j] != 0:
+            mark[j] = 2
+        elif nbn[j] >= m:
+            full = True
+    if full:
+        for k in range(nold):
+            mark[nbl[i, k]] = 0
+        return OVERFLOW
+    for k in range(nold):
+        j = nbl[i, k]
+        if mark[j] == 1:
+            mark[j] = 0
+            last = nbn[j] - 1
+            for q in range(last + 1):
+                if nbl[j, q] == i:
+                    nbl[j, q] = nbl[j, last]
+                    nbn[j] = last
+                    break
+    for k in range(count):
+        j = scratch[k]
+        if mark[j] == 2:
+            mark[j] = 0
+        else:
+            nbl[j, nbn[j]] = i
+            nbn[j] += 1
+    for k in range(count):
+        nbl[i, k] = scratch[k]
+    nbn[i] = count
+    if c != was:
+        slot_remove(i, was, cell_ids, cell_n)
+        slot_insert(i, c, cell_ids, cell_n)
+    centre[i, 0] = xi32
+    centre[i, 1] = yq
+    centre[i, 2] = zq
+    sh.built[i] = t
+    return 0
+
+
+@kernel
+def build_all_lists_le(t, rec, lists, cells, space, shell, sh):
+    """Every particle's centre (in its row's frame, float32), the cells and all lists at time
+    t (all particles inside [0, L_y)). Returns 0, CELL_OVERFLOW or OVERFLOW."""
+    centre = lists.centre
+    nbl = lists.nbl
+    nbn = lists.nbn
+    cell_ids = cells.ids
+    cell_n = cells.n
+    ncell = space.ncell
+    period = space.period
+    n = rec.shape[0]
+    m = nbl.shape[1]
+    zr = 1 if ncell[2] >= 3 else 0
+    cell_n[:] = 0
+    for i in range(n):
+        yq = np.float32(rec[i, 1] - sh.ly)
+        r = row_of(np.float64(yq), sh)
+        xi = np.float32(_reduce(rec[i, 0] - row_offset(r, t, sh), sh.lx))
+        if np.float64(xi) >= sh.lx:
+            xi = np.float32(0.0)
+        centre[i, 0] = xi
+        centre[i, 1] = yq
+        centre[i, 2] = rec[i, 2]
+        c = _centre_cell(centre, i, sh, ncell, space.box)
+        if cell_n[c] >= cell_ids.shape[1]:
+            return CELL_OVERFLOW
+        slot_insert(i, c, cell_ids, cell_n)
+        sh.built[i] = t
+    nbn[:] = 0
+    for i in range(n):
+        yq = np.float64(centre[i, 1])
+        zq = np.float64(centre[i, 2])
+        r = row_of(yq, sh)
+        xq = _reduce(np.float64(centre[i, 0]) + row_offset(r, t, sh), sh.lx)
+        cz = int(zq * (ncell[2] / space.box[2]))
+        cz = min(max(cz, 0), ncell[2] - 1)
+        for o in range(-1, 2):
+            rho = r + o
+            g = _wrap(rho, sh.ny)
+            ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
+            xr = _reduce(xq - row_offset(rho, t, sh), sh.lx)
+            c0 = col_of(xr, sh)
+            for oz in range(-zr, zr + 1):
+                kz = cz + oz
+                if kz < 0 or kz >= ncell[2]:
+                    if period[2] == math.inf:
+                        continue
+                    kz = _wrap(kz, ncell[2])
+                for ox in range(-1, 2):
+                    c = _wrap(c0 + ox, sh.nx) + ncell[0] * (g + ncell[1] * kz)
+                    for q in range(cell_n[c]):
+                        j = cell_ids[c, q]
+                        if j <= i:
+                            continue
+                        dx = min_image(xr - centre[j, 0], sh.lx)
+                        dy = ys - centre[j, 1]
+                        dz = min_image(zq - centre[j, 2], period[2])
+                        cut = rec[i, 7] + rec[j, 7] + shell
+                        if dx * dx + dy * dy + dz * dz < cut * cut:
+                            if nbn[i] >= m or nbn[j] >= m:
+                                return OVERFLOW
+                            nbl[i, nbn[i]] = j
+                            nbn[i] += 1
+                            nbl[j, nbn[j]] = i
+                            nbn[j] += 1
+    return 0
+
+
+# ------------------------------------------------------------------ cell crossings
+@inlined
+def predict_crossing_le(i, t, rec, grid, space, sh):
+    """Earliest cell crossing of i (streamed to t): (time, face 2 a + side); x in the frame
+    of i's row (relative velocity v_x - u_r), y through the sheared boundary (period L_y)."""
+    cell = grid.cell
+    r = cell[i, 1]
+    gap, speed, side = face_gap(_reduce(rec[i, 0] - row_offset(r, t, sh), sh.lx), rec[i, 3] - row_speed(r, sh),
+                                cell[i, 0], grid.width[0], space.ncell[0], sh.lx)
+    face = side
+    g, v, sd = face_gap(rec[i, 1] - sh.ly, rec[i, 4], r, grid.width[1], space.ncell[1], sh.ly)
+    if (g * speed < gap * v or speed == 0.0) and v > 0.0:
+        gap = g
+        speed = v
+        face = 2 + sd
+    if space.dims == 3:
+        g, v, sd = face_gap(rec[i, 2], rec[i, 5], cell[i, 2], grid.width[2], space.ncell[2], space.period[2])
+        if (g * speed < gap * v or speed == 0.0) and v > 0.0:
+            gap = g
+            speed = v
+            face = 4 + sd
+    if speed == 0.0:
+        return math.inf, face
+    return t + gap / speed, face
+
+
+@inlined
+def _list_heads(first, k, head, g, c0, ncol, cz, z0, z1, ncell, period_z, nx):
+    """Append to ``first`` the heads of the non-empty cells of row g, columns c0 .. c0 + ncol - 1
+    (wrapped), z layers cz + z0 .. cz + z1 (none beyond a wall); returns the new count."""
+    for oz in range(z0, z1 + 1):
+        kz = cz + oz
+        if kz < 0 or kz >= ncell[2]:
+            if period_z == math.inf:
+                continue
+            kz = _wrap(kz, ncell[2])
+        row = ncell[0] * (g + ncell[1] * kz)
+        for u in range(ncol):
+            j = head[(c0 + u) % nx + row]
+            first[k] = j
+            k += 1 if j >= 0 else 0
+    return k
+
+
+@inlined
+def _scan_listed_le(first, k, t, before, rec, i, row_of_, period, sh):
+    xi = rec[i, 0]
+    yi = rec[i, 1]
+    zi = rec[i, 2]
+    vx = rec[i, 3]
+    vy = rec[i, 4]
+    vz = rec[i, 5]
+    ri = rec[i, 7]
+    dlt = image_offset(t, sh)
+    best = before
+    p = -1
+    for q in range(1, k):
+        j = first[q]
+        while j >= 0:
+            tc = t + le_pair_delay(j, t, xi, yi, zi, vx, vy, vz, ri, rec, period, sh, dlt)
+            better = tc < best
+            best = tc if better else best
+            p = j if better else p
+            j = row_of_[j, NEXT]
+    return best, p
+
+
+@inlined
+def _windows(cx, m, nx):
+    """First columns of the windows of the rows above (4 columns) and below (4 columns)."""
+    return cx - 2 - m, cx - 1 + m
+
+
+@kernel(python=False)
+def scan_le(i, t, before, rec, grid, space, sh, own0, own_n, up0, up_n, down0, down_n, z0, z1):
+    """Earliest collision of i (streamed to t), before ``before``, with the particles of:
+    columns own0 .. own0 + own_n - 1 of its own row, up0 .. of the row above, down0 .. of the
+    row below (through the sheared boundary), z layers z0 .. z1 around its cell. (time,
+    partner) or (``before``, -1)."""
+    cell = grid.cell
+    first = grid.fresh
+    ncell = space.ncell
+    r = cell[i, 1]
+    cz = cell[i, 2]
+    k = 1
+    k = _list_heads(first, k, grid.head, r, own0, own_n, cz, z0, z1, ncell, space.period[2], sh.nx)
+    k = _list_heads(first, k, grid.head, _wrap(r + 1, sh.ny), up0, up_n, cz, z0, z1, ncell, space.period[2], sh.nx)
+    k = _list_heads(first, k, grid.head, _wrap(r - 1, sh.ny), down0, down_n, cz, z0, z1, ncell, space.period[2],
+                    sh.nx)
+    return _scan_listed_le(first, k, t, before, rec, i, cell, space.period, sh)
+
+
+@inlined
+def predict_pair_cells_le(i, t, before, rec, count, grid, space, sh):
+    """:func:`granulargas.engine._crossing.predict_pair_cells` with sliding rows: the stored best
+    pair right after a crossing, else the 3 + 4 + 4 columns (times 3 along z) around i."""
+    if grid.fresh[0] == i:
+        grid.fresh[0] = -1
+        pt = grid.pair_t[i]
+        pj = grid.cell[i, PAIR_J]
+    else:
+        zr = 1 if space.ncell[2] >= 3 else 0
+        cx = grid.cell[i, 0]
+        up0, down0 = _windows(cx, sh.slide[0] % sh.nx, sh.nx)
+        pt, pj = scan_le(i, t, math.inf, rec, grid, space, sh, cx - 1, 3, up0, 4, down0, 4, -zr, zr)
+        grid.pair_t[i] = pt
+        grid.cell[i, PAIR_J] = pj
+        grid.cell[i, PAIR_TAG] = count[pj] if pj >= 0 else 0
+    if pt < before:
+        return pt, pj
+    return before, -1
+
+
+@inlined
+def cross_le(i, face, t, rec, img, grid, space, sh):
+    """Move i (at the face ``face`` of its cell, time t) into the cell beyond: an x face to
+    the next column of its row, a y face into the next row (through the sheared boundary:
+    :func:`le_wrap`) re-counted in that row's frame, a z face as without shear. Returns the
+    change of v^2 (sheared boundary)."""
+    a = face >> 1
+    up = face & 1
+    cell = grid.cell
+    dv2 = 0.0
+    if a == 0:
+        cell[i, 0] = _wrap(cell[i, 0] + (1 if up else -1), sh.nx)
+    elif a == 1:
+        r = cell[i, 1] + (1 if up else -1)
+        if r >= sh.ny or r < 0:
+            # through the sheared boundary (the particle is at y = L_y or 0 to round-off;
+            # it may land a round-off outside its new row, as at any face)
+            dv2 = le_shift(i, t, rec, img, sh, r >= sh.ny)
+            r = _wrap(r, sh.ny)
+        cell[i, 1] = r
+        cell[i, 0] = col_of(_reduce(rec[i, 0] - row_offset(r, t, sh), sh.lx), sh)
+    else:
+        n = space.ncell[2]
+        c = cell[i, 2] + (1 if up else -1)
+        cell[i, 2] = _wrap(c, n)
+    grid_remove(i, grid)
+    ncell = space.ncell
+    grid_insert(i, cell[i, 0] + ncell[0] * (cell[i, 1] + ncell[1] * cell[i, 2]), grid)
+    return dv2
+
+
+@inlined
+def scan_new_layer_le(i, t, face, rec, count, grid, space, sh):
+    """After i crossed ``face``: keep the better of its stored pair and the cells that became
+    adjacent (x face: one column in each of the three rows; y face: both adjacent rows'
+    windows; z face: the new layer of the three rows), and mark the stored pair current;
+    nothing if the stored partner has collided since (the prediction then scans all)."""
+    pj = grid.cell[i, PAIR_J]
+    if pj >= 0 and count[pj] != grid.cell[i, PAIR_TAG]:
+        return
+    a = face >> 1
+    o = 1 if face & 1 else -1
+    cx = grid.cell[i, 0]
+    zr = 1 if space.ncell[2] >= 3 else 0
+    up0, down0 = _windows(cx, sh.slide[0] % sh.nx, sh.nx)
+    if a == 0:
+        # the columns entering on the side of motion: own cx + o; above up0 + (3 if o > 0
+        # else 0); below down0 + (3 if o > 0 else 0)
+        e = 3 if o > 0 else 0
+        pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, cx + o, 1, up0 + e, 1, down0 + e, 1, -zr, zr)
+    elif a == 1:
+        pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, cx, 0, up0, 4, down0, 4, -zr, zr)
+    else:
+        pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, cx - 1, 3, up0, 4, down0, 4, o, o)
+    if pn >= 0:
+        grid.pair_t[i] = pt
+        grid.cell[i, PAIR_J] = pn
+        grid.cell[i, PAIR_TAG] = count[pn]
+    grid.fresh[0] = i
+
+
+@kernel
+def build_grid_le(t, rec, grid, space, sh):
+    """Every particle (inside [0, L_y) at t) into the cell of its position in its row's frame."""
+    box = space.box
+    ncell = space.ncell
+    grid.head[:] = -1
+    for i in range(rec.shape[0] - 1, -1, -1):
+        r = row_of(rec[i, 1] - sh.ly, sh)
+        grid.cell[i, 1] = r
+        grid.cell[i, 0] = col_of(_reduce(rec[i, 0] - row_offset(r, t, sh), sh.lx), sh)
+        c = int(rec[i, 2] * (ncell[2] / box[2]))
+        grid.cell[i, 2] = min(max(c, 0), ncell[2] - 1)
+        grid_insert(i, grid.cell[i, 0] + ncell[0] * (grid.cell[i, 1] + ncell[1] * grid.cell[i, 2]), grid)
+
+
+# ------------------------------------------------------------------ stress
+@inlined
+def integrate_stress(stress, dt, sh):
+    """Advance the kinetic sums of ``stress`` by dt of free flight and add their integral:
+    with c_x = v_x - a (y - L_y/2), d c_x/dt = -a c_y, so S_xx' = -2a S_xy, S_xy' = -a S_yy,
+    S_xz' = -a S_yz, the others constant (``sh`` None: a = 0). Nothing without ``stress``."""
+    if stress is not None:
+        st = stress[0]
+        s = st.s
+        k = st.k
+        if sh is None:
+            for q in range(6):
+                k[q] += s[q] * dt
+        else:
+            a = sh.rate
+            ad = a * dt
+            k[XX] += (s[XX] - ad * s[XY] + ad * ad * s[YY] / 3.0) * dt
+            k[XY] += (s[XY] - 0.5 * ad * s[YY]) * dt
+            k[XZ] += (s[XZ] - 0.5 * ad * s[YZ]) * dt
+            k[YY] += s[YY] * dt
+            k[ZZ] += s[ZZ] * dt
+            k[YZ] += s[YZ] * dt
+            s[XX] += (-2.0 * s[XY] + ad * s[YY]) * ad
+            s[XY] -= ad * s[YY]
+            s[XZ] -= ad * s[YZ]
+
+
+@inlined
+def peculiar_x(i, rec, sh):
+    """c_x of particle i at its clock (v_x without shear)."""
+    if sh is None:
+        return rec[i, 3]
+    return rec[i, 3] - sh.rate * (rec[i, 1] - 1.5 * sh.ly)  # y stored + L_y
+
+
+@inlined
+def stress_jump(stress, m, cx, cy, cz, dvx, dvy, dvz):
+    """Add m (c' c' - c c) for a velocity change dv of a particle of peculiar velocity c."""
+    if stress is not None:
+        s = stress[0].s
+        s[XX] += m * (2.0 * cx + dvx) * dvx
+        s[YY] += m * (2.0 * cy + dvy) * dvy
+        s[ZZ] += m * (2.0 * cz + dvz) * dvz
+        s[XY] += m * (cx * dvy + dvx * cy + dvx * dvy)
+        s[XZ] += m * (cx * dvz + dvx * cz + dvx * dvz)
+        s[YZ] += m * (cy * dvz + dvy * cz + dvy * dvz)
+
+
+@inlined
+def stress_virial(stress, f, nx, ny, nz):
+    """Add r_ij (x) Delta p_i = f n (x) n of a collision (f = -impulse |r_ij|)."""
+    if stress is not None:
+        w = stress[0].w
+        w[XX] += f * nx * nx
+        w[YY] += f * ny * ny
+        w[ZZ] += f * nz * nz
+        w[XY] += f * nx * ny
+        w[XZ] += f * nx * nz
+        w[YZ] += f * ny * nz
+
+
+@kernel
+def stress_sums(rec, mass, sh, out):
+    """sum m c_a c_b (xx, yy, zz, xy, xz, yz) of all particles at their own clocks into ``out``
+    (all at one time)."""
+    for q in range(6):
+        out[q] = 0.0
+    for i in range(rec.shape[0]):
+        m = mass[i]
+        cx = peculiar_x(i, rec, sh)
+        cy = rec[i, 4]
+        cz = rec[i, 5]
+        out[XX] += m * cx * cx
+        out[YY] += m * cy * cy
+        out[ZZ] += m * cz * cz
+        out[XY] += m * cx * cy
+        out[XZ] += m * cx * cz
+        out[YZ] += m * cy * cz
+
+
+# ------------------------------------------------------------------ global events
+@inlined
+def next_slide(sh, oncells):
+    """Time of the next slide (cell mode only; inf otherwise)."""
+    if oncells is None:
+        return math.inf
+    return (sh.slide[0] + 1) * sh.slide_time
+
+
+@inlined
+def next_rescale(sh):
+    """Time of the next thermostat rescaling ((k + 1/2) interval; inf without thermostat)."""
+    dt = sh.thermostat[0]
+    if dt == math.inf:
+        return math.inf
+    return (sh.rescales[0] + 0.5) * dt
+
+
+@kernel(python=False)
+def slide_scan(t, rec, img, count, events, grid, space, cal, sh):
+    """The slide at t (the rows' x offsets step by one column against their neighbours): every
+    particle streamed to t scans the new column of its upper window and keeps what it finds
+    if earlier than its event (and its stored best pair, if that is current). Returns False
+    on a calendar overflow."""
+    sh.slide[0] += 1
+    m = sh.slide[0] % sh.nx
+    zr = 1 if space.ncell[2] >= 3 else 0
+    period = space.period
+    for i in range(rec.shape[0]):
+        dt = t - rec[i, 6]
+        for a in range(3):
+            x = rec[i, a] + rec[i, 3 + a] * dt
+            if x >= period[a]:
+                x -= period[a]
+                img[i, a] += 1
+            elif x < 0.0:
+                x += period[a]
+                img[i, a] -= 1
+            rec[i, a] = x
+        rec[i, 6] = t
+        cx = grid.cell[i, 0]
+        pt, pn = scan_le(i, t, math.inf, rec, grid, space, sh, cx, 0, cx - 2 - m, 1, cx, 0, -zr, zr)
+        if pn < 0:
+            continue
+        pj = grid.cell[i, PAIR_J]
+        if (pj < 0 or count[pj] == grid.cell[i, PAIR_TAG]) and pt < grid.pair_t[i]:
+            grid.pair_t[i] = pt
+            grid.cell[i, PAIR_J] = pn
+            grid.cell[i, PAIR_TAG] = count[pn]
+        if pt < cal.qt[i]:
+            events.partner[i] = pn
+            events.tag[i] = count[pn]
+            if not cal_update(i, pt, cal):
+                return False
+    return True
+
+
+@kernel
+def synchronised_le(rec, img, period, t, sh, out_r, out_img, out_v):
+    """Positions, images and velocities of all particles streamed to t and wrapped (through the
+    sheared boundary too; no side effect)."""
+    shift = sh.speed * t
+    q = np.int64(math.floor(shift / sh.lx))
+    d = shift - q * sh.lx
+    for i in range(rec.shape[0]):
+        dt = t - rec[i, 6]
+        vx = rec[i, 3]
+        kx = img[i, 0]
+        ky = img[i, 1]
+        x = rec[i, 0] + vx * dt
+        y = rec[i, 1] - sh.ly + rec[i, 4] * dt
+        if y >= sh.ly:
+            y -= sh.ly
+            x -= d
+            kx -= q
+            ky += 1
+            vx -= sh.speed
+        elif y < 0.0:
+            y += sh.ly
+            if y >= sh.ly:
+                y = 0.0
+            x += d
+            kx += q
+            ky -= 1
+            vx += sh.speed
+        while x >= sh.lx:
+            x -= sh.lx
+            kx += 1
+        while x < 0.0:
+            x += sh.lx
+            kx -= 1
+            if x >= sh.lx:
+                x = 0.0
+                kx += 1
+        z = rec[i, 2] + rec[i, 5] * dt
+        kz = img[i, 2]
+        if z >= period[2]:
+            z -= period[2]
+            kz += 1
+        elif z < 0.0:
+            z += period[2]
+            kz -= 1
+            if z >= period[2]:
+                z = 0.0
+                kz += 1
+        out_r[i, 0] = x
+        out_r[i, 1] = y
+        out_r[i, 2] = z
+        out_img[i, 0] = kx
+        out_img[i, 1] = ky
+        out_img[i, 2] = kz
+        out_v[i, 0] = vx
+        out_v[i, 1] = rec[i, 4]
+        out_v[i, 2] = rec[i, 5]
