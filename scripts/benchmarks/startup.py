@@ -237,9 +237,14 @@ def record(args, rows, first, cached, argv, load, commit):
     records = []
     for name, rs in rows.items():
         key, what = PAGE_ROWS[name]
+        cpu = [x[0] for x in rs]
+        digits = 2 if max(cpu) < 5.0 else 1
+        # no compile column: a run's summary gives its compile time on the wall clock, which a
+        # loaded machine stretches beyond the process's CPU time
         records.append(dict(table="startup", id=f"{key} {what}", what=what,
-                            cpu_seconds=round(statistics.median(x[0] for x in rs), 1),
-                            compile_seconds=round(statistics.median(x[3] for x in rs), 1), rounds=len(rs)))
+                            cpu_seconds=round(statistics.median(cpu), digits),
+                            cpu_range=[round(min(cpu), digits), round(max(cpu), digits)],
+                            compile_seconds=None, rounds=len(rs)))
     for (tree, mode), f in first.items():
         records.append(dict(table="compile", id=f"3D {mode}", neighbours=mode,
                             first_seconds=round(statistics.median(x[0] for x in f), 1),
