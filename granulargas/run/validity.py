@@ -512,7 +512,8 @@ def _check_sheared(config, gas, scene) -> RunValidity:
         return rv
     horizon = gas.end_time if gas.end_time is not None else math.inf
     t_reach, s_reach = theory.shear.grad_transient(sh.rate, eps, n, gas.temperature, d, sigma, m, chi,
-                                                   t_end=horizon if math.isfinite(horizon) else math.inf)
+                                                   t_end=horizon if math.isfinite(horizon) else math.inf,
+                                                   T_steady=float(T_s))
     short_t = gas.end_time is not None and not t_reach <= gas.end_time
     short_s = gas.collisions_per_particle is not None and not s_reach <= gas.collisions_per_particle
     if short_t or short_s:

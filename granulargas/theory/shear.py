@@ -399,14 +399,18 @@ def steady_temperature(rate, eps, n, dimension=3, sigma=1.0, m=1.0, packing=0.0,
     return math.exp(optimize.brentq(mismatch, lo, hi, xtol=1e-10))
 
 
-def grad_transient(rate, eps, n, T0, dimension=3, sigma=1.0, m=1.0, chi=1.0, t_end=math.inf, tolerance=0.25):
+def grad_transient(rate, eps, n, T0, dimension=3, sigma=1.0, m=1.0, chi=1.0, t_end=math.inf, tolerance=0.25,
+                   T_steady=None):
     """The approach to the steady USF from a Maxwellian gas at T0, by the dilute Grad moment
     equations (S2) with (S5), every collision rate times the contact value ``chi`` (an estimate
     of the Enskog gas's pace). ``eps`` a number or a callable eps(T).
 
     Returns (t_reach, s_reach): the time, and the collisions per particle by then, at which
     |ln(T / T_s)| first falls below ln(1 + tolerance) (T_s of :func:`steady_temperature`
-    with the same rates); inf if not by ``t_end``.
+    with the same rates); inf if not by ``t_end``. ``T_steady``: the steady temperature the
+    caller compares with (e.g. the Enskog one of :func:`steady_temperature` at a finite
+    packing); the equations then start at the same ratio T0 / T_steady to their own T_s, so
+    that a gas already at ``T_steady`` has arrived.
     """
     from scipy.integrate import solve_ivp
 
@@ -436,10 +440,11 @@ def grad_transient(rate, eps, n, T0, dimension=3, sigma=1.0, m=1.0, chi=1.0, t_e
 
     reached.terminal = True
     reached.direction = -1
-    y0 = [n * T0, n * T0, n * T0 if d == 3 else 0.0, 0.0, 0.0]
+    T_start = T0 if T_steady is None else T0 * T_s / T_steady
+    y0 = [n * T_start, n * T_start, n * T_start if d == 3 else 0.0, 0.0, 0.0]
     if reached(0.0, y0) <= 0.0:
         return 0.0, 0.0
-    horizon = t_end if math.isfinite(t_end) else 1e6 / (nu1 * math.sqrt(min(T0, T_s) / m))
+    horizon = t_end if math.isfinite(t_end) else 1e6 / (nu1 * math.sqrt(min(T_start, T_s) / m))
     sol = solve_ivp(rhs3, (0.0, horizon), y0, events=reached, rtol=1e-6, atol=1e-12 * n * max(T0, T_s),
                     method="LSODA")
     if sol.t_events[0].size:

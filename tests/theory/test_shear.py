@@ -101,3 +101,17 @@ def test_normal_stress_differences_and_bad_input():
         shear.grad_usf(1.0, 3)
     with pytest.raises(ValueError):
         shear.grad_usf(1.2, 3)
+
+
+def test_transient_of_a_gas_already_at_the_enskog_steady_temperature_is_zero():
+    """At finite density the dilute moment equations (rates times chi) have their own steady
+    temperature; started at the caller's steady T (Enskog) the gas has arrived, and one 40 % above
+    it takes a finite time."""
+    packing, eps, d = 0.1, 0.9, 3
+    n = float(th.number_density(packing, d))
+    chi = float(th.contact_value(packing, d))
+    rate = 0.4
+    t_s = float(shear.steady_temperature(rate, eps, n, d, 1.0, 1.0, packing))
+    assert shear.grad_transient(rate, eps, n, t_s, d, chi=chi, t_end=1.0, T_steady=t_s) == (0.0, 0.0)
+    t_reach, _ = shear.grad_transient(rate, eps, n, 1.4 * t_s, d, chi=chi, T_steady=t_s)
+    assert 0.0 < t_reach < math.inf
