@@ -139,6 +139,7 @@ from granulargas.engine._walls import (
 )
 from granulargas.engine._probe import (
     COLLIDE,
+    GLOBAL,
     PEEK,
     POP,
     PREDICT,
@@ -1110,6 +1111,7 @@ def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collis
                          stress)
         if status != DONE or t_next > until:
             return status
+        clock = probe_start(probe)
         if t_slide == t_next:
             if oncells is not None:  # slides only in the cell mode
                 if not slide_scan(c.time, engine.particles.rec, engine.particles.img, engine.particles.count,
@@ -1122,6 +1124,7 @@ def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collis
             status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
                                   engine.calendar, c, prm, engine.contacts, sh, stress,
                                   engine.spins)
+        tick(probe, GLOBAL, clock)
         c.events += 1
         if status != DONE or c.time >= until:
             return status
