@@ -885,9 +885,10 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
         prefetch(p.count, i1)
     elif p1 == EXPIRY:
         dt1 = cal_next_time(cal) - rec[i1, 6]
-        prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
-                       rec[i1, 2] + rec[i1, 5] * dt1,
-                       rec[i1, 7] + prm.rmax + prm.shell, prm.space, cells, lists.stencil)
+        if prm.space.shear is None:  # (sheared: the centres' cells are counted in the rows' frames)
+            prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
+                           rec[i1, 2] + rec[i1, 5] * dt1,
+                           rec[i1, 7] + prm.rmax + prm.shell, prm.space, cells, lists.stencil)
         for k in range(nbn[i1]):
             prefetch(nbl, nbl[i1, k])
             prefetch(nbn, nbl[i1, k])
