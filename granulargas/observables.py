@@ -39,7 +39,39 @@ from __future__ import annotations
 
 import numpy as np
 
-from granulargas._numba import jit
+from granulargas._numba import inlined, jit
+
+
+@inlined
+def _momentum_and_largest(v, dim, masses, shared):
+    """(p_x, p_y, p_z, total mass, largest |velocity component|) of ``v[:, :dim]``."""
+    p0 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    msum = 0.0
+    vmax = 0.0
+    for i in range(v.shape[0]):
+        m = masses[0] if shared else masses[i]
+        msum += m
+        p0 += m * v[i, 0]
+        p1 += m * v[i, 1]
+        vmax = max(vmax, abs(v[i, 0]), abs(v[i, 1]))
+        if dim == 3:
+            p2 += m * v[i, 2]
+            vmax = max(vmax, abs(v[i, 2]))
+    return p0, p1, p2, msum, vmax
+
+
+@inlined
+def _scaled_peculiar_energy(v, i, dim, m, scale, u0, u1, u2):
+    """m_i c_i^2 of the velocity of row i times ``scale``, less the scaled mean (u0, u1, u2)."""
+    c0 = v[i, 0] * scale - u0
+    c1 = v[i, 1] * scale - u1
+    e = c0 * c0 + c1 * c1
+    if dim == 3:
+        c2 = v[i, 2] * scale - u2
+        e += c2 * c2
+    return e * m
 
 
 @jit
@@ -51,20 +83,7 @@ def energy_moments(v, dim, masses):
     """
     n = v.shape[0]
     shared = masses.shape[0] == 1
-    p0 = 0.0
-    p1 = 0.0
-    p2 = 0.0
-    msum = 0.0
-    vmax = 0.0
-    for i in range(n):
-        m = masses[0] if shared else masses[i]
-        msum += m
-        p0 += m * v[i, 0]
-        p1 += m * v[i, 1]
-        vmax = max(vmax, abs(v[i, 0]), abs(v[i, 1]))
-        if dim == 3:
-            p2 += m * v[i, 2]
-            vmax = max(vmax, abs(v[i, 2]))
+    p0, p1, p2, msum, vmax = _momentum_and_largest(v, dim, masses, shared)
     if not vmax > 0.0:
         return 0.0, np.nan, np.nan
     scale = 1.0 / vmax
@@ -75,14 +94,7 @@ def energy_moments(v, dim, masses):
     s2 = 0.0
     s3 = 0.0
     for i in range(n):
-        m = masses[0] if shared else masses[i]
-        c0 = v[i, 0] * scale - u0
-        c1 = v[i, 1] * scale - u1
-        e = c0 * c0 + c1 * c1
-        if dim == 3:
-            c2 = v[i, 2] * scale - u2
-            e += c2 * c2
-        e *= m
+        e = _scaled_peculiar_energy(v, i, dim, masses[0] if shared else masses[i], scale, u0, u1, u2)
         s1 += e
         s2 += e * e
         s3 += e * e * e
@@ -131,21 +143,9 @@ def rough_moments(v, dim, masses, w, inertia):
     ishared = inertia.shape[0] == 1
     dr = 3 if dim == 3 else 1
     c0 = w.shape[1] - dr  # first spin column used
-    p0 = 0.0
-    p1 = 0.0
-    p2 = 0.0
-    msum = 0.0
-    vmax = 0.0
+    p0, p1, p2, msum, vmax = _momentum_and_largest(v, dim, masses, shared)
     wmax = 0.0
     for i in range(n):
-        m = masses[0] if shared else masses[i]
-        msum += m
-        p0 += m * v[i, 0]
-        p1 += m * v[i, 1]
-        vmax = max(vmax, abs(v[i, 0]), abs(v[i, 1]))
-        if dim == 3:
-            p2 += m * v[i, 2]
-            vmax = max(vmax, abs(v[i, 2]))
         for a in range(dr):
             wmax = max(wmax, abs(w[i, c0 + a]))
     vs = 1.0 / vmax if vmax > 0.0 else 1.0
@@ -159,14 +159,7 @@ def rough_moments(v, dim, masses, w, inertia):
     syy = 0.0
     sxy = 0.0
     for i in range(n):
-        m = masses[0] if shared else masses[i]
-        q0 = v[i, 0] * vs - u0
-        q1 = v[i, 1] * vs - u1
-        x = q0 * q0 + q1 * q1
-        if dim == 3:
-            q2 = v[i, 2] * vs - u2
-            x += q2 * q2
-        x *= m
+        x = _scaled_peculiar_energy(v, i, dim, masses[0] if shared else masses[i], vs, u0, u1, u2)
         y = 0.0
         for a in range(dr):
             y += (w[i, c0 + a] * ws) ** 2

@@ -429,7 +429,8 @@ def plot_vibrated(analysis, path):
     p = a.profile
     ax_name = "xyz"[a.axis]
     ok = p.counts >= 30
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5))
+    dist = a.distributions
+    fig, axes = plt.subplots(3 if dist is not None else 2, 2, figsize=(10, 11 if dist is not None else 7.5))
     ax = axes[0, 0]
     ax.plot(p.centres, p.density, "o", ms=3, label="measured")
     hyd = a.hydrostatic
@@ -465,7 +466,30 @@ def plot_vibrated(analysis, path):
     ax.axvline(a.t_from, color="0.6", lw=0.8)
     ax.set_xlabel("t")
     ax.set_ylabel(f"centre of mass {ax_name}")
-    fig.suptitle(_title(a.info, "Vibrated gas: profiles, energy balance, centre of mass"), fontsize=10)
+    h, he = a.com_height()
+    if math.isfinite(h):
+        title = f"steady: height above the floor {h:.4g} ± {he:.2g}"
+        if math.isfinite(a.plate_velocity):
+            title += f" at A omega = {a.plate_velocity:.3g}"
+        ax.set_title(title, fontsize=9)
+    if dist is not None:
+        # the velocity distribution in layers, each component scaled by its layer's temperature
+        c = dist.centres
+        for j, (ax, hist, label) in enumerate(((axes[2, 0], dist.along, f"c_{ax_name} (m / T_{ax_name})^1/2"),
+                                                (axes[2, 1], dist.across, "c across (m / T_across)^1/2"))):
+            for i in range(dist.edges.size - 1):
+                good = hist[i] > 0
+                ax.plot(c[good], hist[i][good], "o", ms=2.5,
+                        label=f"{ax_name} {dist.edges[i]:.3g}–{dist.edges[i + 1]:.3g}: "
+                              f"a2 = {dist.a2[i, j]:+.3f} ± {dist.kurtosis_error[i, j] / 3:.2g}")
+            ax.plot(c, dist.gaussian, "k-", lw=1, label="Gaussian")
+            ax.set_yscale("log")
+            ax.set_ylim(bottom=max(1e-5, 0.3 / max(float(dist.counts[:, j].max()), 1.0)))
+            ax.set_xlabel(f"{label} in layers")
+            ax.set_ylabel("probability density")
+            ax.legend(fontsize=7)
+    fig.suptitle(_title(a.info, "Vibrated gas: profiles, energy balance, centre of mass"
+                        + (", velocity distribution in layers" if dist is not None else "")), fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -10,7 +10,17 @@ What a run shows:
   components along and across the axis), and the central moments of each velocity
   component, whose excess kurtosis <c^4>/<c^2>^2 - 3 is 0 for a Maxwellian (standard
   error sqrt(24 / n) from n samples);
-* the **centre of mass** along the axis against time, and its mean in the steady state;
+* the **velocity distribution in layers** (:class:`LayerDistributionAccumulator`): a few
+  thick layers, each holding an equal share of the samples, in which the component along the
+  axis and the components across it (pooled) are scaled by their own temperature,
+  c_a sqrt(m / T_a), and histogrammed against the unit Gaussian, with the excess kurtosis
+  k = <c^4>/<c^2>^2 - 3 of each (a_2 = k / 3 for one component, 0 for a Maxwellian) and its
+  error from block means over the snapshots;
+* the **centre of mass** along the axis against time, its height above the floor (the
+  wall the gas rests on, at its rest position) in the steady state (time mean, block-mean
+  error), against that of a dilute barometric column, sigma/2 + T / (m g), which for a dilute
+  bed on a vibrating floor scales as T, i.e. as (A omega)^2 / N_L at leading order
+  (:func:`centre_of_mass_height`, :func:`barometric_height`);
 * the **energy balance** of the steady state: the power the walls put in (the slope of
   the cumulative ``wall_work``) against the power dissipated in collisions (the slope of
   ``dissipated_energy``), each the mean over blocks of the second half of the run with
@@ -29,8 +39,9 @@ import numpy as np
 from granulargas.analysis.elastic import block_mean
 from granulargas.analysis.run import run_identity
 
-__all__ = ["LayerAccumulator", "LayerProfile", "centre_of_mass", "energy_balance", "EnergyBalance", "steady_mean",
-           "VibratedAnalysis", "analyze_vibrated"]
+__all__ = ["LayerAccumulator", "LayerProfile", "LayerDistributionAccumulator", "LayerDistributions",
+           "distribution_edges", "centre_of_mass", "centre_of_mass_height", "barometric_height", "energy_balance",
+           "EnergyBalance", "steady_mean", "VibratedAnalysis", "analyze_vibrated"]
 
 
 @dataclass(frozen=True)
@@ -105,6 +116,20 @@ class LayerAccumulator:
         self.frames += 1
         return self
 
+    def moments(self, groups):
+        """Mean velocity (G, d), m <c_a^2> along the axis and across it (G,) of the groups of
+        layers ``groups`` (list of index arrays into the layers)."""
+        d = self.box.shape[0]
+        others = [a for a in range(d) if a != self.axis]
+        n = np.array([self.n[g].sum() for g in groups])
+        m = np.array([self.m[g].sum() for g in groups])
+        s1 = np.array([self.s1[g].sum(axis=0) for g in groups]).reshape(len(groups), d)
+        mv = np.array([self.mv[g].sum(axis=0) for g in groups]).reshape(len(groups), d)
+        mv2 = np.array([self.mv2[g].sum(axis=0) for g in groups]).reshape(len(groups), d)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            comp = (mv2 - mv**2 / m[:, None]) / n[:, None]
+            return s1 / n[:, None], comp[:, self.axis], comp[:, others].mean(axis=1)
+
     def profile(self) -> LayerProfile:
         d = self.box.shape[0]
         width = np.diff(self.edges)
@@ -122,6 +147,166 @@ class LayerAccumulator:
         others = [a for a in range(d) if a != self.axis]
         return LayerProfile(self.axis, self.edges.copy(), density, comp.sum(axis=1) / d, comp[:, self.axis],
                             comp[:, others].mean(axis=1), kurt, self.n.copy(), self.frames)
+
+
+#: the scaled velocity histograms: bins of width 0.2 over [-4.8, 4.8] (|c| = 2 is a bin edge)
+HISTOGRAM_BINS = np.linspace(-4.8, 4.8, 49)
+#: the tail weight P(|c| > 2) of the unit Gaussian
+GAUSSIAN_TAIL_2 = math.erfc(2.0 / math.sqrt(2.0))
+
+
+def distribution_edges(profile: LayerProfile, layers: int) -> np.ndarray:
+    """Edges of ``layers`` thick layers from the fine layers of ``profile``, each holding about
+    an equal share of the samples (cut at the fine edges; fewer if the samples are too few)."""
+    c = np.concatenate([[0.0], np.cumsum(profile.counts)])
+    if c[-1] <= 0:
+        return profile.edges[[0, -1]].copy()
+    cuts = np.searchsorted(c, c[-1] * np.arange(1, layers) / layers)
+    inner = np.unique(np.clip(cuts, 1, profile.edges.size - 2))
+    lo = int(np.argmax(c > 0)) - 1  # the first filled fine layer
+    hi = int(np.searchsorted(c, c[-1]))  # the edge after the last filled one
+    inner = inner[(inner > lo) & (inner < hi)]
+    return profile.edges[np.concatenate([[lo], inner, [hi]])]
+
+
+@dataclass(frozen=True)
+class LayerDistributions:
+    """The velocity distribution in the layers between ``edges`` (L + 1,) along ``axis``.
+
+    ``along``, ``across``: histograms (L, K) of the scaled components c_a sqrt(m / T_a) over
+    ``bins`` (K + 1,) as probability densities (normalised by all samples of the layer, those
+    beyond the bins too); ``counts`` (L, 2): samples along and across; ``kurtosis``,
+    ``kurtosis_error`` (L, 2): excess kurtosis along and across, and its standard error from
+    block means over the snapshots (sqrt(24 / n), that of n independent Gaussian samples, with
+    fewer than 4 snapshots); ``tail`` (L, 2): P(|c| > 2) (Gaussian: :data:`GAUSSIAN_TAIL_2`);
+    ``temperature`` (L, 2): T along and across by which the components were scaled.
+    """
+
+    axis: int
+    edges: np.ndarray
+    bins: np.ndarray
+    along: np.ndarray
+    across: np.ndarray
+    counts: np.ndarray
+    kurtosis: np.ndarray
+    kurtosis_error: np.ndarray
+    tail: np.ndarray
+    temperature: np.ndarray
+
+    @property
+    def centres(self) -> np.ndarray:
+        """Centres of the histogram bins."""
+        return 0.5 * (self.bins[1:] + self.bins[:-1])
+
+    @property
+    def gaussian(self) -> np.ndarray:
+        """The unit Gaussian density at the bin centres."""
+        return np.exp(-0.5 * self.centres**2) / math.sqrt(2.0 * math.pi)
+
+    @property
+    def a2(self) -> np.ndarray:
+        """Sonine a_2 of one component, k / 3 (L, 2)."""
+        return self.kurtosis / 3.0
+
+    def summary(self) -> list:
+        """One dict per layer (JSON-ready)."""
+        def f(x):
+            return float(x) if math.isfinite(x) else None
+
+        out = []
+        for i in range(self.edges.size - 1):
+            out.append({"from": float(self.edges[i]), "to": float(self.edges[i + 1]),
+                        "samples_along": int(self.counts[i, 0]), "samples_across": int(self.counts[i, 1]),
+                        "T_along": f(self.temperature[i, 0]), "T_across": f(self.temperature[i, 1]),
+                        "kurtosis_along": f(self.kurtosis[i, 0]), "kurtosis_along_error": f(self.kurtosis_error[i, 0]),
+                        "kurtosis_across": f(self.kurtosis[i, 1]),
+                        "kurtosis_across_error": f(self.kurtosis_error[i, 1]),
+                        "a2_along": f(self.a2[i, 0]), "a2_across": f(self.a2[i, 1]),
+                        "tail_along": f(self.tail[i, 0]), "tail_across": f(self.tail[i, 1]),
+                        "bins": self.bins.tolist(), "density_along": self.along[i].tolist(),
+                        "density_across": self.across[i].tolist(), "gaussian": self.gaussian.tolist()})
+        return out
+
+
+class LayerDistributionAccumulator:
+    """Histograms of the scaled velocity components in the layers between ``edges`` along ``axis``.
+
+    ``mean`` (L, d): each layer's mean velocity; ``t_along``, ``t_across`` (L,): its m <c_a^2>
+    along the axis and across it (from a first pass, :meth:`LayerAccumulator.moments`), by which
+    c_a = v_a - mean_a is scaled to c_a sqrt(m / T_a). Each snapshot's sums of c^2 and c^4 are
+    kept apart, for the block error of the kurtosis.
+    """
+
+    def __init__(self, axis: int, edges, mean, t_along, t_across, bins=HISTOGRAM_BINS):
+        self.axis = int(axis)
+        self.edges = np.asarray(edges, dtype=float)
+        self.mean = np.asarray(mean, dtype=float)
+        self.t = np.stack([np.asarray(t_along, dtype=float), np.asarray(t_across, dtype=float)], axis=1)
+        self.bins = np.asarray(bins, dtype=float)
+        n_layers, k = self.edges.size - 1, self.bins.size - 1
+        self.hist = np.zeros((2, n_layers, k))
+        self.frame_sums = []  # per snapshot: (3, 2, L) sums of 1, c^2, c^4
+
+    def add(self, positions, velocities, masses):
+        """Add one snapshot (positions (N, d), velocities (N, d), masses (N,))."""
+        z = np.asarray(positions, dtype=float)[:, self.axis]
+        v = np.asarray(velocities, dtype=float)
+        d = v.shape[1]
+        m = np.broadcast_to(np.asarray(masses, dtype=float), z.shape)
+        n_layers, k = self.edges.size - 1, self.bins.size - 1
+        lay = np.searchsorted(self.edges, z, side="right") - 1
+        ok = (lay >= 0) & (lay < n_layers)
+        lay, v, m = lay[ok], v[ok], m[ok]
+        across = [a for a in range(d) if a != self.axis]
+        scale = np.empty_like(v)
+        scale[:, self.axis] = self.t[lay, 0]
+        scale[:, across] = self.t[lay, 1][:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c = (v - self.mean[lay]) * np.sqrt(m[:, None] / scale)
+        sums = np.zeros((3, 2, n_layers))
+        for j, (cs, ls) in enumerate(((c[:, self.axis], lay), (c[:, across].ravel(), np.repeat(lay, d - 1)))):
+            good = np.isfinite(cs)
+            cs, ls = cs[good], ls[good]
+            b = np.searchsorted(self.bins, cs, side="right") - 1
+            inside = (b >= 0) & (b < k)
+            self.hist[j] += np.bincount(ls[inside] * k + b[inside], minlength=n_layers * k).reshape(n_layers, k)
+            for p, w in enumerate((np.ones_like(cs), cs**2, cs**4)):
+                sums[p, j] = np.bincount(ls, weights=w, minlength=n_layers)
+        self.frame_sums.append(sums)
+        return self
+
+    def distributions(self, blocks: int = 10) -> LayerDistributions:
+        f = np.array(self.frame_sums) if self.frame_sums else np.zeros((0, 3, 2, self.edges.size - 1))
+        tot = f.sum(axis=0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            n = tot[0]
+            kurt = tot[2] * n / tot[1] ** 2 - 3.0
+            err = np.sqrt(24.0 / n)
+            k = min(blocks, f.shape[0])
+            if k >= 4:
+                parts = np.array([p.sum(axis=0) for p in np.array_split(f, k)])
+                kb = parts[:, 2] * parts[:, 0] / parts[:, 1] ** 2 - 3.0
+                err = np.std(kb, axis=0, ddof=1) / math.sqrt(k)
+            width = np.diff(self.bins)
+            dens = self.hist / (n[:, :, None] * width)
+            inner = (self.bins[:-1] >= -2.0) & (self.bins[1:] <= 2.0)
+            tail = 1.0 - self.hist[:, :, inner].sum(axis=2) / n
+        return LayerDistributions(self.axis, self.edges.copy(), self.bins.copy(), dens[0], dens[1], n.T.copy(),
+                                  kurt.T.copy(), err.T.copy(), tail.T.copy(), self.t.copy())
+
+
+def centre_of_mass_height(time, com, floor: float, t_from: float | None = None, up: int = 1):
+    """(mean, standard error) of the height of the centre of mass above ``floor`` in the steady
+    state (from ``t_from`` on, default the second half): the time mean of ``com`` - ``floor``
+    (``up`` = -1: a floor above the gas, the height ``floor`` - ``com``), block-mean error."""
+    return steady_mean(time, up * (np.asarray(com, dtype=float) - float(floor)), t_from)
+
+
+def barometric_height(temperature: float, g: float, mass: float = 1.0, diameter: float = 1.0) -> float:
+    """Height of the centre of mass of a dilute barometric column above its floor:
+    sigma/2 + T / (m g) (the centres reach down to sigma/2, their density falls as
+    exp(-m g z / T))."""
+    return 0.5 * diameter + temperature / (mass * g)
 
 
 def centre_of_mass(positions, masses, axis: int) -> float:
@@ -192,6 +377,8 @@ def steady_mean(time, values, t_from: float | None = None):
 # ------------------------------------------------------------------ a run's file
 #: layers of the profiles
 LAYERS = 40
+#: thick layers of the velocity distributions (equal shares of the samples)
+DISTRIBUTION_LAYERS = 4
 
 
 @dataclass(frozen=True)
@@ -214,6 +401,7 @@ class VibratedAnalysis:
     com: np.ndarray  # centre of mass along ``axis`` at the snapshots
     balance: EnergyBalance
     kind: str = "vibrated"
+    distributions: LayerDistributions | None = None  # the velocity distribution in layers
 
     @property
     def theory_name(self) -> str:
@@ -280,6 +468,33 @@ class VibratedAnalysis:
                                 self.g_axis, self.info.dimension, self.info.diameter, self.info.mass)
 
     @property
+    def floor(self):
+        """(position, direction) of the floor along the axis: the wall gravity points into, at
+        its rest position (a vibrating wall's is A inside the box), and +1 if the gas lies
+        above it, -1 below; without gravity along the axis, the low wall, +1."""
+        down = 1 if self.gravity is not None and self.gravity[self.axis] > 0 else 0
+        w = self.walls.get("xyz"[self.axis] + ("_low", "_high")[down]) or {}
+        inside = float(w.get("amplitude", 0.0)) if w.get("kind") == "vibrating" else 0.0
+        L = float(self.info.box[self.axis])
+        return (L - inside, -1) if down else (inside, 1)
+
+    @property
+    def plate_velocity(self) -> float:
+        """A omega of the vibrating floor (nan without one)."""
+        down = 1 if self.gravity is not None and self.gravity[self.axis] > 0 else 0
+        w = self.walls.get("xyz"[self.axis] + ("_low", "_high")[down]) or {}
+        if w.get("kind") != "vibrating":
+            return math.nan
+        return 2.0 * math.pi * float(w["amplitude"]) * float(w["frequency"])
+
+    def com_height(self):
+        """(mean, error) of the centre of mass's height above the floor in the steady state."""
+        floor, up = self.floor
+        if not self.com.size:
+            return math.nan, math.nan
+        return centre_of_mass_height(self.com_time, self.com, floor, self.t_from, up)
+
+    @property
     def steady(self) -> np.ndarray:
         return self.time >= self.t_from
 
@@ -302,7 +517,18 @@ class VibratedAnalysis:
                        bed_floor_packing=bed["floor_packing"])
         if self.thermal_floor is not None:
             out["T_wall"] = self.thermal_floor
-        return {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+        h, he = self.com_height()
+        out.update(com_height=h, com_height_error=he, plate_velocity=self.plate_velocity)
+        if self.g_axis > 0:
+            # against the dilute barometric column at the measured T and at the leading-order T
+            out["com_height_barometric"] = barometric_height(T, self.g_axis, self.info.mass, self.info.diameter)
+            if bed is not None:
+                out["com_height_bed_theory"] = barometric_height(bed["temperature"], self.g_axis, self.info.mass,
+                                                                 self.info.diameter)
+        out = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in out.items()}
+        if self.distributions is not None:
+            out["layer_distributions"] = self.distributions.summary()
+        return out
 
 
 def _scene_axis(gravity, walls: dict, boundary) -> int:
@@ -350,11 +576,23 @@ def analyze_vibrated(path, t_range=None, with_sonine: bool = True, **_) -> Vibra
     edges = np.linspace(0.0, span, LAYERS + 1) if gravity is None or gravity[axis] <= 0 else \
         np.linspace(L - span, L, LAYERS + 1)
     acc = LayerAccumulator(axis, edges, info.box)
+    dists = None
     if with_sonine:
         for snap in iter_snapshots(path):
             if snap.time >= t_from:
                 acc.add(snap.positions, snap.velocities, snap.masses)
+        # the velocity distribution in thick layers, scaled by their temperatures (a second pass)
+        fine = acc.profile()
+        if fine.counts.sum() > 0:
+            thick = distribution_edges(fine, DISTRIBUTION_LAYERS)
+            idx = np.searchsorted(fine.edges, thick)
+            mean, t_al, t_ac = acc.moments([np.arange(a, b) for a, b in zip(idx[:-1], idx[1:])])
+            dacc = LayerDistributionAccumulator(axis, thick, mean, t_al, t_ac)
+            for snap in iter_snapshots(path):
+                if snap.time >= t_from:
+                    dacc.add(snap.positions, snap.velocities, snap.masses)
+            dists = dacc.distributions()
     balance = energy_balance(t, series("wall_work"), series("dissipated_energy"), t_from)
     return VibratedAnalysis(info, t, obs["temperature"][2], series("kinetic_energy"), series("potential_energy"),
                             series("dissipated_energy"), series("wall_work"), t_from, axis, gravity, walls,
-                            acc.profile(), np.asarray(com_t), np.asarray(com), balance)
+                            acc.profile(), np.asarray(com_t), np.asarray(com), balance, distributions=dists)

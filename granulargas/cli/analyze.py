@@ -276,6 +276,8 @@ def shear_report(a, rows: int = 10) -> str:
 
 def vibrated_report(a, rows: int = 10) -> str:
     """Text report of a :class:`granulargas.analysis.vibrated.VibratedAnalysis`."""
+    from granulargas.analysis.vibrated import GAUSSIAN_TAIL_2
+
     s = a.summary()
     lines = _header(a.info)
     ax = "xyz"[a.axis]
@@ -298,6 +300,17 @@ def vibrated_report(a, rows: int = 10) -> str:
                      f"its small parameters: (1-e^2) N = {s['bed_dissipation']:.2g}, m<U^2>/T = "
                      f"{s['bed_plate_speed']:.2g}, A m g/T = {s['bed_amplitude']:.2g}, floor packing "
                      f"{s['bed_floor_packing']:.2g}")
+    if s.get("com_height") is not None:
+        h = (f"  centre of mass above the floor h = {_pm(s.get('com_height'), s.get('com_height_error'))}")
+        if s.get("plate_velocity") is not None:
+            h += f" at plate velocity A omega = {s['plate_velocity']:.4g}"
+        lines.append(h)
+        if s.get("com_height_barometric") is not None:
+            lines.append(f"  dilute barometric column sigma/2 + T/(m g): {s['com_height_barometric']:.5g} at the measured T"
+                         f"{_dev(s.get('com_height'), s['com_height_barometric'])}" + (
+                             f"; {s['com_height_bed_theory']:.5g} at the leading-order T (scales as (A omega)^2/N)"
+                             f"{_dev(s.get('com_height'), s['com_height_bed_theory'])}"
+                             if s.get("com_height_bed_theory") is not None else ""))
     lines.append(f"  energy: walls put in {_pm(s.get('power_in'), s.get('power_in_error'))} per unit time, collisions "
                  f"dissipate {_pm(s.get('dissipation'), s.get('dissipation_error'))}; ratio "
                  f"{_pm(s.get('balance_ratio'), s.get('balance_ratio_error'), '.4f')} (1 in a steady state)")
@@ -311,6 +324,19 @@ def vibrated_report(a, rows: int = 10) -> str:
         row = (f"  {p.centres[i]:8.4g} {p.density[i]:10.4g} {p.temperature[i]:10.4g} {p.t_along[i]:10.4g} "
                f"{p.t_across[i]:10.4g} {k:8.3f}")
         lines.append(row + (f" {hyd[i]:10.4g}" if hyd is not None else ""))
+    dist = s.get("layer_distributions")
+    if dist:
+        lines += ["", f"  velocity distribution in layers: c_a sqrt(m/T_a) against the unit Gaussian (excess kurtosis 0, "
+                      f"P(|c| > 2) = {GAUSSIAN_TAIL_2:.4f}); kurtosis errors from block means",
+                  f"  {ax + ' from':>9} {'to':>8} {'samples':>8} {'kurt. along':>16} {'a2 along':>9} "
+                  f"{'kurt. across':>16} {'a2 across':>9} {'P(|c|>2) al.':>12} {'ac.':>7}"]
+        for row in dist:
+            lines.append(f"  {row['from']:9.4g} {row['to']:8.4g} {row['samples_along']:8d} "
+                         f"{_pm(row['kurtosis_along'], row['kurtosis_along_error'], '+.3f'):>16} "
+                         f"{_fmt(row['a2_along'], '+.4f'):>9} "
+                         f"{_pm(row['kurtosis_across'], row['kurtosis_across_error'], '+.3f'):>16} "
+                         f"{_fmt(row['a2_across'], '+.4f'):>9} {_fmt(row['tail_along'], '.4f'):>12} "
+                         f"{_fmt(row['tail_across'], '.4f'):>7}")
     return "\n".join(lines)
 
 

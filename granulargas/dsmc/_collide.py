@@ -43,7 +43,7 @@ import numpy as np
 
 from granulargas._numba import inlined
 from granulargas.dsmc._random import next_u64
-from granulargas.engine._rough import contact_slip, rough_pair_collision
+from granulargas.engine._rough import apply_rough_pair, contact_slip, rough_pair_collision
 
 _MASK32 = np.uint64(0xFFFFFFFF)
 _S32 = np.uint64(32)
@@ -122,20 +122,5 @@ def apply_rough_update(rec, spins, i, j, dim, px, py, pz, gn2, eps, mi, mj, ri, 
                                   ri * w[i, 2] + rj * w[j, 2])
     fi, fj, ti, tj, si, sj, loss, _ = rough_pair_collision(un, gx * gx + gy * gy + gz * gz, mi, mj, ki, kj, ri, rj,
                                                            eps, spins.model, spins.beta, spins.mu)
-    rec[i, 0] -= fi * nx + ti * gx
-    rec[i, 1] -= fi * ny + ti * gy
-    rec[j, 0] += fj * nx + tj * gx
-    rec[j, 1] += fj * ny + tj * gy
-    if dim == 3:
-        rec[i, 2] -= fi * nz + ti * gz
-        rec[j, 2] += fj * nz + tj * gz
-    cx = ny * gz - nz * gy
-    cy = nz * gx - nx * gz
-    cz = nx * gy - ny * gx
-    w[i, 0] += si * cx
-    w[i, 1] += si * cy
-    w[i, 2] += si * cz
-    w[j, 0] += sj * cx
-    w[j, 1] += sj * cy
-    w[j, 2] += sj * cz
+    apply_rough_pair(rec, 0, w, i, j, dim, nx, ny, nz, gx, gy, gz, fi, fj, ti, tj, si, sj)
     return loss

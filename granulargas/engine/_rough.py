@@ -128,6 +128,28 @@ def rough_pair_collision(un, gt2, mi, mj, ki, kj, ri, rj, eps, model, beta, mu):
     return fi, fj, c / mi, c / mj, c / (ki * mi * ri), c / (kj * mj * rj), loss, impulse
 
 
+
+@inlined
+def apply_rough_pair(rec, col, w, i, j, dim, nx, ny, nz, gx, gy, gz, fi, fj, ti, tj, si, sj):
+    """Apply the changes of :func:`rough_pair_collision` in place: velocities in the columns
+    ``col``, ``col + 1`` (and ``col + 2`` when ``dim == 3``) of ``rec``, spins in ``w`` (N, 3)."""
+    rec[i, col] -= fi * nx + ti * gx
+    rec[i, col + 1] -= fi * ny + ti * gy
+    rec[j, col] += fj * nx + tj * gx
+    rec[j, col + 1] += fj * ny + tj * gy
+    if dim == 3:
+        rec[i, col + 2] -= fi * nz + ti * gz
+        rec[j, col + 2] += fj * nz + tj * gz
+    cx = ny * gz - nz * gy
+    cy = nz * gx - nx * gz
+    cz = nx * gy - ny * gx
+    w[i, 0] += si * cx
+    w[i, 1] += si * cy
+    w[i, 2] += si * cz
+    w[j, 0] += sj * cx
+    w[j, 1] += sj * cy
+    w[j, 2] += sj * cz
+
 @inlined
 def rough_wall_collision(vn, gt2, mi, ki, ri, eps, model, beta, mu):
     """Rough particle against a flat wall at rest (n into the gas, ``vn`` = v_i.n of either sign).

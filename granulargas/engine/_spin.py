@@ -36,7 +36,13 @@ import numpy as np
 
 from granulargas._numba import inlined, kernel
 from granulargas.engine._drive import kick_normals
-from granulargas.engine._rough import TANGENTIAL_CONSTANT, contact_slip, rough_pair_collision, rough_wall_collision
+from granulargas.engine._rough import (
+    TANGENTIAL_CONSTANT,
+    apply_rough_pair,
+    contact_slip,
+    rough_pair_collision,
+    rough_wall_collision,
+)
 
 #: mixed into the driving's seed for the spin kicks (an arbitrary odd 64-bit word)
 SPIN_KEY = np.uint64(0x5851F42D4C957F2D)
@@ -70,21 +76,7 @@ def rough_pair(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
     beta = -1.0 if elastic else spins.beta
     fi, fj, ti, tj, si, sj, loss, impulse = rough_pair_collision(
         un, gx * gx + gy * gy + gz * gz, mi, mj, kap[i], kap[j], ri, rj, eps, model, beta, spins.mu)
-    rec[i, 3] -= fi * nx + ti * gx
-    rec[i, 4] -= fi * ny + ti * gy
-    rec[i, 5] -= fi * nz + ti * gz
-    rec[j, 3] += fj * nx + tj * gx
-    rec[j, 4] += fj * ny + tj * gy
-    rec[j, 5] += fj * nz + tj * gz
-    cx = ny * gz - nz * gy
-    cy = nz * gx - nx * gz
-    cz = nx * gy - ny * gx
-    w[i, 0] += si * cx
-    w[i, 1] += si * cy
-    w[i, 2] += si * cz
-    w[j, 0] += sj * cx
-    w[j, 1] += sj * cy
-    w[j, 2] += sj * cz
+    apply_rough_pair(rec, 3, w, i, j, 3, nx, ny, nz, gx, gy, gz, fi, fj, ti, tj, si, sj)  # 2D: z rows stay 0
     drot = 0.5 * (_spin_energy(w, kap, i, mi, ri) + _spin_energy(w, kap, j, mj, rj) - e0)
     return loss, impulse, drot
 

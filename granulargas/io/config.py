@@ -1323,7 +1323,10 @@ def _check_shear(v: Values):
     if v.get("run.method") == "dsmc" and lo is not None and hi is not None and lo < hi:
         v.fail("particles.diameter", 'the DSMC of uniform shear flow takes identical particles: one diameter '
                                      '(or method = "edmd")', v.raw.get("particles.diameter"))
-    if v.get("collision.model") == "elastic" and not v.has("shear.thermostat_temperature"):
+    eps = v.get("collision.restitution")
+    elastic = v.get("collision.model") == "elastic" or (
+        v.get("collision.model") == "constant" and isinstance(eps, (int, float)) and eps == 1.0)
+    if elastic and not v.has("shear.thermostat_temperature"):
         v.fail("shear.rate", 'an elastic gas only heats under shear and never reaches a steady state: give '
                              "shear.thermostat_temperature or an inelastic collision model")
 

@@ -541,7 +541,9 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
         cooled.terminal = True
         events = cooled
         if not math.isfinite(x_end):
-            x_end = 200.0  # t = t_free e^200: the event comes first for any cooling gas
+            # t = t_free e^200: the event comes first for any cooling gas, unless t_free is so
+            # long (a very dilute gas) that the time would leave float64's range first
+            x_end = min(200.0, math.log(np.finfo(np.float64).max) - math.log(t_free) - 1.0)
     sol = solve_ivp(rhs, (0.0, x_end), y0, method="LSODA", rtol=rtol, atol=atol, dense_output=True, events=events)
     if sol.status < 0:
         raise RuntimeError(f"cooling_curve: the ODE solver failed ({sol.message})")

@@ -245,10 +245,194 @@ interval = 0.05
 [run]
 method = "dsmc"
 """, 10.0),
+    "rough-3d-lists": ("""
+[system]
+dimension = 3
+particles = 400
+packing_fraction = 0.15
+seed = 16
+[particles]
+inertia = 0.4
+[initial]
+rotational_temperature = 0.5
+[collision]
+model = "constant"
+restitution = 0.8
+[collision.tangential]
+model = "coulomb"
+restitution = 0.5
+friction = 0.2
+[run]
+neighbours = "lists"
+""", 10.0),
+    "rough-driven-2d-cells": ("""
+[system]
+dimension = 2
+particles = 400
+packing_fraction = 0.1
+seed = 17
+[particles]
+inertia = 0.5
+[collision]
+model = "viscoelastic"
+damping = 0.1
+[collision.tangential]
+restitution = 0.0
+[driving]
+heating_rate = 0.5
+rotational_fraction = 0.5
+[run]
+neighbours = "cells"
+""", 10.0),
+    "rough-dsmc-3d": ("""
+[system]
+dimension = 3
+particles = 2000
+packing_fraction = 0.05
+seed = 18
+[particles]
+inertia = 0.4
+[collision]
+model = "constant"
+restitution = 0.9
+[collision.tangential]
+restitution = -0.5
+[run]
+method = "dsmc"
+""", 10.0),
+    "species-3d-lists": ("""
+[system]
+dimension = 3
+particles = 400
+packing_fraction = 0.15
+seed = 19
+[[species]]
+name = "big"
+fraction = 0.5
+diameter = 1.2
+mass = 2.0
+[[species]]
+name = "small"
+fraction = 0.5
+diameter = 0.8
+mass = 1.0
+[collision]
+model = "constant"
+restitution = { "big-big" = 0.9, "big-small" = 0.8, "small-small" = 0.7 }
+[run]
+neighbours = "lists"
+""", 10.0),
+    "species-dsmc-3d": ("""
+[system]
+dimension = 3
+particles = 2000
+packing_fraction = 0.05
+seed = 20
+[[species]]
+name = "heavy"
+fraction = 0.5
+diameter = 1.0
+mass = 4.0
+[[species]]
+name = "light"
+fraction = 0.5
+diameter = 1.0
+mass = 1.0
+[collision]
+model = "constant"
+restitution = 0.8
+[run]
+method = "dsmc"
+""", 10.0),
+    "vibrated-2d-cells": ("""
+[system]
+dimension = 2
+particles = 300
+packing_fraction = 0.05
+seed = 21
+boundary = ["periodic", "wall"]
+[collision]
+model = "constant"
+restitution = 0.9
+elastic_below = 1e-3
+[gravity]
+acceleration = [0.0, -1.0]
+[walls]
+y_low = { kind = "vibrating", amplitude = 0.05, frequency = 3.183, waveform = "sine" }
+[run]
+neighbours = "cells"
+""", 10.0),
+    "thermal-gravity-3d-lists": ("""
+[system]
+dimension = 3
+particles = 400
+packing_fraction = 0.1
+seed = 22
+boundary = ["periodic", "periodic", "wall"]
+[collision]
+model = "viscoelastic"
+damping = 0.1
+[gravity]
+acceleration = [0.0, 0.0, -0.5]
+[walls]
+z_low = { kind = "thermal", temperature = 1.0 }
+z_high = { kind = "vibrating", amplitude = 0.05, frequency = 1.0, waveform = "triangle" }
+[run]
+neighbours = "lists"
+""", 10.0),
+    "shear-3d-lists": ("""
+[system]
+dimension = 3
+particles = 400
+packing_fraction = 0.1
+seed = 23
+boundary = ["periodic", "lees-edwards", "periodic"]
+[collision]
+model = "elastic"
+[shear]
+rate = 0.3
+thermostat_temperature = 1.0
+[run]
+neighbours = "lists"
+""", 10.0),
+    "shear-2d-cells": ("""
+[system]
+dimension = 2
+particles = 400
+packing_fraction = 0.1
+seed = 24
+boundary = ["periodic", "lees-edwards"]
+[collision]
+model = "constant"
+restitution = 0.9
+[shear]
+rate = 0.5
+thermostat_temperature = 1.0
+thermostat_interval = 0.05
+[run]
+neighbours = "cells"
+""", 10.0),
+    "shear-dsmc-3d": ("""
+[system]
+dimension = 3
+particles = 2000
+packing_fraction = 0.02
+seed = 25
+boundary = ["periodic", "lees-edwards", "periodic"]
+[collision]
+model = "viscoelastic"
+damping = 0.1
+[shear]
+rate = 0.2
+thermostat_temperature = 1.0
+[run]
+method = "dsmc"
+""", 10.0),
 }
 #: scenes continued from a file written at half their end time (fingerprint: that of the scene)
 RESTARTS = ("tc-3d-lists", "viscoelastic-2d-cells", "walls-3d-lists", "driven-walls-2d-cells", "resolved-3d-lists",
-            "dsmc-driven-2d")
+            "dsmc-driven-2d", "rough-3d-lists", "rough-dsmc-3d", "species-3d-lists", "vibrated-2d-cells",
+            "shear-3d-lists", "shear-dsmc-3d")
 
 #: observables left out of the fingerprint: averages over the last sampling window
 WINDOWED = ("pressure", "wall_pressure", "pressure_tensor")

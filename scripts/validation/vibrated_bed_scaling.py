@@ -8,7 +8,10 @@ of ``--time`` averaged) and its temperature T = m <c^2> / d is compared with the
 balance of plate input and collisional loss (Kumaran 1998; McNamara & Luding 1998;
 :func:`granulargas.theory.vibrated.vibrated_bed_temperature`), which holds for
 (1 - e^2) N_L sigma << 1, m <U^2> << T and A << T / (m g). The table gives T / T_theory with
-those small parameters; the figure (``--figure``) T against A omega per N_L beside the theory's
+those small parameters, and the height h of the centre of mass above the floor against
+that of a dilute barometric column at the measured T, h_baro = sigma/2 + T/(m g)
+(:func:`granulargas.analysis.vibrated.centre_of_mass_height`, the same as ``analyze`` reports);
+the figure (``--figure``) T against A omega per N_L beside the theory's
 (A omega)^2, and T / T_theory against (1 - e^2) N_L.
 
 Usage::
@@ -26,6 +29,7 @@ import time
 import numpy as np
 
 from granulargas.analysis.elastic import block_mean
+from granulargas.analysis.vibrated import barometric_height, centre_of_mass, centre_of_mass_height
 from granulargas.engine import CollisionRule, Simulation, Wall, Walls
 from granulargas.initial import random_state
 from granulargas.theory import vibrated as V
@@ -55,15 +59,16 @@ def run_bed(column, speed, e, dim, amplitude, t_end, width, seed):
     g = [0.0] * (dim - 1) + [-1.0]
     sim = Simulation(st, CollisionRule.constant(e, wall_restitution=1.0, elastic_below=1e-4),
                      gravity=g, walls=walls, neighbours="cells")
-    temps, coms = [], []
+    temps, times, coms = [], [], []
     for k in range(1, 201):
         sim.run(k * t_end / 200)
         if k > 100:
             temps.append(sim.temperature)
-            z = sim.positions[:, dim - 1]
-            coms.append(float(np.mean(z)) - amplitude)
+            times.append(sim.time)
+            coms.append(centre_of_mass(sim.positions, 1.0, dim - 1))
     T, Te = block_mean(temps)
-    com, _ = block_mean(coms)
+    # above the floor's rest position, A inside the box
+    com, _ = centre_of_mass_height(times, coms, floor=amplitude, t_from=times[0])
     return T, Te, com, p, n
 
 
@@ -84,7 +89,7 @@ def main(argv=None) -> int:
     print(f"# {args.dim}D, e = {e:g} (elastic floor), A = {args.amplitude:g}, g = 1, steady state: second half of "
           f"t = {args.time:g}")
     print(f"{'N_L':>6} {'A omega':>8} {'N':>5} {'T':>10} {'T_theory':>9} {'T/T_th':>12} {'(1-e^2)N':>9} "
-          f"{'m<U^2>/T':>9} {'A m g/T':>8} {'floor eta':>9} {'z_cm/ell':>8} {'s':>6}")
+          f"{'m<U^2>/T':>9} {'A m g/T':>8} {'floor eta':>9} {'h/h_baro':>8} {'s':>6}")
     for column in args.columns:
         for speed in args.speeds:
             t0 = time.perf_counter()
@@ -92,7 +97,7 @@ def main(argv=None) -> int:
             rows.append((column, speed, T, Te, p))
             print(f"{column:6.3g} {speed:8.3g} {n:5d} {T:10.4g} {p['temperature']:9.4g} "
                   f"{T / p['temperature']:7.3f}±{Te / p['temperature']:.3f} {p['dissipation']:9.3g} "
-                  f"{p['plate_speed']:9.3g} {p['amplitude']:8.2g} {p['floor_packing']:9.2g} {com / T:8.3f} "
+                  f"{p['plate_speed']:9.3g} {p['amplitude']:8.2g} {p['floor_packing']:9.2g} {com / barometric_height(T, 1.0):8.3f} "
                   f"{time.perf_counter() - t0:6.0f}", flush=True)
     if args.figure:
         import matplotlib
@@ -108,6 +113,8 @@ def main(argv=None) -> int:
             th = [V.vibrated_bed_temperature(column, e, 0.5 * u**2, args.dim) for u in s]
             a1.plot(s, th, "-", color=line[0].get_color(), lw=1)
         a1.set_xscale("log")
+        a1.set_xticks(args.speeds, [f"{x:g}" for x in args.speeds])
+        a1.minorticks_off()
         a1.set_yscale("log")
         a1.set_xlabel("plate velocity A omega")
         a1.set_ylabel("T (points); leading order (lines)")

@@ -165,5 +165,13 @@ def test_a_vibrated_scene_gets_its_own_numbers_and_no_cooling_advice(name, tmp_p
     assert Scene.from_file(out) == scene  # the file says what the config said
     result = json.loads(_call(["analyze", str(out), "--json"]))
     assert result["scene"]["kind"] == "vibrated" and result["kind"] == "vibrated"
+    # the velocity distribution in layers and the centre of mass above the floor
+    layers = result["layer_distributions"]
+    assert 1 <= len(layers) <= 4 and all(a["to"] > a["from"] for a in layers)
+    assert all(len(a["density_along"]) == len(a["gaussian"]) == len(a["bins"]) - 1 for a in layers)
+    assert sum(a["samples_along"] for a in layers) > 0 and result["com_height"] > 0
     report = _call(["analyze", str(out)])
     assert "Haff" not in report and "L_c" not in report
+    assert "velocity distribution in layers" in report and "centre of mass above the floor" in report
+    _call(["analyze", str(out), "--plot", str(tmp_path / "profiles.png")])
+    assert (tmp_path / "profiles.png").stat().st_size > 0

@@ -49,6 +49,8 @@ BAD = {
     "nan rate": (_with("rate = 0.114", "rate = nan"), "shear.rate = nan: must be"),
     "elastic without thermostat": (_with('model = "constant"\nrestitution = 0.8', 'model = "elastic"'),
                                    "an elastic gas only heats under shear"),
+    "restitution 1 without thermostat": (_with("restitution = 0.8", "restitution = 1.0"),
+                                         "an elastic gas only heats under shear"),
     "interval without temperature": (_with("rate = 0.114", "rate = 0.114\nthermostat_interval = 0.1"),
                                      "shear.thermostat_interval = 0.1: needs shear.thermostat_temperature"),
     "driving": (SHEARED + "\n[driving]\nheating_rate = 0.1\n", "[driving] is not available with [shear]"),
