@@ -139,6 +139,7 @@ from granulargas.engine._walls import (
 )
 from granulargas.engine._probe import (
     COLLIDE,
+    GLOBAL,
     PEEK,
     POP,
     PREDICT,
@@ -884,9 +885,10 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
         prefetch(p.count, i1)
     elif p1 == EXPIRY:
         dt1 = cal_next_time(cal) - rec[i1, 6]
-        prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
-                       rec[i1, 2] + rec[i1, 5] * dt1,
-                       rec[i1, 7] + prm.rmax + prm.shell, prm.space, cells, lists.stencil)
+        if prm.space.shear is None:  # (sheared: the centres' cells are counted in the rows' frames)
+            prefetch_cells(rec[i1, 0] + rec[i1, 3] * dt1, rec[i1, 1] + rec[i1, 4] * dt1,
+                           rec[i1, 2] + rec[i1, 5] * dt1,
+                           rec[i1, 7] + prm.rmax + prm.shell, prm.space, cells, lists.stencil)
         for k in range(nbn[i1]):
             prefetch(nbl, nbl[i1, k])
             prefetch(nbn, nbl[i1, k])
@@ -1110,6 +1112,7 @@ def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collis
                          stress)
         if status != DONE or t_next > until:
             return status
+        clock = probe_start(probe)
         if t_slide == t_next:
             if oncells is not None:  # slides only in the cell mode
                 if not slide_scan(c.time, engine.particles.rec, engine.particles.img, engine.particles.count,
@@ -1122,6 +1125,7 @@ def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collis
             status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
                                   engine.calendar, c, prm, engine.contacts, sh, stress,
                                   engine.spins)
+        tick(probe, GLOBAL, clock)
         c.events += 1
         if status != DONE or c.time >= until:
             return status

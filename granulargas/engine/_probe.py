@@ -18,9 +18,9 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
-POP, COLLIDE, REBUILD, WALL, STALE, PREDICT, UPDATE, PREFETCH, PEEK = range(9)
+POP, COLLIDE, REBUILD, WALL, STALE, PREDICT, UPDATE, PREFETCH, PEEK, GLOBAL = range(10)
 PART_NAMES = ["pop + validate", "collide (+ partner)", "list rebuild", "wall", "stale",
-              "predict i", "update i", "prefetch", "peek next"]
+              "predict i", "update i", "prefetch", "peek next", "global events"]
 PARTS = len(PART_NAMES)
 #: probe[GUESSES]: events whose successor was guessed for the prefetch; probe[GUESSED]: right
 GUESSES = 2 * PARTS

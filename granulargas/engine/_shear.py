@@ -45,20 +45,30 @@ particles move at their peculiar velocity plus at most a w_y / 2.
 *Neighbour lists* (:func:`rebuild_list_le`, :func:`predict_expiry_le`). A particle's
 list centre moves with its row: it is stored as (x - s_r(t_b), y, z) in float32, r the
 row of y, t_b the time of the list's build (``ShearGeometry.built``). Two centres in the
-same row keep their distance; in adjacent rows it changes at most at a w_y; rows two
-apart are farther than w_y >= R_i + R_j + shell. A list built at t_b lists every j whose
-centre (its image through the sheared boundary included) is within R_i + R_j + shell of
-c_i at t_b, and i's list expires when
+same row keep their distance; in adjacent rows their x separation changes at a w_y, in
+the direction the rows slide (row r + 1 moves towards +x against row r); rows two apart
+are farther than w_y >= R_i + R_j + shell along y, which the sliding leaves alone. With a
+margin D (:func:`list_margin`) and the lifetime T = D / (a w_y), a build of i at t_b lists
+every j whose centre (its image through the sheared boundary included) comes within
+R_i + R_j + shell of c_i while their rows slide by up to D (:func:`slid`: for a j in an
+adjacent row the x separation is shortened by up to D on the side the sliding closes),
+and i's list expires at the first of
 
-    |r_i(t) - c_i(t)| + kappa (t - t_b) = shell/2,    kappa = a w_y / 2            (3)
+    |r_i(t) - c_i(t)| = shell/2,    t = t_b + T                                        (3)
 
-(a quadratic in t: :func:`budget_delay`). Why no collision is missed: let i and j not
-be in each other's lists; the later of their two builds, at t*, found the centres
-apart by at least R_i + R_j + shell. Until either list expires,
-|r_i - r_j| >= |c_i - c_j| - |r_i - c_i| - |r_j - c_j|
->= R_i + R_j + shell - a w_y (t - t*) - (shell/2 - kappa (t - t_i)) - (shell/2 - kappa (t - t_j))
->= R_i + R_j, since t_i, t_j <= t* and 2 kappa = a w_y. Listed pairs are predicted
-exactly, and every velocity change re-predicts against the whole list, as without shear.
+(:func:`budget_delay` with r_i - c_i moving at v_i - u_r). Why no collision is missed:
+let i and j not be in each other's lists; the later of their two builds, at t*, found
+that their centres stay at least R_i + R_j + shell apart while the rows slide by D, that
+is until t* + T; both lists expire by min(t_i, t_j) + T <= t* + T. Until then
+|r_i - r_j| >= |c_i - c_j| - |r_i - c_i| - |r_j - c_j| >= R_i + R_j + shell - shell/2
+- shell/2. Listed pairs are predicted exactly, and every velocity change re-predicts
+against the whole list, as without shear. (A budget shared by both lists, |r_i - c_i| +
+a w_y (t - t_b) / 2 = shell/2, needs no margin, but the particles then spend the budget
+at their peculiar speed plus a w_y / 2: about 1.5 times as many expiries at the steady
+shear rate of packing 0.1.) The search covers 3 columns of i's row and 4 of each adjacent
+row (D <= 2 w_x - cut), times 3 along z, and skips the cells the slid cut-off cannot
+reach. The full build dates the lists back by up to T / 2 (spread over the particles), so
+that they do not all end in one calendar window.
 
 *Cell crossings* (:func:`predict_pair_cells_le`, :func:`cross_le`,
 :func:`slide_scan`). Cells are at least 2 R_max (1 + 1e-6) wide, every particle sits
@@ -94,13 +104,14 @@ from granulargas.engine._geometry import collision_delay, min_image
 #: The sheared geometry and its mutable scalars (``Space.shear``; None without shear):
 #: ``rate`` a > 0, box sides ``lx``, ``ly``, cell sides ``wx``, ``wy`` and counts ``nx``,
 #: ``ny`` (the list-centre grid in the list mode, the crossing grid in the cell mode),
-#: ``speed`` = a L_y (the image velocity), ``kappa`` = a w_y / 2 (eq. 3), ``slide_time``
+#: ``speed`` = a L_y (the image velocity), ``margin`` D and ``lifetime`` D / (a w_y) of the
+#: lists (list mode, eq. 3; 0 and inf otherwise), ``slide_time``
 #: = w_x / (a w_y) (cell mode: time between slides), ``slide`` (1,) i8 the index k of the
 #: last slide (m = k mod n_x), ``built`` (N,) f8 the build time of each particle's list
 #: (list mode; (1,) otherwise), ``thermostat`` (2,) f8: interval and temperature of the
 #: velocity rescaling (interval inf: none), ``rescales`` (1,) i8 the index of the next one.
-ShearGeometry = namedtuple("ShearGeometry", ["rate", "lx", "ly", "wx", "wy", "nx", "ny", "speed", "kappa",
-                                             "slide_time", "slide", "built", "thermostat", "rescales"])
+ShearGeometry = namedtuple("ShearGeometry", ["rate", "lx", "ly", "wx", "wy", "nx", "ny", "speed", "margin",
+                                             "lifetime", "slide_time", "slide", "built", "thermostat", "rescales"])
 
 #: Pressure-tensor accumulators (a (1,) record, ``Engine.stress``; None when not asked for):
 #: ``s`` the kinetic sums sum m c_a c_b now (xx, yy, zz, xy, xz, yz), ``k`` their time
@@ -109,15 +120,32 @@ STRESS = np.dtype([("s", "f8", (6,)), ("k", "f8", (6,)), ("w", "f8", (6,))], ali
 
 XX, YY, ZZ, XY, XZ, YZ = 0, 1, 2, 3, 4, 5
 
+#: The lists' sliding margin D in shells (eq. 3): a wider margin lists more pairs of
+#: adjacent rows, a narrower one ends lists sooner (lifetime D / (a w_y)). In the gas of
+#: ``scripts/benchmarks/shear.py`` (N = 10^4, packing 0.1, this constant set before the
+#: ``Simulation`` is built) 0.5 and 1 cost within 2 % of each other (2.7 and 2.2 list
+#: expiries per collision, lists of 12.8 and 13.9), 1.5 some 5 % more.
+MARGIN = 1.0
+
+
+def list_margin(shell, cut, wx, lx):
+    """The sliding margin D of the lists (eq. 3): :data:`MARGIN` shells, at most what the five
+    columns of an adjacent row reach, 2 w_x - cut (cut = 2 R_max + shell), and L_x / 2 - cut
+    (so that a pair's other x image stays beyond the cut-off)."""
+    return min(MARGIN * shell, (min(2.0 * wx, 0.5 * lx) - cut) * (1.0 - 1e-9))
+
 
 def shear_geometry(rate, box3, ncell, n, thermostat_interval=math.inf, thermostat_temperature=1.0,
-                   slide=0, rescales=0, lists=True):
-    """A :class:`ShearGeometry` with the dtypes the kernels are compiled for."""
+                   slide=0, rescales=0, lists=True, shell=0.0, cut=0.0):
+    """A :class:`ShearGeometry` with the dtypes the kernels are compiled for (``shell``, ``cut``:
+    the list shell and 2 R_max + shell, list mode)."""
     lx, ly = float(box3[0]), float(box3[1])
     nx, ny = int(ncell[0]), int(ncell[1])
     wx, wy = lx / nx, ly / ny
     a = float(rate)
-    return ShearGeometry(a, lx, ly, wx, wy, nx, ny, a * ly, 0.5 * a * wy, wx / (a * wy),
+    margin = list_margin(float(shell), float(cut), wx, lx) if lists else 0.0
+    lifetime = margin / (a * wy) if lists else math.inf
+    return ShearGeometry(a, lx, ly, wx, wy, nx, ny, a * ly, margin, lifetime, wx / (a * wy),
                          np.array([slide], dtype=np.int64),
                          np.zeros(n if lists else 1), np.array([thermostat_interval, thermostat_temperature]),
                          np.array([rescales], dtype=np.int64))
@@ -284,10 +312,11 @@ def predict_expiry_le(i, t, rec, centre, period, half_shell, sh):
     r = row_of(np.float64(centre[i, 1]), sh)
     xc = np.float64(centre[i, 0]) + row_offset(r, t, sh)
     xc = xc - sh.lx if xc >= sh.lx else xc
-    h = half_shell - sh.kappa * (t - sh.built[i])
-    return t + budget_delay(min_image(rec[i, 0] - xc, period[0]), rec[i, 1] - sh.ly - np.float64(centre[i, 1]),
-                            min_image(rec[i, 2] - np.float64(centre[i, 2]), period[2]),
-                            rec[i, 3] - row_speed(r, sh), rec[i, 4], rec[i, 5], h, sh.kappa)
+    s = budget_delay(min_image(rec[i, 0] - xc, period[0]), rec[i, 1] - sh.ly - np.float64(centre[i, 1]),
+                     min_image(rec[i, 2] - np.float64(centre[i, 2]), period[2]),
+                     rec[i, 3] - row_speed(r, sh), rec[i, 4], rec[i, 5], half_shell, 0.0)
+    end = sh.built[i] + sh.lifetime
+    return min(t + s, end if end > t else t)
 
 
 @inlined
@@ -313,6 +342,41 @@ def predict_pair_le(i, t, before, rec, nbl, nbn, period, sh):
 
 
 @inlined
+def slid(dx, o, margin):
+    """The x separation x_i - x_j (frame of j's row) closest to 0 that the pair's centres reach
+    while row r + o slides by up to ``margin`` against row r of i (eq. 3): row r + 1 moves
+    towards +x, so a j above that is ahead of i (dx < 0) only moves away; one behind
+    (dx > 0) comes up to margin nearer. Row r - 1 the mirror image; the own row not at all."""
+    if o == 0:
+        return dx
+    u = dx if o > 0 else -dx
+    return u - min(max(u, 0.0), margin)
+
+
+@inlined
+def _columns(c0, o, nx):
+    """First column (unwrapped) and number of the columns around column c0 (of the query
+    point) that a list search scans: 3 in its own row (o = 0); in row r + o the 4 that reach
+    from cut behind to cut + D ahead of the sliding (margin D <= 2 w_x - cut), or all of a
+    row of 3 columns (no cell twice)."""
+    if o == 0:
+        return c0 - 1, 3
+    if nx < 4:
+        return 0, nx
+    return (c0 - 2 if o > 0 else c0 - 1), 4
+
+
+@inlined
+def _gap(x, lo, w):
+    """Distance from x to the interval [lo, lo + w) (0 inside)."""
+    if x < lo:
+        return lo - x
+    if x > lo + w:
+        return x - lo - w
+    return 0.0
+
+
+@inlined
 def _centre_cell(centre, i, sh, ncell, box):
     """Flat cell of the stored centre of i: (x in its row's frame, row, z)."""
     cz = int(np.float64(centre[i, 2]) * (ncell[2] / box[2]))
@@ -323,11 +387,11 @@ def _centre_cell(centre, i, sh, ncell, box):
 
 @kernel(python=False)
 def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space, sh):
-    """Particles j != i whose centre (at t, through the sheared images) is within
-    R_i + R_j + shell of the query point (laboratory (xq, yq, zq) at t, in row r), into
-    ``lists.scratch``: the 3 x 3 x 3 cells around it in the frames of rows r - 1, r, r + 1
-    (none beyond a wall on z). Returns the number, or -1 if more than m or the scratch
-    is short."""
+    """Particles j != i whose centre (at t, through the sheared images) comes within
+    R_i + R_j + shell of the query point (laboratory (xq, yq, zq) at t, in row r) while the
+    rows slide by the margin D (:func:`slid`, eq. 3), into ``lists.scratch``: 3 columns of
+    its own row and 5 of rows r - 1 and r + 1 (in their frames), times 3 along z (none
+    beyond a wall on z). Returns the number, or -1 if more than m or the scratch is short."""
     scratch = lists.scratch
     centre = lists.centre
     cell_ids = cells.ids
@@ -341,27 +405,43 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
     cz = int(zq * (ncell[2] / box[2]))
     cz = min(max(cz, 0), ncell[2] - 1)
     zr = 1 if ncell[2] >= 3 else 0
+    # cells the cut-off (slid by the margin along x) cannot reach are skipped, as in
+    # granulargas.engine._cells._reach, with its round-off margin
+    wz = box[2] / ncell[2]
+    lim = cut_max * (1.0 + 1e-9) + 1e-12 * (sh.lx + sh.ly + box[2])
+    lim2 = lim * lim
     count = 0
     for o in range(-1, 2):
         rho = r + o
         g = _wrap(rho, sh.ny)
         ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
+        gy = _gap(ys, g * sh.wy, sh.wy)
         xi = _reduce(xq - row_offset(rho, t, sh), sh.lx)
         c0 = col_of(xi, sh)
+        x0, ncol = _columns(c0, o, sh.nx)
         for oz in range(-zr, zr + 1):
             kz = cz + oz
+            gz = _gap(zq, kz * wz, wz) if zr > 0 else 0.0
             if kz < 0 or kz >= ncell[2]:
                 if period[2] == math.inf:
                     continue
                 kz = _wrap(kz, ncell[2])
-            for ox in range(-1, 2):
-                c = _wrap(c0 + ox, sh.nx) + ncell[0] * (g + ncell[1] * kz)
+            for ox in range(ncol):
+                gx = 0.0
+                if o == 0 or sh.nx >= 4:  # distinct unwrapped columns: their gaps hold
+                    k = x0 + ox
+                    gx = _gap(xi, k * sh.wx, sh.wx)
+                    if (o > 0 and k < c0) or (o < 0 and k > c0):
+                        gx = gx - sh.margin if gx > sh.margin else 0.0
+                if gx * gx + gy * gy + gz * gz >= lim2:
+                    continue
+                c = _wrap(x0 + ox, sh.nx) + ncell[0] * (g + ncell[1] * kz)
                 nq = cell_n[c]
                 if count + nq > cap:
                     return -1
                 for q in range(nq):
                     j = cell_ids[c, q]
-                    dx = min_image(xi - centre[j, 0], sh.lx)
+                    dx = slid(min_image(xi - centre[j, 0], sh.lx), o, sh.margin)
                     dy = ys - centre[j, 1]
                     dz = min_image(zq - centre[j, 2], period[2])
                     scratch[count] = j
@@ -380,7 +460,7 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
                     continue
                 ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
                 xi = _reduce(xq - row_offset(rho, t, sh), sh.lx)
-                dx = min_image(xi - centre[j, 0], sh.lx)
+                dx = slid(min_image(xi - centre[j, 0], sh.lx), o, sh.margin)
                 dy = ys - centre[j, 1]
                 dz = min_image(zq - centre[j, 2], period[2])
                 best = min(best, dx * dx + dy * dy + dz * dz)
@@ -498,7 +578,10 @@ def build_all_lists_le(t, rec, lists, cells, space, shell, sh):
         if cell_n[c] >= cell_ids.shape[1]:
             return CELL_OVERFLOW
         slot_insert(i, c, cell_ids, cell_n)
-        sh.built[i] = t
+        # build times spread over half a lifetime before t (a list may be taken as older
+        # than it is: it ends sooner), so that the lists built together do not all end at
+        # t + lifetime in one calendar window
+        sh.built[i] = t - 0.5 * sh.lifetime * ((i * 0.6180339887498949) % 1.0) if sh.lifetime < math.inf else t
     nbn[:] = 0
     for i in range(n):
         yq = np.float64(centre[i, 1])
@@ -513,19 +596,20 @@ def build_all_lists_le(t, rec, lists, cells, space, shell, sh):
             ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
             xr = _reduce(xq - row_offset(rho, t, sh), sh.lx)
             c0 = col_of(xr, sh)
+            x0, ncol = _columns(c0, o, sh.nx)
             for oz in range(-zr, zr + 1):
                 kz = cz + oz
                 if kz < 0 or kz >= ncell[2]:
                     if period[2] == math.inf:
                         continue
                     kz = _wrap(kz, ncell[2])
-                for ox in range(-1, 2):
-                    c = _wrap(c0 + ox, sh.nx) + ncell[0] * (g + ncell[1] * kz)
+                for ox in range(ncol):
+                    c = _wrap(x0 + ox, sh.nx) + ncell[0] * (g + ncell[1] * kz)
                     for q in range(cell_n[c]):
                         j = cell_ids[c, q]
                         if j <= i:
                             continue
-                        dx = min_image(xr - centre[j, 0], sh.lx)
+                        dx = slid(min_image(xr - centre[j, 0], sh.lx), o, sh.margin)
                         dy = ys - centre[j, 1]
                         dz = min_image(zq - centre[j, 2], period[2])
                         cut = rec[i, 7] + rec[j, 7] + shell

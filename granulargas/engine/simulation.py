@@ -499,7 +499,8 @@ class Simulation:
             sh = _shear.shear_geometry(
                 self.shear.rate, spc.box, spc.ncell, n,
                 math.inf if self.shear.interval is None else self.shear.interval,
-                self.shear.temperature or 1.0, rescales=self._rescale_step, lists=self.neighbours == "lists")
+                self.shear.temperature or 1.0, rescales=self._rescale_step, lists=self.neighbours == "lists",
+                shell=self.shell, cut=2.0 * float(self._radii.max()) + self.shell)
             sh.slide[0] = int(math.floor(self._time / sh.slide_time))
             spc = spc._replace(shear=sh)
             self._space = spc

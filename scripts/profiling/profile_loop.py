@@ -20,6 +20,14 @@ Usage::
     python scripts/profiling/profile_loop.py 1e5 --packing 0.1
     python scripts/profiling/profile_loop.py 1e4 --walls      # walls on the z axis
     python scripts/profiling/profile_loop.py 1e4 --packing 0.05 --neighbours cells
+    python scripts/profiling/profile_loop.py 1e4 --packing 0.1 --shear   # Lees-Edwards vs periodic
+
+``--shear``: the gas of ``scripts/benchmarks/shear.py`` (constant eps = 0.8, the steady
+shear rate of the packing) under Lees-Edwards boundaries, and the same gas in a periodic
+box with the stress sums on, profiled one after the other; the "global events" part is
+the slides of the sliding rows (cell mode). Each table also gives the events per
+collision by kind and the pair predictions per collision (list mode: list entries
+scanned by the predictions).
 """
 
 from __future__ import annotations
@@ -28,40 +36,97 @@ import argparse
 import time
 
 
-def profile(n, packing, walls=False, seed=1, neighbours="lists"):
+def _make(n, packing, walls, seed, neighbours, shear, shell):
     import numpy as np
 
-    from granulargas.engine import CollisionRule, Simulation, _loop, _probe
+    from granulargas.engine import CollisionRule, Simulation
     from granulargas.initial import random_state
 
+    kw = {} if shell is None else {"shell": shell}
+    if shear is not None:
+        from granulargas.engine.shear import Shear
+
+        boundary = ("periodic", "lees-edwards", "periodic")
+        rule = CollisionRule.constant(0.8)
+        if shear > 0:
+            return Simulation(random_state(n, packing, 3, seed=seed, boundary=boundary, shear=shear), rule,
+                              neighbours=neighbours, shear=Shear(shear), **kw)
+        return Simulation(random_state(n, packing, 3, seed=seed), rule, neighbours=neighbours, stress=True, **kw)
     st = random_state(n, packing, 3, seed=seed)
     if walls:  # the same gas between walls at z = 0 and L: the spheres touching them are moved in
         pos = st.positions.copy()
         pos[:, 2] = np.clip(pos[:, 2], st.radii, st.box[2] - st.radii)
         st = st.replace(positions=pos, boundary=("periodic", "periodic", "wall"))
-    sim = Simulation(st, CollisionRule.elastic(), neighbours=neighbours)
+    return Simulation(st, CollisionRule.elastic(), neighbours=neighbours, **kw)
+
+
+def profile(n, packing, walls=False, seed=1, neighbours="lists", shear=None, shell=None):
+    """Profile one gas; ``shear``: None (elastic, the default gas), a rate > 0 (sheared) or 0
+    (the sheared benchmark's gas in a periodic box)."""
+    import numpy as np
+
+    from granulargas.engine import _loop, _probe
+    from granulargas.engine._calendar import cal_width
+    from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW
+
+    sim = _make(n, packing, walls, seed, neighbours, shear, shell)
     sim.run(np.inf, max_collisions=2 * n)
     prm = sim._params()
     probe = np.zeros(_probe.PROBE_SIZE, np.int64)
+    sheared = sim.shear is not None
 
     def go(ncoll):
+        # chunks of N collisions, between which the calendar's window is matched to the
+        # event rate as Simulation.run does (a cooling gas slows down); a full list or
+        # cell table is widened as there
         c0 = sim.collisions
         w = time.perf_counter()
-        e = sim._engine
-        status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, np.inf, 10**12, c0 + ncoll, probe)
-        assert status == _loop.MAX_COLLISIONS, status
+        while sim.collisions < c0 + ncoll:
+            cal = sim._engine.calendar
+            if not 0.5 <= cal_width(sim.time, cal.qt) / float(cal.state[0]["width"]) <= 2.0:
+                sim._place_events(sim.time)
+            e = sim._engine
+            target = min(c0 + ncoll, sim.collisions + n)
+            if sheared:
+                status = _loop.advance_sheared(e, *_loop.mode_flags(e.cells), prm, np.inf, 10**12, target, probe,
+                                               prm.space.shear, e.stress)
+            else:
+                status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, np.inf, 10**12, target, probe, None,
+                                       e.stress)
+            if status == OVERFLOW:
+                sim._grow_lists()
+            elif status == CELL_OVERFLOW:
+                sim._grow_cells()
+            else:
+                assert status == _loop.MAX_COLLISIONS, status
         return time.perf_counter() - w, sim.collisions - c0
 
     t = time.perf_counter()
     go(1000)
     compile_s = time.perf_counter() - t
     probe[:] = 0
+    fields = ("events", "expiries", "crossings", "stale")
+    c = sim._engine.counters[0]
+    before = {k: int(c[k]) for k in fields}
+    slides = int(prm.space.shear.slide[0]) if sheared and sim.neighbours == "cells" else 0
     dt, nc = go(max(300_000, n))
+    counts = {k: (int(c[k]) - before[k]) / nc for k in fields}
+    if sheared and sim.neighbours == "cells":
+        slides = int(prm.space.shear.slide[0]) - slides
     parts = _probe.PARTS
     total = probe[:parts].sum()
-    print(f"N = {n}, packing {packing}{', walls on z' if walls else ''}, {sim.neighbours}: {nc / dt / 1e6:.3f} M "
+    kind = "" if shear is None else (f", eps 0.8, sheared at a = {shear:.4g}" if sheared else
+                                     ", eps 0.8, periodic (stress sums on)")
+    print(f"N = {n}, packing {packing}{', walls on z' if walls else ''}{kind}, {sim.neighbours} "
+          f"(shell {sim.shell:.3f}): {nc / dt / 1e6:.3f} M "
           f"collisions/s instrumented, {total / nc:.0f} cycles per collision ({dt / nc * 1e9:.0f} ns); "
           f"compile or cache load {compile_s:.1f} s")
+    line = "  per collision: " + ", ".join(f"{k} {v:.3f}" for k, v in counts.items())
+    if sim.neighbours == "lists":
+        line += f"; mean list length {sim._engine.lists.nbn.mean():.2f}"
+    if sheared and sim.neighbours == "cells":
+        line += f"; slides {slides} ({slides * n / nc:.3f} particle scans per collision)"
+    print(line)
     for k, name in enumerate(_probe.PART_NAMES):
         calls = probe[parts + k]
         if calls == 0:
@@ -79,11 +144,25 @@ def main(argv=None):
     p.add_argument("--walls", action="store_true", help="flat walls at z = 0 and L")
     p.add_argument("--neighbours", choices=["lists", "cells"], default="lists",
                    help="neighbour search (cells: the 'list rebuild' part is the cell crossing)")
+    p.add_argument("--shear", action="store_true",
+                   help="the sheared gas of scripts/benchmarks/shear.py and the same gas periodic")
+    p.add_argument("--shell", type=float, default=None, help="list shell in diameters (default: the engine's)")
     args = p.parse_args(argv)
     if any(n < 100 for n in args.sizes) or not 0.0 < args.packing <= 0.5:
         p.error("sizes must be >= 100 and 0 < --packing <= 0.5")
+    if args.shear and args.walls:
+        p.error("--shear and --walls exclude each other")
     for n in args.sizes:
-        profile(int(n), args.packing, args.walls, neighbours=args.neighbours)
+        if args.shear:
+            from granulargas import theory
+
+            dens = float(theory.number_density(args.packing, 3))
+            rate = theory.shear.grad_usf(0.8, 3, args.packing).a_star * float(
+                theory.shear.reference_frequency(dens, 1.0, 3))
+            for a in (0.0, rate):
+                profile(int(n), args.packing, neighbours=args.neighbours, shear=a, shell=args.shell)
+        else:
+            profile(int(n), args.packing, args.walls, neighbours=args.neighbours, shell=args.shell)
 
 
 if __name__ == "__main__":
