@@ -11,9 +11,11 @@ prints the command that continues it (exit 130 / 143).
 from __future__ import annotations
 
 import shlex
+import warnings
 
 from granulargas.cli._args import add_override_argument, overrides_from
 from granulargas.io.config import load_config
+from granulargas.run import predictions
 from granulargas.run.advise import method_line, summary_line
 from granulargas.run.runner import RunInterrupted, run_config, stop_on_signals
 from granulargas.run.validity import raise_if_invalid
@@ -53,12 +55,35 @@ def run(args) -> int:
         overrides["output.file"] = args.restart
     with stop_on_signals() as stop:  # before this returns a signal stops at once (nothing to keep)
         config = load_config(args.config, overrides)
-        validity = raise_if_invalid(config)  # refuses runs that would leave float64; predicts T range, t_c/t_free
+        kept = predictions.load(config)  # this config's checks passed before: its lines, no theory solved
+        warned = []
+        try:
+            with warnings.catch_warnings(record=True) as warned:
+                # refuses runs that would leave float64; predicts T range, t_c/t_free
+                validity = kept.validity if kept else tuple(raise_if_invalid(config).lines())
+        finally:
+            _show(warned)
         try:
             summary = run_config(config, overwrite=args.overwrite, quiet=args.quiet, append=args.append, stop=stop)
         except RunInterrupted as exc:
             raise RunInterrupted(f"{exc}; continue with: {continue_command(args, exc.output)}", signum=exc.signum,
                                  time=exc.time, collisions=exc.collisions, output=exc.output) from None
-    advice = [line for line in (summary_line(config), method_line(config)) if line]
-    print("\n".join(summary.lines() + validity.lines() + advice))
+    if kept:
+        advice = kept.advice
+    else:
+        warned_advice = []
+        try:
+            with warnings.catch_warnings(record=True) as warned_advice:
+                advice = tuple(line for line in (summary_line(config), method_line(config)) if line)
+        finally:
+            _show(warned_advice)
+        if not warned and not warned_advice:
+            predictions.store(config, predictions.Predictions(validity, advice))
+    print("\n".join(summary.lines() + list(validity) + list(advice)))
     return 0
+
+
+def _show(caught) -> None:
+    """Show warnings recorded while the predictions were solved, as they would have been shown."""
+    for w in caught:
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)

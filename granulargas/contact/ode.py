@@ -37,8 +37,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from granulargas.contact import _taylor, _taylor_np
 
@@ -155,6 +153,9 @@ def solve_contact_scipy(beta: float, end: str = "overlap", method: str = "DOP853
     -------
     (eps, tau_c) : tuple of float
     """
+    from scipy.integrate import solve_ivp  # here, not at the top: a run's start-up loads no scipy
+    from scipy.optimize import brentq
+
     beta = float(beta)
     end_code(end)
 
@@ -198,6 +199,8 @@ def trajectory(beta: float, end: str = "overlap", n: int = 400, rtol: float = 1e
     t, x, v : ndarray (n,)
         Dimensionless time, compression and compression rate from impact to the end.
     """
+    from scipy.integrate import solve_ivp
+
     s_end = solve_many(beta, end)[0, 4]
     s = np.linspace(0.0, s_end, n)
     sol = solve_ivp(_rhs, (0.0, s_end), [0.0, 1.0, 0.0], method="DOP853", rtol=rtol, atol=1e-14,

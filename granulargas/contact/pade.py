@@ -20,9 +20,11 @@ import math
 import warnings
 
 import numpy as np
-from scipy.special import gamma
 
-C1 = gamma(0.6) * math.sqrt(math.pi) / (2 ** 0.2 * 5 ** 0.4 * gamma(2.1))
+#: ``Gamma(3/5) sqrt(pi) / (2^(1/5) 5^(2/5) Gamma(21/10))``, the leading coefficient of
+#: ``1 - eps = C1 beta + ...``, as scipy.special.gamma evaluates it (written out so that loading
+#: the contact module loads no scipy; tests/contact/test_contact_pade_api.py recomputes it)
+C1 = np.float64(1.1534488580952884)
 C2 = 0.6 * C1 ** 2
 A_PADE = 2.0 / (3.0 * C1 ** 2)
 

@@ -36,7 +36,6 @@ import math
 import warnings
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from granulargas.contact import _series_kernel
 from granulargas.contact.ode import end_code, solve_many
@@ -190,6 +189,8 @@ def radius_of_convergence(end: str = "overlap") -> float:
     """
     end_code(end)
     if end == "overlap":
+        from scipy.optimize import minimize_scalar  # here, not at the top: a run's start-up loads no scipy
+
         res = minimize_scalar(lambda b: -b * solve_many(b, "overlap")[0, 0] ** 0.2, bounds=(1.0, 20.0),
                               method="bounded", options={"xatol": 1e-10})
         return float(-res.fun)

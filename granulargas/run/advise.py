@@ -82,7 +82,6 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from granulargas import theory
 from granulargas.contact.material import damping_from_prefactor
@@ -517,6 +516,8 @@ def constant_error(gas: V.Gas, eps: float, curve: V.CoolingCurve, t_end: float) 
 
 def best_constant(gas: V.Gas, curve: V.CoolingCurve, t_end: float):
     """(eps, error): the constant eps minimising :func:`constant_error`."""
+    from scipy.optimize import minimize_scalar  # here, not at the top: a run's start-up loads no scipy
+
     # search in q = 1 - eps^2 on a log grid, then refine
     q_ref = float(V.effective_inelasticity(gas, gas.temperature))
     qs = q_ref * np.geomspace(0.05, 1.5, 80)
@@ -533,6 +534,8 @@ def best_constant(gas: V.Gas, curve: V.CoolingCurve, t_end: float):
 def _equivalent_prefactor(gas: V.Gas, eps: float) -> float | None:
     """Prefactor k whose viscoelastic gas has (1 - eps^2)_eff(T0) = 1 - eps^2; None if no beta
     at the thermal impact speed up to 20 gives it (eps below what the table's range reaches)."""
+    from scipy.optimize import brentq
+
     target = 1.0 - eps**2
 
     def f(log_k):

@@ -50,7 +50,6 @@ import functools
 import math
 
 import numpy as np
-from scipy.interpolate import pade
 
 __all__ = [
     "particle_volume",
@@ -129,9 +128,23 @@ EOS_NAMES = {
 }
 
 
+#: the [6/3] Padé approximant of Z as scipy.interpolate.pade gives it from DISK_VIRIAL_RATIOS
+#: (numerator, denominator; highest power of x = 2 eta first), written out so that a 2D run
+#: loads no scipy; tests/theory/test_enskog.py recomputes it
+_DISK_PADE_3 = (
+    [-0.00011461979991070921, -0.000570451077751047, -0.0013932532833688166, 0.0007391426813274623,
+     0.039852898891187705, -0.09379595010037933, 1.0],
+    [-0.027783788275844733, 0.3516444110800258, -1.0937959501003793, 1.0],
+)
+
+
 @functools.lru_cache(maxsize=None)
 def _disk_pade(denominator_degree: int = 3):
     """Numerator and denominator (numpy poly1d in x = 2 eta) of the Padé approximant of Z."""
+    if denominator_degree == 3:
+        return tuple(np.poly1d(c) for c in _DISK_PADE_3)
+    from scipy.interpolate import pade  # here, not at the top: a run's start-up loads no scipy
+
     coeffs = [1.0, *DISK_VIRIAL_RATIOS]  # Z = 1 + sum_k (B_k / B_2^(k-1)) x^(k-1)
     return pade(coeffs, denominator_degree)
 

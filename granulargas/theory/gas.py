@@ -109,7 +109,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.polynomial.legendre import leggauss
-from scipy.integrate import solve_ivp
 
 from granulargas.contact import restitution_table
 from granulargas.contact.material import pair_constant
@@ -544,6 +543,8 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
             # t = t_free e^200: the event comes first for any cooling gas, unless t_free is so
             # long (a very dilute gas) that the time would leave float64's range first
             x_end = min(200.0, math.log(np.finfo(np.float64).max) - math.log(t_free) - 1.0)
+    from scipy.integrate import solve_ivp  # here, not at the top: a run's start-up loads no scipy
+
     sol = solve_ivp(rhs, (0.0, x_end), y0, method="LSODA", rtol=rtol, atol=atol, dense_output=True, events=events)
     if sol.status < 0:
         raise RuntimeError(f"cooling_curve: the ODE solver failed ({sol.message})")

@@ -84,8 +84,6 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq, least_squares
 
 from granulargas.theory.enskog import _check_dim, particle_volume
 
@@ -225,6 +223,8 @@ def mixture_cooling_rates(temperatures, masses, diameters, densities, restitutio
 
 def _solve_ratios(residual: Callable[[np.ndarray], np.ndarray], size: int) -> np.ndarray:
     """Solve residual(g) = 0 for the S - 1 log-ratios g_i = ln(T_i / T_1), i >= 1."""
+    from scipy.optimize import brentq, least_squares  # here, not at the top: a run's start-up loads no scipy
+
     if size == 1:
         return np.zeros(0)
     if size == 2:
@@ -309,6 +309,8 @@ def temperature_history(times, initial, masses, diameters, densities, restitutio
     keeps the step count small over many decades of cooling (scipy ``solve_ivp``, LSODA,
     relative tolerance 1e-10).
     """
+    from scipy.integrate import solve_ivp
+
     t = np.asarray(times, dtype=float)
     t0 = np.atleast_1d(np.asarray(initial, dtype=float))
     if t.ndim != 1 or (t.size and (t[0] < 0 or np.any(np.diff(t) < 0))):
@@ -433,6 +435,8 @@ class Mixture:
         """(t_end, T_i at t_end) of a cooling run from every species at ``temperature``: the
         balance dT_i/dt = -zeta_i T_i with the collisions per particle ds/dt = sum_i x_i nu_i,
         up to ``end_time`` or ``collisions_per_particle`` (s = 2 C / N), whichever comes first."""
+        from scipy.integrate import solve_ivp
+
         if end_time is None and collisions_per_particle is None:
             raise ValueError("predicted_end needs end_time or collisions_per_particle")
         size = len(self.names)

@@ -86,9 +86,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
-from scipy.special import erf, erfc, exp1
 
 from granulargas.contact import restitution_table
 from granulargas.theory.gas import Gas, _kernel_nodes, effective_inelasticity
@@ -269,6 +266,8 @@ def _slip_integrals(dim: int, Y):
     ``C0 = int_Y^inf p``, ``A0 = int_0^Y p``, ``B0 = int_Y^inf p / y`` with p the law of y
     (Rayleigh in 3D, two tangential components; half-normal in 2D, one component).
     """
+    from scipy.special import erf, erfc, exp1  # here, not at the top: a run's start-up loads no scipy
+
     Y = np.asarray(Y, dtype=float)
     e = np.exp(-0.5 * Y * Y)
     if dim == 3:
@@ -392,6 +391,8 @@ def _ratio_root(f, lo=1e-8, hi=1e8):
     f is scanned on a log grid (10 points per decade) and the crossing refined by brentq;
     with Walton's model f need not be monotonic (two roots, or none).
     """
+    from scipy.optimize import brentq
+
     s = np.linspace(math.log(lo), math.log(hi), int(round(10 * math.log10(hi / lo))) + 1)
     prev = f(math.exp(s[0]))
     for a, b in zip(s[:-1], s[1:]):
@@ -434,6 +435,8 @@ def driven_state(rough: RoughGas, table=None):
     ``R = -dT/dt`` of the collisions), the total power then T_tr. Needs ``heating_rate > 0``
     and a coupling of the spins (b_0 > 0) unless lambda = 0, where a smooth gas keeps its T_rot.
     """
+    from scipy.optimize import brentq
+
     H, lam = rough.heating_rate, rough.rotational_fraction
     if not H > 0.0:
         raise ValueError("driven_state needs heating_rate > 0")
@@ -523,6 +526,8 @@ def two_temperature_curve(rough: RoughGas, t_end: float, points: int = 400,
     Viscoelastic eps(g): the exact law through the restitution table, as
     :func:`granulargas.theory.gas.cooling_curve`.
     """
+    from scipy.integrate import solve_ivp
+
     T0 = rough.translational_temperature
     R0 = rough.initial_rotational_temperature
     t_free = 1.0 / _collision_frequency(rough, T0)
@@ -563,6 +568,8 @@ def two_temperature_curve(rough: RoughGas, t_end: float, points: int = 400,
 def mpemba_crossing_time(first: TwoTemperatureCurve, second: TwoTemperatureCurve) -> float | None:
     """Earliest time at which the translational temperatures of two curves cross (None: never
     within both curves). The curves must share their time scale (the same gas)."""
+    from scipy.optimize import brentq
+
     t = np.union1d(first.time, second.time)
     t = t[t <= min(first.time[-1], second.time[-1])]
     diff = np.log(first.translational_at(t)) - np.log(second.translational_at(t))

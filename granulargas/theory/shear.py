@@ -92,9 +92,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import optimize
-from scipy.integrate import solve_ivp
-from scipy.special import erfc
 
 from granulargas.theory.enskog import _check_dim, collision_frequency, contact_value, number_density, sonine_a2
 
@@ -183,6 +180,8 @@ def _directions(dim):
 
 def _shifted_moments(x, rmax):
     """K_r(x) = int_0^inf t^r phi(t + x) dt for r = 0..rmax, eq. (S4); x an array."""
+    from scipy.special import erfc  # here, not at the top: a run's start-up loads no scipy
+
     out = np.empty((rmax + 1,) + np.shape(x))
     out[0] = 0.5 * erfc(x / math.sqrt(2.0))
     if rmax >= 1:
@@ -276,6 +275,8 @@ def grad_usf(eps, dimension=3, packing=0.0, chi=None, a_star=None, form="accurat
     -------
     ShearState
     """
+    from scipy import optimize
+
     _check_dim(dimension)
     dim = dimension
     alpha = float(eps)
@@ -376,6 +377,8 @@ def steady_temperature(rate, eps, n, dimension=3, sigma=1.0, m=1.0, packing=0.0,
     :func:`grad_usf`): a = a*(alpha) nu0(n, T), so T = m (a / (a* nu0(n, T = m)))^2 for a
     constant alpha. ``eps`` may be a callable eps(T) (the effective restitution of a
     viscoelastic gas at T): then T solves a*(eps(T)) nu0(n, T) = a (bisection in ln T)."""
+    from scipy import optimize
+
     nu1 = float(reference_frequency(n, m, dimension, sigma, m))  # nu0 at T = m: sqrt(T/m) = 1
     if not callable(eps):
         a_star = grad_usf(eps, dimension, packing, chi).a_star
@@ -405,6 +408,8 @@ def grad_transient(rate, eps, n, T0, dimension=3, sigma=1.0, m=1.0, chi=1.0, t_e
     |ln(T / T_s)| first falls below ln(1 + tolerance) (T_s of :func:`steady_temperature`
     with the same rates); inf if not by ``t_end``.
     """
+    from scipy.integrate import solve_ivp
+
     d = dimension
     eps_of = eps if callable(eps) else (lambda T: eps)
     T_s = steady_temperature(rate, eps_of if callable(eps) else eps, n, d, sigma, m, 0.0, 1.0) / chi**2

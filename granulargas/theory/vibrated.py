@@ -59,8 +59,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import quad, solve_ivp, trapezoid
-from scipy.optimize import brentq
 
 from granulargas.theory.enskog import compressibility_factor, enskog_cooling_rate, particle_volume
 
@@ -120,6 +118,9 @@ def hydrostatic_density(z, column, temperature, gravity, mass=1.0, diameter=1.0,
     array
         n(z), zero outside [bottom, top].
     """
+    from scipy.integrate import solve_ivp, trapezoid  # here, not at the top: a run's start-up loads no scipy
+    from scipy.optimize import brentq
+
     bottom = 0.5 * diameter if bottom is None else bottom
     v = particle_volume(diameter, dim)
     ell = temperature / (mass * gravity)
@@ -180,6 +181,8 @@ def bounce_map(time: float, velocity: float, amplitude: float, omega: float, gra
     ``periods`` periods) and refined by ``brentq``; the impact law with the plate velocity
     there gives the new velocity. Returns (nan, nan) if no root is found.
     """
+    from scipy.optimize import brentq
+
     z0 = amplitude * math.sin(omega * time + phase)
 
     def gap(s):
@@ -235,6 +238,8 @@ def bed_loss(column: float, restitution: float, temperature: float, gravity: flo
     """Collisional loss per unit floor area of a dilute barometric column at T (module doc):
     the integral of zeta (d/2) n T over the height, zeta the dilute Maxwellian Enskog
     cooling rate (proportional to n), by quadrature of the barometric profile."""
+    from scipy.integrate import quad
+
     ell = temperature / (mass * gravity)
 
     def loss(z):

@@ -18,7 +18,6 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from scipy.special import gamma as _gamma
 
 from granulargas.contact.material import pair_constant
 from granulargas.contact.pade import C1, C2
@@ -72,6 +71,8 @@ def effective_inelasticity(b, T, m=1.0, order=1):
     is averaged the same way (``p = 17/5``), adding
     ``-(C1^2 + 2 C2) b^2 Gamma(11/5) (4 T / m)^(1/5)``.
     """
+    from scipy.special import gamma as _gamma  # here, not at the top: a run's start-up loads no scipy
+
     x = 4.0 * np.asarray(T, dtype=float) / m
     out = 2.0 * C1 * b * _gamma(2.1) * x**0.1
     if order == 2:

@@ -196,6 +196,37 @@ def block_scene_costs(data):
     return t.markdown()
 
 
+def block_rough(data):
+    t = Table(["d", "N", "packing", "neighbours", "constant β_t = +1 / smooth", "Coulomb / smooth",
+               "state B / particle, smooth → rough", "rounds"], ["--:", "--:", "--:", "---", "--:", "--:", "--:", "--:"])
+    for r in sorted(by_table(data, "rough"), key=lambda r: (r["n"], r["packing"], r["neighbours"])):
+        t.add([str(r["dim"]), power(r["n"]), fmt(r["packing"]), r["neighbours"], f"**×{r['ratio']:.2f}**",
+               f"×{r['ratio_coulomb']:.2f}", f"{fmt(r['bytes_per_particle_smooth'])} → {fmt(r['bytes_per_particle'])}",
+               str(r["rounds"])], r)
+    return t.markdown()
+
+
+def block_shear_edmd(data):
+    t = Table(["d", "N", "packing", "ε", "neighbours", "CPU per collision, sheared / periodic", "rounds"],
+              ["--:", "--:", "--:", "--:", "---", "--:", "--:"])
+    recs = [r for r in by_table(data, "uniform_shear") if r["method"] == "edmd"]
+    for r in sorted(recs, key=lambda r: (r["n"], r["neighbours"])):
+        spread = f" ({fmt(r['ratio_range'])})" if r.get("ratio_range") else ""
+        t.add([str(r["dim"]), power(r["n"]), fmt(r["packing"]), fmt(r["restitution"]), r["neighbours"],
+               f"**×{r['ratio']:.2f}**{spread}", str(r["rounds"])], r)
+    return t.markdown()
+
+
+def block_shear_dsmc(data):
+    t = Table(["d", "N", "packing", "ε", "M collisions/s (CPU)", "runs"], ["--:", "--:", "--:", "--:", "--:", "--:"])
+    recs = [r for r in by_table(data, "uniform_shear") if r["method"] == "dsmc"]
+    for r in sorted(recs, key=lambda r: r["n"]):
+        spread = f" ({fmt(r['rate_range'])})" if r.get("rate_range") else ""
+        t.add([str(r["dim"]), power(r["n"]), fmt(r["packing"]), fmt(r["restitution"]), f"**{fmt(r['rate_cpu'])}**{spread}",
+               str(r["rounds"])], r)
+    return t.markdown()
+
+
 def block_dsmc(data):
     t = Table(["d", "N", "DSMC, M collisions/s (CPU)", "acceptance", "engine at packing 0.02", "engine at 0.3",
                "DSMC / engine at 0.02", "at 0.3"], ["--:", "--:", "--:", "--:", "--:", "--:", "--:", "--:"])

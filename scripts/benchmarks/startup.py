@@ -12,10 +12,13 @@ changes far less than the wall clock, with the run's own start-up and compile fi
   further kind (2D, driven, walls, DSMC, constant eps, dense 3D with neighbour lists),
   each from its own copy: what the first run of that kind adds;
 * ``warm``: a small 2D run (400 disks, 5 collisions per particle) with everything
-  cached, the per-run overhead of a sweep of small runs made as separate commands;
+  cached (compiled code, tables, the run's predictions, :mod:`granulargas.run.predictions`),
+  the per-run overhead of a sweep of small runs made as separate commands;
 * ``engine`` (not in the default set): the first compile of the event loop alone per
   neighbour mode (``--modes``), a 64-sphere run timed after the import and the initial
   state, for source trees side by side (``--trees``, alternated rounds).
+
+Python's bytecode cache is on in every process (``_bytecode_cache``), as on an install.
 
 Prints every round and the medians, with the load average at the start.
 
@@ -88,6 +91,7 @@ def run_cli(args, numba_cache, table_cache, tree=ROOT, core=None):
     env = dict(os.environ, PYTHONPATH=os.path.abspath(tree), NUMBA_CACHE_DIR=numba_cache,
                GRANULARGAS_CACHE_DIR=table_cache)
     env.pop("GRANULARGAS_NO_CACHE", None)
+    _bytecode_cache(env)
     wall = time.perf_counter()
     with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
         proc = subprocess.Popen(cmd, env=env, cwd=tree, stdout=out, stderr=err, text=True)
@@ -104,6 +108,14 @@ def run_cli(args, numba_cache, table_cache, tree=ROOT, core=None):
     return usage.ru_utime + usage.ru_stime, wall, startup, compiled
 
 
+def _bytecode_cache(env):
+    """Python's bytecode cache on (``__pycache__`` beside the sources, git ignores it), as on an
+    installed package, whose ``.pyc`` files pip writes. An environment may turn it off
+    (PYTHONDONTWRITEBYTECODE); each process then compiles every module of the package again,
+    ~0.15 s of CPU of a warm run."""
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+
+
 def engine_compile(tree, mode, cache, core=None):
     """(CPU s, wall s) of one fresh process's first engine run against ``tree`` with numba cache ``cache``."""
     cmd = [sys.executable, "-c", _CHILD, mode]
@@ -111,6 +123,7 @@ def engine_compile(tree, mode, cache, core=None):
         cmd = ["taskset", "-c", str(core)] + cmd
     env = dict(os.environ, PYTHONPATH=os.path.abspath(tree), NUMBA_CACHE_DIR=cache)
     env.pop("GRANULARGAS_NO_CACHE", None)
+    _bytecode_cache(env)
     out = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True)
     if out.returncode != 0:
         raise SystemExit(f"{tree}: run failed:\n{out.stderr[-2000:]}")
@@ -224,9 +237,14 @@ def record(args, rows, first, cached, argv, load, commit):
     records = []
     for name, rs in rows.items():
         key, what = PAGE_ROWS[name]
+        cpu = [x[0] for x in rs]
+        digits = 2 if max(cpu) < 5.0 else 1
+        # no compile column: a run's summary gives its compile time on the wall clock, which a
+        # loaded machine stretches beyond the process's CPU time
         records.append(dict(table="startup", id=f"{key} {what}", what=what,
-                            cpu_seconds=round(statistics.median(x[0] for x in rs), 1),
-                            compile_seconds=round(statistics.median(x[3] for x in rs), 1), rounds=len(rs)))
+                            cpu_seconds=round(statistics.median(cpu), digits),
+                            cpu_range=[round(min(cpu), digits), round(max(cpu), digits)],
+                            compile_seconds=None, rounds=len(rs)))
     for (tree, mode), f in first.items():
         records.append(dict(table="compile", id=f"3D {mode}", neighbours=mode,
                             first_seconds=round(statistics.median(x[0] for x in f), 1),

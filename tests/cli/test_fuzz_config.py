@@ -29,6 +29,7 @@ from hypothesis import strategies as st
 from tests.cli.fuzzing import (
     BASES,
     EXTREMES,
+    GENERAL_BASES,
     SHEAR_BASES,
     MutatedConfig,
     Mutation,
@@ -174,7 +175,7 @@ def _property_run(mc):
 @example(case("constant-3d", ("system.packing_fraction", 1e-300)))
 @example(case("constant-3d", ("run.end_time", 2**63 - 1)))
 @example(case("constant-3d", ("output.snapshots", 2**63 - 1)))
-def test_run_any_config(mc):
+def test_run_any_config(kernels_compiled, mc):
     _property_run(mc)
 
 
@@ -186,21 +187,34 @@ def test_run_any_config_long(mc):
     _property_run(mc)
 
 
-@pytest.fixture(scope="module")
-def sheared_kernels_compiled():
-    """The sheared engine and DSMC compiled (or loaded) before the bounded examples: a first
-    compile of them can take longer than :data:`BOUND` on a loaded machine, and the bound's
-    SIGINT would then land inside numba's compiler."""
-    variants = [("shear-3d", []), ("shear-3d", ["run.neighbours=\"lists\""]),
-                ("shear-3d", ["run.neighbours=\"cells\""]), ("shear-3d", ["system.dimension=2"]),
-                ("shear-3d", ["system.dimension=2", "run.neighbours=\"lists\""]), ("shear-thermostat-2d", []),
-                ("shear-thermostat-2d", ["system.dimension=3"])]
+def _compile_variants(variants):
+    """Run each (base, --set overrides) once without a bound: its kernels compiled (or loaded)
+    before the bounded examples. A first compile can take longer than :data:`BOUND` on a loaded
+    machine, and the bound's SIGINT would then land inside numba's compiler."""
     for base, sets in variants:
         with tempfile.TemporaryDirectory() as tmp:
             d = Path(tmp)
             (d / "c.toml").write_text(to_toml(BASES[base]))
             argv = ["run", "c.toml", "--quiet"] + [a for o in sets for a in ("--set", o)]
             invoke(argv, d, bound=3600.0)
+
+
+@pytest.fixture(scope="module")
+def kernels_compiled():
+    """The kernels of every general base (:func:`_compile_variants`), and both neighbour modes
+    and dimensions of the vibrated one (the wall-kind variants)."""
+    flips = [("vibrated-2d", ['run.neighbours="lists"']), ("vibrated-2d", ['run.neighbours="cells"'])]
+    _compile_variants([(base, []) for base in GENERAL_BASES] + flips)
+
+
+@pytest.fixture(scope="module")
+def sheared_kernels_compiled():
+    """The sheared engine and DSMC compiled (or loaded) before the bounded examples
+    (:func:`_compile_variants`)."""
+    _compile_variants([("shear-3d", []), ("shear-3d", ["run.neighbours=\"lists\""]),
+                       ("shear-3d", ["run.neighbours=\"cells\""]), ("shear-3d", ["system.dimension=2"]),
+                       ("shear-3d", ["system.dimension=2", "run.neighbours=\"lists\""]),
+                       ("shear-thermostat-2d", []), ("shear-thermostat-2d", ["system.dimension=3"])])
 
 
 @settings(parent=FAST, max_examples=60)

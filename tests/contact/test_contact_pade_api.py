@@ -70,3 +70,16 @@ def test_table_method_refuses_beyond(cache_dir):
         t.restitution(0.6)
     # the API builds a table large enough instead of extrapolating
     assert restitution(0.6, method="table") == pytest.approx(restitution(0.6), abs=1e-8)
+
+
+def test_written_out_c1_is_scipys_gamma_expression():
+    # pade.C1 is a literal (the contact module loads no scipy): it must be the bits of the expression
+    import math
+
+    from scipy.special import gamma
+
+    from granulargas.contact import pade
+
+    expected = gamma(0.6) * math.sqrt(math.pi) / (2 ** 0.2 * 5 ** 0.4 * gamma(2.1))
+    assert type(pade.C1) is type(expected) and pade.C1 == expected
+    assert pade.C2 == 0.6 * expected ** 2

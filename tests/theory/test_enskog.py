@@ -309,3 +309,15 @@ def test_viscoelastic_cooling_is_faster_when_hotter():
     # zeta ~ T^(3/5)
     r = th.viscoelastic_cooling_rate(0.1, n, 2.0) / th.viscoelastic_cooling_rate(0.1, n, 1.0)
     assert r == pytest.approx(2**0.6, rel=1e-12)
+
+
+def test_written_out_disk_pade_is_scipys():
+    # the [6/3] approximant is a literal (a 2D run loads no scipy): the bits scipy's pade gives
+    from scipy.interpolate import pade
+
+    from granulargas.theory.enskog import DISK_VIRIAL_RATIOS, _disk_pade
+
+    p, q = pade([1.0, *DISK_VIRIAL_RATIOS], 3)
+    p3, q3 = _disk_pade(3)
+    assert p3.coeffs.tolist() == p.coeffs.tolist() and q3.coeffs.tolist() == q.coeffs.tolist()
+    assert p3.coeffs.dtype == p.coeffs.dtype
