@@ -17,7 +17,7 @@ from granulargas.cli._args import add_override_argument, overrides_from
 from granulargas.io.config import load_config
 from granulargas.run import predictions
 from granulargas.run.advise import method_line, summary_line
-from granulargas.run.runner import RunInterrupted, run_config, stop_on_signals
+from granulargas.run.runner import Interrupted, RunInterrupted, run_config, stop_on_signals
 from granulargas.run.validity import raise_if_invalid
 
 
@@ -68,6 +68,12 @@ def run(args) -> int:
         except RunInterrupted as exc:
             raise RunInterrupted(f"{exc}; continue with: {continue_command(args, exc.output)}", signum=exc.signum,
                                  time=exc.time, collisions=exc.collisions, output=exc.output) from None
+        except Exception:
+            # a signal before the output file existed raises at once; inside numba's compiler
+            # it surfaces as the compiler's own error: the signal is the cause
+            if stop.signum is not None:
+                raise Interrupted(stop.signum) from None
+            raise
     if kept:
         advice = kept.advice
     else:

@@ -179,6 +179,23 @@ def test_stop_request_before_and_after_arming():
         stop.request(signal.SIGINT)
 
 
+def test_signal_during_the_compile_is_an_interruption(small_3d, write_config, monkeypatch, capsys):
+    """A signal before the output file exists raises at once; inside numba's compiler it
+    surfaces as the compiler's own error. The command line names the signal (exit 130), no
+    traceback."""
+    import granulargas.cli.run as cli_run
+
+    def compiling(config, *, stop, **kwargs):
+        try:
+            stop.request(signal.SIGINT)
+        except Interrupted:
+            raise RuntimeError("no compiled object yet for <Library 'advance'>") from None
+
+    monkeypatch.setattr(cli_run, "run_config", compiling)
+    assert main(["run", str(write_config(small_3d)), "--quiet"]) == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "interrupted: SIGINT"
+
+
 def _long_config(write_config, small_3d, end=100000.0):
     text = small_3d.replace("end_time = 4.0", f"end_time = {end!r}").replace(
         "snapshot_interval = 1.0", "snapshot_interval = 0.5").replace("observables_interval = 0.25",
