@@ -691,14 +691,16 @@ def execute_wall(i, wall, te, p, c, walls, prm, flight, wallkinds, shear, stress
     return DONE
 
 
-@kernel(python=False)
+@inlined
 def execute_wall_kind(i, wall, te, p, c, walls, prm, spec, species):
     """Collision of i (streamed to te) with wall ``wall`` of kind ``spec.kind[a, side]``
     (:mod:`granulargas.engine._walls`): hard (at rest), thermal (outgoing velocity drawn
     from the wall's Maxwellian flux) or vibrating (the rule at the normal speed relative to
     the wall, the wall's velocity at te; a mixture: the law of i's species). The energy a
     thermal or vibrating wall gives the
-    gas is added to ``walls.work``. A re-check event (tag bit ``RECHECK``) changes nothing."""
+    gas is added to ``walls.work``. A re-check event (tag bit ``RECHECK``) changes nothing.
+    Inlined into :func:`execute_wall`: a second call, which passes the particle and parameter
+    records again, cost about as much as the collision itself."""
     if wall & RECHECK:
         walls.rechecks[0] += 1
         return DONE
