@@ -39,7 +39,7 @@ from granulargas import theory
 from granulargas.dsmc import DSMC
 from granulargas.engine import CollisionRule, Simulation
 from granulargas.engine.shear import Shear
-from granulargas.initial import random_state
+from granulargas.initial import maxwell_velocities, random_state
 from granulargas.state import State
 
 QUANTITIES = ("T", "a_star", "eta_star", "Pxx", "Pyy", "Pzz", "mode")
@@ -94,13 +94,6 @@ def combined(runs):
     return out
 
 
-def maxwellian(n, dim, seed):
-    rng = np.random.default_rng(seed)
-    v = rng.normal(size=(n, dim))
-    v -= v.mean(axis=0)
-    return State(None, v, np.full(n, 0.5), np.ones(n), None)  # no positions, no box: the DSMC takes a density
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--packings", type=float, nargs="+", default=[0.05, 0.1, 0.2])
@@ -139,8 +132,10 @@ def main(argv=None):
                                   t_end, 100))
         t1 = time.process_time()
         for seed in range(args.seed, args.seed + args.seeds):
-            ds_runs.append(steady(DSMC(maxwellian(args.n_dsmc, dim, seed), rule, packing_fraction=phi, seed=seed,
-                                       shear=Shear(rate)), rate, dim, n, t_relax, t_end, 100))
+            # no positions, no box: the DSMC takes the density
+            gas = State(None, maxwell_velocities(np.ones(args.n_dsmc), dim, seed=seed), 0.5, 1.0, None)
+            ds_runs.append(steady(DSMC(gas, rule, packing_fraction=phi, seed=seed, shear=Shear(rate)), rate, dim, n,
+                                  t_relax, t_end, 100))
         t2 = time.process_time()
         md, ds = combined(md_runs), combined(ds_runs)
         for name, res in (("engine", md), ("DSMC", ds)):
