@@ -99,6 +99,7 @@ from granulargas._numba import inlined, kernel
 from granulargas.engine._calendar import cal_update
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, slot_insert, slot_remove
 from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, face_gap, grid_insert, grid_remove
+from granulargas.engine._flight import stream
 from granulargas.engine._geometry import collision_delay, min_image
 
 #: The sheared geometry and its mutable scalars (``Space.shear``; None without shear):
@@ -921,17 +922,7 @@ def slide_scan(t, rec, img, count, events, grid, space, cal, sh):
     zr = 1 if space.ncell[2] >= 3 else 0
     period = space.period
     for i in range(rec.shape[0]):
-        dt = t - rec[i, 6]
-        for a in range(3):
-            x = rec[i, a] + rec[i, 3 + a] * dt
-            if x >= period[a]:
-                x -= period[a]
-                img[i, a] += 1
-            elif x < 0.0:
-                x += period[a]
-                img[i, a] -= 1
-            rec[i, a] = x
-        rec[i, 6] = t
+        stream(i, t, rec, img, period, None)  # straight flights: shear has no gravity
         cx = grid.cell[i, 0]
         pt, pn = scan_le(i, t, math.inf, rec, grid, space, sh, cx, 0, cx - 2 - m, 1, cx, 0, -zr, zr)
         if pn < 0:
