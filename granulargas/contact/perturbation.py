@@ -38,7 +38,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 
 def puiseux_x(t, beta, order: int = 3):
@@ -78,6 +77,8 @@ def perturbation_solution(t_end: float = None, t0: float = 1e-3, rtol: float = 1
     scipy OdeSolution-like object (``sol(t)`` -> (6,) or (6, n)) and the turning time t_m
     (x0' = 0), i.e. Theta_c^0 / 2.
     """
+    from scipy.integrate import solve_ivp  # here, not at the top: importing the package loads no scipy
+
     y0 = []
     for m in range(3):
         terms = puiseux_x(t0, 1.0, order=m)

@@ -42,6 +42,9 @@ Usage::
 
     python scripts/benchmarks/gravity.py --n 1e4 1e5 --modes lists cells
     python scripts/benchmarks/gravity.py --scenes wall wallcost --n 1e4 --rounds 10
+
+``--record`` writes each figure into ``docs/performance/results.json`` (table of scene costs)
+and rewrites the performance page.
 """
 
 from __future__ import annotations
@@ -159,7 +162,18 @@ def main(argv=None) -> int:
                     help="the wallcost scene's amplitude A (A omega = 0.3 whatever A): a tiny A leaves the contact "
                          "search a step or two, the rest of what a vibrating wall costs stays")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--record", action="store_true", help="write the ratios into docs/performance/results.json and "
+                    "rewrite the performance page (table of scene costs)")
     args = ap.parse_args(argv)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import results
+
+    load, commit, records = os.getloadavg()[0], results.this_commit(), []
+
+    def add(scene, reference, n, mode, packing, ratio, **extra):
+        records.append(dict(table="scene_cost", id=f"{scene} 3D {mode} packing {packing:g} N={n}", scene=scene,
+                            reference=reference, dim=3, n=n, packing=packing, neighbours=mode,
+                            ratio=round(ratio, 3), rounds=args.rounds, **extra))
     print(f"# load {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}; {args.rounds} rounds "
           f"of {args.chunk} pair collisions; ratio = CPU time per collision of B / of A (median)")
     print(f"{'scene':>8} {'mode':>6} {'N':>7} {'packing':>8} {'A M/s':>8} {'B M/s':>8} {'B/A':>7} {'wall share':>10} "
@@ -176,12 +190,25 @@ def main(argv=None) -> int:
                           f"diameters, A = {args.wall_amplitude:g}, pair collisions {100 * ph:.1f} % / {100 * pv:.1f} % of the collisions; CPU "
                           f"time per wall collision hard {th * 1e6:.3f} us, vibrating {tv * 1e6:.3f} us: vibrating / "
                           f"hard = {r:.3f} (IQR {iqr[0]:.3f}-{iqr[1]:.3f})", flush=True)
+                    amplitude = "," if args.wall_amplitude == 0.05 else f" A = {args.wall_amplitude:g},"
+                    add(f"vibrating floor{amplitude} per wall collision (Knudsen slab {args.knudsen_slab:g} diameters)",
+                        "hard floor", n, mode, args.knudsen_packing, r,
+                        quartiles=[round(float(iqr[0]), 3), round(float(iqr[1]), 3)])
                     continue
                 ratio, ra, rb, share, extra = measure(scene, n, mode, packing, args.rounds, args.chunk, args.fall,
                                                       args.slab, args.seed)
                 print(f"{scene:>8} {mode:>6} {n:>7d} {packing:>8.3g} {ra / 1e6:>8.4f} {rb / 1e6:>8.4f} {ratio:>7.3f} "
                       f"{share:>10.3f} {extra:>16.3g}", flush=True)
+                if scene == "gravity":
+                    add("gravity (elastic gas falling freely)", "the same gas without gravity", n, mode, packing, ratio)
+                else:
+                    add(f"vibrating floor, per collision (slab {args.slab:g} diameters)", "hard floor", n, mode,
+                        packing, ratio)
     print(f"# load {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}")
+    if args.record:
+        words = argv if argv is not None else sys.argv[1:]
+        results.record_and_render(records, " ".join(["python scripts/benchmarks/gravity.py", *words]),
+                                  load_average=max(load, os.getloadavg()[0]), commit=commit)
     return 0
 
 

@@ -86,3 +86,12 @@ def record(new, command, path=RESULTS, load_average=None, commit=None):
     data["records"] = [r for r in data["records"] if (r["table"], r["id"]) not in done] + fresh
     save(data, path)
     return fresh
+
+
+def record_and_render(new, command, load_average=None, commit=None):
+    """:func:`record` the measured records, then rewrite ``docs/performance.md`` from the file."""
+    import performance_page  # scripts/benchmarks: imports this module
+
+    fresh = record(new, command, load_average=load_average, commit=commit)
+    performance_page.main([])
+    return fresh

@@ -12,10 +12,12 @@ state; the figure per case is the median over rounds of the ratio of CPU time pe
 (``engine._state.nbytes``, every array of the compiled state).
 
     taskset -c 1 python scripts/benchmarks/rough.py [--sizes 1e4 1e5] [--packings 0.1 0.3]
-        [--modes lists cells] [--rounds 15] [--chunk 0.5]
+        [--modes lists cells] [--rounds 15] [--chunk 0.5] [--record]
 
 Prints one line per case: the medians (and the 25-75 % range) of the ratios, the smooth
 collision rate, and the engine bytes per particle of the smooth and the rough state.
+``--record`` writes each case into ``docs/performance/results.json`` (table ``rough``) and
+rewrites the performance page.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 import time
 
 import numpy as np
@@ -73,7 +76,13 @@ def main(argv=None):
     p.add_argument("--modes", nargs="+", default=["lists", "cells"])
     p.add_argument("--rounds", type=int, default=15)
     p.add_argument("--chunk", type=float, default=0.5, help="collisions per particle per chunk")
+    p.add_argument("--record", action="store_true", help="write the ratios into docs/performance/results.json and "
+                   "rewrite the performance page (table of rough grains)")
     args = p.parse_args(argv)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import results
+
+    load, commit, records = os.getloadavg()[0], results.this_commit(), []
     print(f"load {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}")
     print(f"{'N':>8} {'packing':>7} {'mode':>6}  {'rough/smooth':>22}  {'coulomb/smooth':>22}  "
           f"{'smooth coll/s':>13}  {'B/particle smooth, rough':>25}")
@@ -84,7 +93,16 @@ def main(argv=None):
                 fmt = lambda x: f"{x[0]:.3f} ({x[1]:.3f}-{x[2]:.3f})"  # noqa: E731
                 print(f"{int(n):8d} {packing:7.3g} {mode:>6}  {fmt(r['rough']):>22}  {fmt(r['coulomb']):>22}  "
                       f"{r['rate_smooth']:13.3g}  {r['bytes_smooth']:11.1f}, {r['bytes_rough']:11.1f}", flush=True)
+                records.append(dict(table="rough", id=f"3D {mode} packing {packing:g} N={int(n)}", dim=3, n=int(n),
+                                    packing=packing, neighbours=mode, ratio=round(r["rough"][0], 3),
+                                    ratio_coulomb=round(r["coulomb"][0], 3),
+                                    bytes_per_particle=round(r["bytes_rough"]),
+                                    bytes_per_particle_smooth=round(r["bytes_smooth"]), rounds=args.rounds))
     print(f"load {os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}")
+    if args.record:
+        words = argv if argv is not None else sys.argv[1:]
+        results.record_and_render(records, " ".join(["python scripts/benchmarks/rough.py", *words]),
+                                  load_average=max(load, os.getloadavg()[0]), commit=commit)
 
 
 if __name__ == "__main__":
