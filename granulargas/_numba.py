@@ -33,6 +33,18 @@ and the typing repeat at each and cost more than the library saves: the loop's
 per-event steps (one call site in each build of the loop) are of this kind,
 the shared helpers are :func:`inlined` or plain kernels.
 
+No function here has numba's C-callable wrapper (``no_cfunc_wrapper``): it serves a
+function passed as a first-class function value (``FunctionType``), which the package
+never does, and costs a wrapper's lowering, LLVM optimisation and machine code in every
+compiled function's library. Python calls go through the CPython wrapper, compiled code
+calls the function itself.
+
+Literal arguments. A compiled function called from compiled code with a constant
+argument (``f(x, 3)``) is typed with that argument's literal type (``Literal[int](3)``)
+and compiled once per distinct constant and again for a variable argument; a call site
+passes ``np.int64(3)`` where one compiled copy serves all (an :func:`inlined` callee
+gets the constant back from LLVM's constant propagation after inlining).
+
 Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function
 whose compilation triggered the callee's, so that a kernel first compiled from
@@ -150,6 +162,7 @@ def jit(*args, **kwargs):
     """``numba.njit`` with the package defaults (cached with the package's stamp, no fastmath)."""
     cache = kwargs.pop("cache", _CACHE)
     kwargs.setdefault("forceinline", False)
+    kwargs.setdefault("no_cfunc_wrapper", True)
 
     def decorate(func):
         dispatcher = numba.njit(**kwargs)(func)
