@@ -287,14 +287,14 @@ def predict_pair_cells(i, t, before, rec, count, grid, space, flight):
         if _interior(i, grid, space):
             nx = space.ncell[0]
             sz = nx * space.ncell[1]
-            # int64, not a literal, where a kernel takes a constant: numba compiles a kernel once per
-            # literal value passed (granulargas._numba, "Literal arguments")
+            # int64, not a literal: numba compiles a kernel once per literal value passed
+            # (granulargas._numba, "Literal arguments"); LLVM inlines scan_block and sees the constant
             pt, pj = scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz,
                                 np.int64(3), flight)
         else:
             zr = 1 if space.ncell[2] >= 3 else 0
             pt, pj = scan_cells(i, t, math.inf, rec, grid.head, grid.cell, grid.fresh, space.ncell, space.period,
-                                np.int64(-1), np.int64(1), np.int64(-1), np.int64(1), -zr, zr, flight)
+                                -1, 1, -1, 1, -zr, zr, flight)
         grid.pair_t[i] = pt
         grid.cell[i, PAIR_J] = pj
         grid.cell[i, PAIR_TAG] = count[pj] if pj >= 0 else 0
