@@ -41,9 +41,11 @@ calls the function itself.
 
 Literal arguments. A compiled function called from compiled code with a constant
 argument (``f(x, 3)``) is typed with that argument's literal type (``Literal[int](3)``)
-and compiled once per distinct constant and again for a variable argument; a call site
-passes ``np.int64(3)`` where one compiled copy serves all (an :func:`inlined` callee
-gets the constant back from LLVM's constant propagation after inlining).
+and compiled once per distinct constant and once more for a variable argument: a few
+of the cell scans' and the calendar's kernels are compiled twice for that reason
+(``scripts/profiling/compile_profile.py`` lists them). Their constant-specialised code
+is kept: passing ``np.int64(3)`` instead saves the copy but measured slower in the
+cell-crossing loop (the callee optimised generically before LLVM inlines it).
 
 Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function

@@ -375,7 +375,7 @@ def cal_update_root(i, t, cal):
         if last > 0:
             small[0, 0] = small[last, 0]
             small[0, 1] = small[last, 1]
-            _sift_down(small, cal.where, np.int64(0), last)  # int64: one compiled _sift_down (_numba)
+            _sift_down(small, cal.where, 0, last)
         cs.nring += 1
         return True
     return cal_update(i, t, cal)
@@ -446,7 +446,7 @@ def _open_bucket(slot, cal, cs):
             j = chunks[c, q]
             if where[j] == slot:
                 cs.nring -= 1
-                if not _small_push(np.int64(j), qt[j], cal.small, where, cs):  # int64: one compiled copy
+                if not _small_push(j, qt[j], cal.small, where, cs):
                     return False
         _release(c, chunks, cs)
         c = nx

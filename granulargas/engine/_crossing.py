@@ -287,10 +287,8 @@ def predict_pair_cells(i, t, before, rec, count, grid, space, flight):
         if _interior(i, grid, space):
             nx = space.ncell[0]
             sz = nx * space.ncell[1]
-            # int64, not a literal: numba compiles a kernel once per literal value passed
-            # (granulargas._numba, "Literal arguments"); LLVM inlines scan_block and sees the constant
-            pt, pj = scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz,
-                                np.int64(3), flight)
+            pt, pj = scan_block(i, t, math.inf, rec, grid, space, grid.cell[i, FLAT] - 1 - nx - sz, nx, sz, 3,
+                                flight)
         else:
             zr = 1 if space.ncell[2] >= 3 else 0
             pt, pj = scan_cells(i, t, math.inf, rec, grid.head, grid.cell, grid.fresh, space.ncell, space.period,
@@ -322,7 +320,7 @@ def scan_new_layer(i, t, face, rec, count, grid, space, flight):
         s1 = nx if a == 0 else 1
         s2 = nx if a == 2 else sz
         pt, pn = scan_block(i, t, grid.pair_t[i], rec, grid, space, grid.cell[i, FLAT] + o * sa - s1 - s2,
-                            s1, s2, np.int64(1), flight)
+                            s1, s2, 1, flight)
     else:
         zr = 1 if space.ncell[2] >= 3 else 0
         x0 = o if a == 0 else -1

@@ -64,10 +64,9 @@ def _uniform(key, u, i, a, dim):
 def _trial(r, i, step, key, u, dim, box):
     """Trial position r_i + step (2 u - 1) (u of particle i: :func:`_uniform`), wrapped
     into the box; x = box[0] flags a move to skip (-tiny + L rounded to L)."""
-    # the axes as int64, not literals: one compiled _uniform (granulargas._numba, "Literal arguments")
-    x = r[i, 0] + step * (2.0 * _uniform(key, u, i, np.int64(0), dim) - 1.0)
-    y = r[i, 1] + step * (2.0 * _uniform(key, u, i, np.int64(1), dim) - 1.0)
-    z = r[i, 2] + step * (2.0 * _uniform(key, u, i, np.int64(2), dim) - 1.0) if dim == 3 else r[i, 2]
+    x = r[i, 0] + step * (2.0 * _uniform(key, u, i, 0, dim) - 1.0)
+    y = r[i, 1] + step * (2.0 * _uniform(key, u, i, 1, dim) - 1.0)
+    z = r[i, 2] + step * (2.0 * _uniform(key, u, i, 2, dim) - 1.0) if dim == 3 else r[i, 2]
     x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
     y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
     z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
