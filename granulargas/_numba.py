@@ -44,8 +44,8 @@ argument (``f(x, 3)``) is typed with that argument's literal type (``Literal[int
 and compiled once per distinct constant and once more for a variable argument: a few
 of the cell scans' and the calendar's kernels are compiled twice for that reason
 (``scripts/profiling/compile_profile.py`` lists them). Their constant-specialised code
-is kept: passing ``np.int64(3)`` instead saves the copy but measured slower in the
-cell-crossing loop (the callee optimised generically before LLVM inlines it).
+is kept: passing ``np.int64(3)`` instead saves the copy but measured 3-4 % slower in a
+paired comparison of the cell-crossing loop (``scripts/ab/paired.py``).
 
 Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function
