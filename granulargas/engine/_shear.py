@@ -97,10 +97,11 @@ import numpy as np
 
 from granulargas._numba import inlined, kernel
 from granulargas.engine._calendar import cal_update
-from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, slot_insert, slot_remove
+from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, PREFETCH_CENTRES_FROM, slot_insert, slot_remove
 from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, face_gap, grid_insert, grid_remove
 from granulargas.engine._flight import stream
 from granulargas.engine._geometry import collision_delay, min_image
+from granulargas.engine._prefetch import prefetch
 
 #: The sheared geometry and its mutable scalars (``Space.shear``; None without shear):
 #: ``rate`` a > 0, box sides ``lx``, ``ly``, cell sides ``wx``, ``wy`` and counts ``nx``,
@@ -391,9 +392,19 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
     """Particles j != i whose centre (at t, through the sheared images) comes within
     R_i + R_j + shell of the query point (laboratory (xq, yq, zq) at t, in row r) while the
     rows slide by the margin D (:func:`slid`, eq. 3), into ``lists.scratch``: 3 columns of
-    its own row and 5 of rows r - 1 and r + 1 (in their frames), times 3 along z (none
-    beyond a wall on z). Returns the number, or -1 if more than m or the scratch is short."""
+    its own row and 4 of rows r - 1 and r + 1 (in their frames), times 3 along z (none
+    beyond a wall on z). Returns the number, or -1 if more than m or the scratch is short.
+
+    Passes, as :func:`granulargas.engine._cells._collect`: (1) the cells the slid cut-off can
+    reach into ``lists.stencil`` (cell, row, and the periodic shifts of its column and
+    layer), each cell's row of ids prefetched; (2) a prefetch of every candidate's centre
+    (large systems); (3) the branch-free distance tests, with the query point shifted by
+    the cell's periodic offset (no minimum image: a scanned column or layer is the nearest
+    image when the row has at least 6 columns and z at least 4 layers, or none to wrap;
+    otherwise the minimum image is taken); (4) the hits compacted, with the exact cut-off for partners
+    smaller than R_max."""
     scratch = lists.scratch
+    stencil = lists.stencil
     centre = lists.centre
     cell_ids = cells.ids
     cell_n = cells.n
@@ -406,47 +417,84 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
     cz = int(zq * (ncell[2] / box[2]))
     cz = min(max(cz, 0), ncell[2] - 1)
     zr = 1 if ncell[2] >= 3 else 0
+    shifted = sh.nx >= 6 and (ncell[2] >= 4 or period[2] == math.inf or space.dims == 2)
     # cells the cut-off (slid by the margin along x) cannot reach are skipped, as in
     # granulargas.engine._cells._reach, with its round-off margin
     wz = box[2] / ncell[2]
     lim = cut_max * (1.0 + 1e-9) + 1e-12 * (sh.lx + sh.ly + box[2])
     lim2 = lim * lim
-    count = 0
+    # the query point in the frames of rows r - 1, r, r + 1 (x) and through the sheared
+    # boundary (y)
+    xm = _reduce(xq - row_offset(r - 1, t, sh), sh.lx)
+    xo = _reduce(xq - row_offset(r, t, sh), sh.lx)
+    xp = _reduce(xq - row_offset(r + 1, t, sh), sh.lx)
+    ym = yq + (sh.ly if r - 1 < 0 else 0.0)
+    yp = yq - (sh.ly if r + 1 >= sh.ny else 0.0)
+    ns = 0
     for o in range(-1, 2):
         rho = r + o
         g = _wrap(rho, sh.ny)
-        ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
+        ys = ym if o < 0 else (yp if o > 0 else yq)
         gy = _gap(ys, g * sh.wy, sh.wy)
-        xi = _reduce(xq - row_offset(rho, t, sh), sh.lx)
+        xi = xm if o < 0 else (xp if o > 0 else xo)
         c0 = col_of(xi, sh)
         x0, ncol = _columns(c0, o, sh.nx)
         for oz in range(-zr, zr + 1):
             kz = cz + oz
             gz = _gap(zq, kz * wz, wz) if zr > 0 else 0.0
+            zs = 0
             if kz < 0 or kz >= ncell[2]:
                 if period[2] == math.inf:
                     continue
+                zs = -1 if kz < 0 else 1
                 kz = _wrap(kz, ncell[2])
             for ox in range(ncol):
                 gx = 0.0
+                k = x0 + ox
                 if o == 0 or sh.nx >= 4:  # distinct unwrapped columns: their gaps hold
-                    k = x0 + ox
                     gx = _gap(xi, k * sh.wx, sh.wx)
                     if (o > 0 and k < c0) or (o < 0 and k > c0):
                         gx = gx - sh.margin if gx > sh.margin else 0.0
                 if gx * gx + gy * gy + gz * gz >= lim2:
                     continue
-                c = _wrap(x0 + ox, sh.nx) + ncell[0] * (g + ncell[1] * kz)
-                nq = cell_n[c]
-                if count + nq > cap:
-                    return -1
-                for q in range(nq):
-                    j = cell_ids[c, q]
-                    dx = slid(min_image(xi - centre[j, 0], sh.lx), o, sh.margin)
-                    dy = ys - centre[j, 1]
-                    dz = min_image(zq - centre[j, 2], period[2])
-                    scratch[count] = j
-                    count += (dx * dx + dy * dy + dz * dz < cut_max2) & (j != i)
+                xs = -1 if k < 0 else (1 if k >= sh.nx else 0)
+                c = _wrap(k, sh.nx) + ncell[0] * (g + ncell[1] * kz)
+                prefetch(cell_ids, c)
+                stencil[ns] = 64 * c + (o + 1) + 3 * (xs + 1) + 9 * (zs + 1)
+                ns += 1
+    if centre.shape[0] > PREFETCH_CENTRES_FROM:
+        for k in range(ns):
+            c = stencil[k] >> 6
+            for q in range(cell_n[c]):
+                prefetch(centre, cell_ids[c, q])
+    count = 0
+    for k in range(ns):
+        c = stencil[k] >> 6
+        code = stencil[k] & 63
+        o = code % 3 - 1
+        ys = ym if o < 0 else (yp if o > 0 else yq)
+        qx = xm if o < 0 else (xp if o > 0 else xo)
+        qz = zq
+        if shifted:
+            qx -= ((code // 3) % 3 - 1) * sh.lx
+            qz -= (code // 9 - 1) * box[2]
+        sgn = -1.0 if o < 0 else 1.0
+        mo = 0.0 if o == 0 else sh.margin
+        nq = cell_n[c]
+        if count + nq > cap:
+            return -1
+        for q in range(nq):
+            j = cell_ids[c, q]
+            dx = qx - centre[j, 0]
+            dz = qz - centre[j, 2]
+            if not shifted:
+                dx = min_image(dx, sh.lx)
+                dz = min_image(dz, period[2])
+            u = sgn * dx
+            dx = u - min(max(u, 0.0), mo)  # slid(), branch-free
+            dy = ys - centre[j, 1]
+            scratch[count] = j
+            count += (dx * dx + dy * dy + dz * dz < cut_max2) & (j != i)
     found = 0
     for k in range(count):
         j = scratch[k]
@@ -459,8 +507,8 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
                 rho = r + o
                 if _wrap(rho, sh.ny) != g:
                     continue
-                ys = yq - (sh.ly if rho >= sh.ny else (-sh.ly if rho < 0 else 0.0))
-                xi = _reduce(xq - row_offset(rho, t, sh), sh.lx)
+                ys = ym if o < 0 else (yp if o > 0 else yq)
+                xi = xm if o < 0 else (xp if o > 0 else xo)
                 dx = slid(min_image(xi - centre[j, 0], sh.lx), o, sh.margin)
                 dy = ys - centre[j, 1]
                 dz = min_image(zq - centre[j, 2], period[2])
@@ -508,6 +556,11 @@ def rebuild_list_le(i, t, rec, lists, cells, space, rmax, shell, sh):
     if count < 0:
         return OVERFLOW
     nold = nbn[i]
+    for k in range(count):
+        prefetch(nbl, scratch[k])
+        prefetch(nbn, scratch[k])
+    for k in range(nold):
+        prefetch(nbl, nbl[i, k])
     for k in range(nold):
         mark[nbl[i, k]] = 1
     full = False

@@ -521,7 +521,7 @@ class Simulation:
         events = _state.Events(partner=partner, tag=tag)
         centre = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
         pos = np.ascontiguousarray(rec[:, :3])
-        stencil = np.empty(27, dtype=np.int64)
+        stencil = np.empty(27 if sh is None else 36, dtype=np.int64)  # (sheared: 3 + 4 + 4 columns x 3)
         while True:
             lists = _state.Lists(centre=centre, nbl=np.empty((n, self._nb_width), dtype=np.int32),
                                  nbn=np.zeros(n, dtype=np.int32), scratch=np.empty(1, np.int32),

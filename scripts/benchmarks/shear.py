@@ -14,12 +14,17 @@ rate), median of ``--repeats`` timed runs after a warm-up, at ``--dsmc-sizes``.
 
     python scripts/benchmarks/shear.py                          # engine N = 1e4, 1e5; DSMC N = 1e6
     python scripts/benchmarks/shear.py --sizes 1e4 --dsmc-sizes 1e5 --repeats 3
+
+``--record`` writes each figure into ``docs/performance/results.json`` (table of uniform shear
+flow) and rewrites the performance page.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
+import sys
 import time
 
 import numpy as np
@@ -89,7 +94,13 @@ def main(argv=None):
     ap.add_argument("--per-run", type=float, default=2.0, help="collisions per particle per timed run")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--dsmc-sizes", type=float, nargs="*", default=[1e6])
+    ap.add_argument("--record", action="store_true", help="write the figures into docs/performance/results.json "
+                    "and rewrite the performance page (table of uniform shear flow)")
     args = ap.parse_args(argv)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import results
+
+    load, commit, records = os.getloadavg()[0], results.this_commit(), []
     print(f"engine: 3D, eps = {EPS}, packing {args.packing}, CPU time per collision (median of {args.repeats} "
           "alternated rounds)")
     print(f"{'N':>8} {'mode':>6} {'periodic (us)':>14} {'sheared (us)':>13} {'ratio':>7} {'range':>13}")
@@ -97,10 +108,20 @@ def main(argv=None):
         for mode in args.modes:
             tp, ts, r, lo, hi = engine_case(n, mode, args.packing, int(args.per_run * n), args.repeats)
             print(f"{n:>8} {mode:>6} {1e6 * tp:>14.3f} {1e6 * ts:>13.3f} {r:>7.3f} {lo:>6.3f}-{hi:<6.3f}", flush=True)
+            records.append(dict(table="uniform_shear", id=f"lees-edwards 3D {mode} packing {args.packing:g} N={n}",
+                                method="edmd", dim=3, n=n, packing=args.packing, neighbours=mode, restitution=EPS,
+                                ratio=round(r, 3), ratio_range=[round(lo, 3), round(hi, 3)], rounds=args.repeats))
     for n in (int(x) for x in args.dsmc_sizes):
         med, lo, hi = dsmc_case(n, int(args.per_run * n), args.repeats)
         print(f"DSMC of USF, 3D, N = {n}: {med / 1e6:.3g} M collisions per CPU second (range {lo / 1e6:.3g}-"
               f"{hi / 1e6:.3g})", flush=True)
+        records.append(dict(table="uniform_shear", id=f"dsmc 3D packing 0.02 N={n}", method="dsmc", dim=3, n=n,
+                            packing=0.02, restitution=EPS, rate_cpu=round(med / 1e6, 2),
+                            rate_range=[round(lo / 1e6, 2), round(hi / 1e6, 2)], rounds=args.repeats))
+    if args.record:
+        words = argv if argv is not None else sys.argv[1:]
+        results.record_and_render(records, " ".join(["python scripts/benchmarks/shear.py", *words]),
+                                  load_average=max(load, os.getloadavg()[0]), commit=commit)
 
 
 if __name__ == "__main__":
