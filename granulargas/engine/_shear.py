@@ -709,7 +709,7 @@ def _windows(cx, m, nx):
     return cx - 2 - m, cx - 1 + m
 
 
-@kernel(python=False)
+@inlined
 def scan_le(i, t, before, rec, grid, space, sh, own0, own_n, up0, up_n, down0, down_n, z0, z1):
     """Earliest collision of i (streamed to t), before ``before``, with the particles of:
     columns own0 .. own0 + own_n - 1 of its own row, up0 .. of the row above, down0 .. of the
