@@ -85,9 +85,18 @@ window, and keeps the earlier of what it finds and its event (and its stored bes
 if current). The two windows are mirror images (j in the upper window of i iff i is in
 the lower window of j), so the lower particle of every pair that a slide makes adjacent
 scans it. The completeness argument of :mod:`granulargas.engine._crossing` then holds
-as it is, with "the last prediction of either" ranging over full scans, crossings (new
-layers: an x crossing 1 column in each of the three rows; a y crossing both adjacent
-rows' windows; a z crossing the new layer of 11 columns) and slides.
+as it is, with "the last prediction of either" ranging over full scans, crossings and
+slides, each scanning the cells that became adjacent (at the present m): an x crossing
+1 column in each of the three rows; a z crossing the new layer of 11 columns; a y
+crossing (:func:`_y_layer`) from column x of row r into row r + 1 lands in column
+x - m - 1 or x - m of that row's frame (the point is within w_x of its old cell, eq. 2),
+whose 3 own columns lay in the old upper window x - 2 - m .. x + 1 - m, and row r's new
+lower window (x - 2 .. x + 1 or x - 1 .. x + 2) differs from the old own columns
+x - 1 .. x + 1 by one column: the scan is the 4 columns of row r + 2 and that one
+(mirrored for a crossing down; 15 cells instead of both windows' 24). It subtracts the
+runs of columns as integers, so a landing column off by one at round-off only scans
+more. The cells it leaves out were adjacent before the crossing, and the argument goes
+back one prediction, as for the other faces.
 """
 
 import math
