@@ -33,6 +33,20 @@ and the typing repeat at each and cost more than the library saves: the loop's
 per-event steps (one call site in each build of the loop) are of this kind,
 the shared helpers are :func:`inlined` or plain kernels.
 
+No function here has numba's C-callable wrapper (``no_cfunc_wrapper``): it serves a
+function passed as a first-class function value (``FunctionType``), which the package
+never does, and costs a wrapper's lowering, LLVM optimisation and machine code in every
+compiled function's library. Python calls go through the CPython wrapper, compiled code
+calls the function itself.
+
+Literal arguments. A compiled function called from compiled code with a constant
+argument (``f(x, 3)``) is typed with that argument's literal type (``Literal[int](3)``)
+and compiled once per distinct constant and once more for a variable argument: a few
+of the cell scans' and the calendar's kernels are compiled twice for that reason
+(``scripts/profiling/compile_profile.py`` lists them). Their constant-specialised code
+is kept: passing ``np.int64(3)`` instead saves the copy but measured 3-4 % slower in a
+paired comparison of the cell-crossing loop (``scripts/ab/paired.py``).
+
 Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function
 whose compilation triggered the callee's, so that a kernel first compiled from
@@ -150,6 +164,7 @@ def jit(*args, **kwargs):
     """``numba.njit`` with the package defaults (cached with the package's stamp, no fastmath)."""
     cache = kwargs.pop("cache", _CACHE)
     kwargs.setdefault("forceinline", False)
+    kwargs.setdefault("no_cfunc_wrapper", True)
 
     def decorate(func):
         dispatcher = numba.njit(**kwargs)(func)

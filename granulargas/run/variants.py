@@ -55,6 +55,10 @@ _DSMC = {"run.method": "dsmc", "system.particles": 256}
 #: rough particles (spins and a tangential restitution): a loop of their own
 _ROUGH = {"collision.tangential.restitution": 0.0}
 _ROUGH_DRIVEN = {**_DRIVEN, "driving.rotational_fraction": 0.5}
+#: uniform shear flow: Lees-Edwards boundaries on y (the sheared loops of both neighbour modes and the DSMC
+#: of uniform shear flow), a constant restitution as in the example configs, the rate of the steady state at T0
+_SHEAR = {"system.boundary": ["periodic", "lees-edwards", "periodic"], "shear.rate": 0.292,
+          "collision.model": "constant", "collision.restitution": 0.8, "collision.damping": None}
 #: a mixture: two species, the law per pair of species (the loops compiled with the species record)
 _MIXTURE = {"species": [{"name": "a", "fraction": 0.5}, {"name": "b", "fraction": 0.5, "diameter": 0.8}],
             "collision.damping": {"a-a": 0.1, "a-b": 0.1, "b-b": 0.1}}
@@ -75,23 +79,25 @@ def scene_kind(config: RunConfig) -> str | None:
 
 
 def _engine(mode: str, resolved: bool = False, driven: bool = False, rough: bool = False, mixture: bool = False,
-            scene: str | None = None) -> Callable[[RunConfig, str], bool]:
+            scene: str | None = None, sheared: bool = False) -> Callable[[RunConfig, str], bool]:
     """Runs of the event-driven engine in neighbour mode ``mode`` (with collisions that take
     time: ``resolved``; ``driven``: the driven ones only; ``rough``: rough particles;
-    ``mixture``: those with species; ``scene``: their :func:`scene_kind`)."""
+    ``mixture``: those with species; ``scene``: their :func:`scene_kind`; ``sheared``: those
+    with ``[shear]``, Lees-Edwards boundaries)."""
     def uses(config: RunConfig, neighbours: str) -> bool:
         return (config.run.method == "edmd" and neighbours == mode
                 and (config.collision.duration == "resolved") == resolved
                 and config.collision.rough == rough
                 and (config.driving is not None or not driven) and bool(config.species) == mixture
-                and scene_kind(config) == scene)
+                and scene_kind(config) == scene and (config.shear is not None) == sheared)
     return uses
 
 
-def _dsmc(driven: bool = False, rough: bool = False, mixture: bool = False) -> Callable[[RunConfig, str], bool]:
+def _dsmc(driven: bool = False, rough: bool = False, mixture: bool = False,
+          sheared: bool = False) -> Callable[[RunConfig, str], bool]:
     return lambda config, neighbours: (config.run.method == "dsmc" and config.collision.rough == rough
                                        and (config.driving is not None or not driven)
-                                       and bool(config.species) == mixture)
+                                       and bool(config.species) == mixture and (config.shear is not None) == sheared)
 
 
 @dataclass(frozen=True)
@@ -186,6 +192,12 @@ VARIANTS = (
     Variant("dsmc-mixture", "the DSMC of mixtures", {**_DSMC, **_MIXTURE}, _dsmc(mixture=True), after=("dsmc",)),
     Variant("dsmc-mixture-driven", "its driving step", {**_DSMC, **_MIXTURE, **_DRIVEN},
             _dsmc(driven=True, mixture=True), after=("dsmc-mixture",)),
+    Variant("lists-shear", "the neighbour-list engine of uniform shear flow (Lees-Edwards boundaries)",
+            {"run.neighbours": "lists", **_SHEAR}, _engine("lists", sheared=True), after=("placement", "lists")),
+    Variant("cells-shear", "the cell-crossing engine of uniform shear flow (Lees-Edwards boundaries)",
+            {"run.neighbours": "cells", **_SHEAR}, _engine("cells", sheared=True), after=("placement", "cells")),
+    Variant("dsmc-shear", "the DSMC of uniform shear flow", {**_DSMC, **_SHEAR}, _dsmc(sheared=True),
+            after=("dsmc",)),
 )
 BY_NAME = {v.name: v for v in VARIANTS}
 

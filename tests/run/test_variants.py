@@ -17,6 +17,7 @@ from granulargas.engine import Simulation
 from granulargas.errors import ConfigError
 from granulargas.io.config import load_config
 from granulargas.run import runner
+from granulargas.run.validity import raise_if_invalid
 from granulargas.run.variants import BY_NAME, VARIANTS, describe, run_neighbours, tiny_config, variants_for
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -39,7 +40,10 @@ EXAMPLES = {
     "rough_mpemba_hot.toml": ["placement", "cells-rough", "cells-rough-driven"],
     "mixture_hcs_3d.toml": ["dsmc-mixture"],
     "glass_steel_3d.toml": ["placement", "cells-mixture"],
-
+    "shear_2d.toml": ["placement", "lists-shear"],
+    "shear_3d.toml": ["placement", "cells-shear"],
+    "shear_elastic_3d.toml": ["placement", "cells-shear"],
+    "shear_dsmc_3d.toml": ["dsmc-shear"],
 }
 
 
@@ -54,7 +58,8 @@ def test_every_example_config_compiles_a_named_variant():
         names = [v.name for v in variants_for(load_config(path))]
         assert any(n in ("lists", "cells", "resolved", "dsmc", "lists-walls", "cells-walls", "lists-gravity",
                          "cells-gravity", "lists-gravity-walls", "cells-gravity-walls", "lists-rough", "cells-rough",
-                         "dsmc-rough", "lists-mixture", "cells-mixture", "dsmc-mixture") for n in names), (path.name, names)
+                         "dsmc-rough", "lists-mixture", "cells-mixture", "dsmc-mixture", "lists-shear",
+                         "cells-shear", "dsmc-shear") for n in names), (path.name, names)
 
 
 def test_each_variant_tiny_run_selects_it(tmp_path):
@@ -66,6 +71,26 @@ def test_each_variant_tiny_run_selects_it(tmp_path):
         assert v in variants_for(cfg), v.name
         for dep in v.after:
             assert BY_NAME[dep] in VARIANTS
+
+
+def test_each_variant_tiny_run_passes_the_checks_of_a_run(tmp_path):
+    """``granulargas compile`` makes each tiny run by the steps of ``granulargas run``: its
+    config passes the checks before the run (a refused one would compile nothing)."""
+    for v in VARIANTS:
+        if v.config is not None:
+            raise_if_invalid(tiny_config(v, tmp_path))
+
+
+def test_sheared_runs_compile_the_sheared_loops(tmp_path):
+    """A run with ``[shear]`` compiles the Lees-Edwards loop of its neighbour mode (or the
+    DSMC of uniform shear flow), not the loop of the same run without shear, and back."""
+    for loop in ("lists", "cells", "dsmc"):
+        plain = tiny_config(BY_NAME[loop], tmp_path)
+        sheared = tiny_config(BY_NAME[f"{loop}-shear"], tmp_path)
+        mode = None if loop == "dsmc" else loop
+        assert [v.name for v in variants_for(sheared, mode)] == (["dsmc-shear"] if loop == "dsmc"
+                                                                   else ["placement", f"{loop}-shear"])
+        assert f"{loop}-shear" not in [v.name for v in variants_for(plain, mode)]
 
 
 def test_auto_neighbours_follow_the_engine():
