@@ -119,6 +119,7 @@ from granulargas.engine._shear import (
     predict_expiry_le,
     predict_pair_cells_le,
     predict_pair_le,
+    prefetch_around_le,
     rebuild_list_le,
     scan_new_layer_le,
     slide_scan,
@@ -631,8 +632,9 @@ def execute_crossing(i, face, te, p, grid, c, prm, shear):
     the loop's prediction of i then uses it."""
     stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
     if shear is not None:
+        cx_old = grid.cell[i, 0]
         c.sum_mv2 += p.mass[i] * cross_le(i, face, te, p.rec, p.img, grid, prm.space, shear)
-        scan_new_layer_le(i, te, face, p.rec, p.count, grid, prm.space, shear)
+        scan_new_layer_le(i, te, face, cx_old, p.rec, p.count, grid, prm.space, shear)
     else:
         cross(i, face, grid, prm.space)
         scan_new_layer(i, te, face, p.rec, p.count, grid, prm.space, prm.flight)
@@ -837,15 +839,19 @@ def _prefetch_particle(i, p, ev, lists, cal):
 
 
 @inlined_ir
-def prefetch_next_cells(i1, p, ev, grid, cal, prm):
+def prefetch_next_cells(i1, p, ev, grid, cal, prm, shear):
     """Prefetch hints for the next event of the cell-crossing mode: the rows of particle
     i1 and its partner, the cell heads around i1, and the rows of the likely event after
-    it. Returns that event's guessed particle (-1: none). (A particle's cell, event and
+    it (``shear``: the cells of the sliding rows' windows). Returns that event's guessed
+    particle (-1: none). (A particle's cell, event and
     calendar data share one row of ``grid.cell``: :func:`~granulargas.engine._crossing.particle_rows`.)"""
     rec = p.rec
     p1 = ev.partner[i1]
     prefetch(grid.cell, i1)
-    prefetch_around(i1, grid, prm.space)
+    if shear is None:
+        prefetch_around(i1, grid, prm.space)
+    else:
+        prefetch_around_le(i1, grid, prm.space, shear)
     if p1 >= 0:
         prefetch(rec, p1)
         prefetch(grid.cell, p1)
@@ -1054,7 +1060,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             if onlists is not None:
                 guess = prefetch_next_lists(i1, p, ev, lists, cells, cal, prm)
             if oncells is not None:
-                guess = prefetch_next_cells(i1, p, ev, lists, cal, prm)
+                guess = prefetch_next_cells(i1, p, ev, lists, cal, prm, shear)
         clock = tick(probe, PREFETCH, clock)
         if c.collisions >= max_collisions:
             status = MAX_COLLISIONS

@@ -85,9 +85,18 @@ window, and keeps the earlier of what it finds and its event (and its stored bes
 if current). The two windows are mirror images (j in the upper window of i iff i is in
 the lower window of j), so the lower particle of every pair that a slide makes adjacent
 scans it. The completeness argument of :mod:`granulargas.engine._crossing` then holds
-as it is, with "the last prediction of either" ranging over full scans, crossings (new
-layers: an x crossing 1 column in each of the three rows; a y crossing both adjacent
-rows' windows; a z crossing the new layer of 11 columns) and slides.
+as it is, with "the last prediction of either" ranging over full scans, crossings and
+slides, each scanning the cells that became adjacent (at the present m): an x crossing
+1 column in each of the three rows; a z crossing the new layer of 11 columns; a y
+crossing (:func:`_y_layer`) from column x of row r into row r + 1 lands in column
+x - m - 1 or x - m of that row's frame (the point is within w_x of its old cell, eq. 2),
+whose 3 own columns lay in the old upper window x - 2 - m .. x + 1 - m, and row r's new
+lower window (x - 2 .. x + 1 or x - 1 .. x + 2) differs from the old own columns
+x - 1 .. x + 1 by one column: the scan is the 4 columns of row r + 2 and that one
+(mirrored for a crossing down; 15 cells instead of both windows' 24). It subtracts the
+runs of columns as integers, so a landing column off by one at round-off only scans
+more. The cells it leaves out were adjacent before the crossing, and the argument goes
+back one prediction, as for the other faces.
 """
 
 import math
@@ -687,17 +696,22 @@ def predict_crossing_le(i, t, rec, grid, space, sh):
     gap, speed, side = face_gap(_reduce(rec[i, 0] - row_offset(r, t, sh), sh.lx), rec[i, 3] - row_speed(r, sh),
                                 cell[i, 0], grid.width[0], space.ncell[0], sh.lx)
     face = side
+    # the axis chosen without a branch, as in granulargas.engine._crossing.predict_crossing
     g, v, sd = face_gap(rec[i, 1] - sh.ly, rec[i, 4], r, grid.width[1], space.ncell[1], sh.ly)
-    if (g * speed < gap * v or speed == 0.0) and v > 0.0:
-        gap = g
-        speed = v
-        face = 2 + sd
+    take = ((g * speed < gap * v) | (speed == 0.0)) & (v > 0.0)
+    s = np.float64(take)
+    q = 1.0 - s
+    gap = g * s + gap * q
+    speed = v * s + speed * q
+    face = 2 + sd if take else face
     if space.dims == 3:
         g, v, sd = face_gap(rec[i, 2], rec[i, 5], cell[i, 2], grid.width[2], space.ncell[2], space.period[2])
-        if (g * speed < gap * v or speed == 0.0) and v > 0.0:
-            gap = g
-            speed = v
-            face = 4 + sd
+        take = ((g * speed < gap * v) | (speed == 0.0)) & (v > 0.0)
+        s = np.float64(take)
+        q = 1.0 - s
+        gap = g * s + gap * q
+        speed = v * s + speed * q
+        face = 4 + sd if take else face
     if speed == 0.0:
         return math.inf, face
     return t + gap / speed, face
@@ -707,6 +721,9 @@ def predict_crossing_le(i, t, rec, grid, space, sh):
 def _list_heads(first, k, head, g, c0, ncol, cz, z0, z1, ncell, period_z, nx):
     """Append to ``first`` the heads of the non-empty cells of row g, columns c0 .. c0 + ncol - 1
     (wrapped), z layers cz + z0 .. cz + z1 (none beyond a wall); returns the new count."""
+    if ncol <= 0:
+        return k
+    start = c0 % nx  # one division per row; the columns then step with a compare
     for oz in range(z0, z1 + 1):
         kz = cz + oz
         if kz < 0 or kz >= ncell[2]:
@@ -714,10 +731,13 @@ def _list_heads(first, k, head, g, c0, ncol, cz, z0, z1, ncell, period_z, nx):
                 continue
             kz = _wrap(kz, ncell[2])
         row = ncell[0] * (g + ncell[1] * kz)
+        c = start
         for u in range(ncol):
-            j = head[(c0 + u) % nx + row]
+            j = head[c + row]
             first[k] = j
             k += 1 if j >= 0 else 0
+            c += 1
+            c = 0 if c == nx else c
     return k
 
 
@@ -750,7 +770,7 @@ def _windows(cx, m, nx):
     return cx - 2 - m, cx - 1 + m
 
 
-@kernel(python=False)
+@inlined
 def scan_le(i, t, before, rec, grid, space, sh, own0, own_n, up0, up_n, down0, down_n, z0, z1):
     """Earliest collision of i (streamed to t), before ``before``, with the particles of:
     columns own0 .. own0 + own_n - 1 of its own row, up0 .. of the row above, down0 .. of the
@@ -821,12 +841,45 @@ def cross_le(i, face, t, rec, img, grid, space, sh):
     return dv2
 
 
+@inlined(python=True)
+def _minus(n0, nn, o0, on):
+    """The columns n0 .. n0 + nn - 1 that are not among o0 .. o0 + on - 1 (integers, not
+    wrapped; on >= nn - 1, so that the difference is a single run): (first, count), count <= 0
+    if none."""
+    if n0 < o0:
+        return n0, min(nn, o0 - n0)
+    return max(n0, o0 + on), n0 + nn - max(n0, o0 + on)
+
+
+@inlined(python=True)
+def _y_layer(cx, cxn, o, m, nx):
+    """The columns that a crossing of a y face (``o`` = +1 up, -1 down) from column cx of
+    its row into column cxn of the next makes adjacent, at the slide offset m: (own0, own_n,
+    back0, back_n, ahead0), the runs of the new own row, the row left behind and the row
+    ahead (4 columns from ahead0). The new own row lay in the old window of that row
+    (columns cx - 2 - m .. cx + 1 - m up, cx - 1 + m .. cx + 2 + m down), the row left
+    behind was the old own row (cx - 1 .. cx + 1): only the columns outside those are new.
+    cxn is taken at the image nearest the old window (any image would be complete: a column
+    outside the old run in integers is outside it modulo n_x too)."""
+    old0 = cx - 2 - m if o > 0 else cx - 1 + m
+    d = cxn - (old0 + 2)
+    d -= nx * ((d + nx // 2) // nx)  # into [-n_x/2, n_x/2)
+    c = old0 + 2 + d  # cxn unwrapped
+    own0, own_n = _minus(c - 1, 3, old0, 4)
+    back0 = c - 1 + m if o > 0 else c - 2 - m  # the window of the row left behind
+    back0, back_n = _minus(back0, 4, cx - 1, 3)
+    ahead0 = c - 2 - m if o > 0 else c - 1 + m
+    return own0, own_n, back0, back_n, ahead0
+
+
 @inlined
-def scan_new_layer_le(i, t, face, rec, count, grid, space, sh):
-    """After i crossed ``face``: keep the better of its stored pair and the cells that became
-    adjacent (x face: one column in each of the three rows; y face: both adjacent rows'
-    windows; z face: the new layer of the three rows), and mark the stored pair current;
-    nothing if the stored partner has collided since (the prediction then scans all)."""
+def scan_new_layer_le(i, t, face, cx_old, rec, count, grid, space, sh):
+    """After i crossed ``face`` (from column ``cx_old`` of its row before the crossing): keep
+    the better of its stored pair and the cells that became adjacent (x face: one column in
+    each of the three rows; y face: the window of the row ahead and the columns of the other
+    two rows that were not in i's old neighbourhood, :func:`_y_layer`; z face: the new layer
+    of the three rows), and mark the stored pair current; nothing if the stored partner has
+    collided since (the prediction then scans all)."""
     pj = grid.cell[i, PAIR_J]
     if pj >= 0 and count[pj] != grid.cell[i, PAIR_TAG]:
         return
@@ -834,14 +887,21 @@ def scan_new_layer_le(i, t, face, rec, count, grid, space, sh):
     o = 1 if face & 1 else -1
     cx = grid.cell[i, 0]
     zr = 1 if space.ncell[2] >= 3 else 0
-    up0, down0 = _windows(cx, sh.slide[0] % sh.nx, sh.nx)
+    m = sh.slide[0] % sh.nx
+    up0, down0 = _windows(cx, m, sh.nx)
     if a == 0:
         # the columns entering on the side of motion: own cx + o; above up0 + (3 if o > 0
         # else 0); below down0 + (3 if o > 0 else 0)
         e = 3 if o > 0 else 0
         pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, cx + o, 1, up0 + e, 1, down0 + e, 1, -zr, zr)
     elif a == 1:
-        pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, cx, 0, up0, 4, down0, 4, -zr, zr)
+        own0, own_n, back0, back_n, ahead0 = _y_layer(cx_old, cx, o, m, sh.nx)
+        if o > 0:
+            pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, own0, own_n, ahead0, 4, back0, back_n,
+                             -zr, zr)
+        else:
+            pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, own0, own_n, back0, back_n, ahead0, 4,
+                             -zr, zr)
     else:
         pt, pn = scan_le(i, t, grid.pair_t[i], rec, grid, space, sh, cx - 1, 3, up0, 4, down0, 4, o, o)
     if pn >= 0:
@@ -849,6 +909,34 @@ def scan_new_layer_le(i, t, face, rec, count, grid, space, sh):
         grid.cell[i, PAIR_J] = pn
         grid.cell[i, PAIR_TAG] = count[pn]
     grid.fresh[0] = i
+
+
+@inlined
+def prefetch_around_le(i, grid, space, sh):
+    """Prefetch hints for the cell heads that a full scan of particle i reads (no effect on
+    results): per z layer, the line of its own row's cell and of the middles of the two
+    adjacent rows' windows (:func:`_windows`)."""
+    ncell = space.ncell
+    nx = sh.nx
+    cx = grid.cell[i, 0]
+    r = grid.cell[i, 1]
+    cz = grid.cell[i, 2]
+    m = sh.slide[0] % nx
+    up = _wrap(r + 1, sh.ny)
+    down = _wrap(r - 1, sh.ny)
+    cu = (cx - m) % nx  # column 2 of the upper window
+    cd = (cx + m) % nx  # column 1 of the lower window
+    zr = 1 if ncell[2] >= 3 else 0
+    for oz in range(-zr, zr + 1):
+        kz = cz + oz
+        if kz < 0 or kz >= ncell[2]:
+            if space.period[2] == math.inf:
+                continue
+            kz = _wrap(kz, ncell[2])
+        base = ncell[1] * kz
+        prefetch(grid.head, cx + nx * (r + base))
+        prefetch(grid.head, cu + nx * (up + base))
+        prefetch(grid.head, cd + nx * (down + base))
 
 
 @kernel

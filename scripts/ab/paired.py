@@ -77,6 +77,15 @@ def worker(args):
                 sim.run(math.inf, max_collisions=args.n)
                 sims.append(sim)
                 continue
+            if args.shear > 0.0:  # Lees-Edwards (flow x, gradient y), eps = 0.8 as scripts/benchmarks/shear.py
+                shear_mod = importlib.import_module(nm + ".engine.shear")
+                st = ini.random_state(args.n, packing, args.dim, seed=args.seed,
+                                      boundary=("periodic", "lees-edwards", "periodic")[:args.dim], shear=args.shear)
+                sim = eng.Simulation(st, eng.CollisionRule.constant(0.8), neighbours=args.mode,
+                                     shear=shear_mod.Shear(args.shear))
+                sim.run(math.inf, max_collisions=args.n)
+                sims.append(sim)
+                continue
             st = ini.random_state(args.n, packing, args.dim, seed=args.seed)
             # a tree whose initial state is a set of keyword arguments (as_kwargs) or a state record
             state = ((), st.as_kwargs()) if hasattr(st, "as_kwargs") else ((st,), {})
@@ -109,6 +118,8 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=40)
     ap.add_argument("--chunk", type=int, default=20000, help="collisions per timed chunk")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--shear", type=float, default=0.0,
+                    help="Lees-Edwards shear rate (0: the periodic box); sheared gases have eps = 0.8")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--pkgdir", help=argparse.SUPPRESS)
     ap.add_argument("--order", nargs=2, help=argparse.SUPPRESS)
@@ -131,14 +142,15 @@ def main(argv=None):
             cmd = [sys.executable, os.path.abspath(__file__), args.tree_a, args.tree_b, "--worker",
                    "--pkgdir", pkgdir, "--order", *order, "--mode", args.mode, "--n", str(args.n),
                    "--dim", str(args.dim), "--rounds", str(args.rounds), "--chunk", str(args.chunk),
-                   "--seed", str(args.seed), "--packings", *map(str, args.packings)]
+                   "--seed", str(args.seed), "--shear", str(args.shear), "--packings", *map(str, args.packings)]
             run = subprocess.run(cmd, env=env, capture_output=True, text=True)
             if run.returncode != 0:
                 lines = run.stderr.strip().splitlines() or ["(no output)"]
                 print(f"error: worker ({' '.join(order)}) failed: {lines[-1]}", file=sys.stderr)
                 return 1
             passes.append(json.loads(run.stdout.strip().splitlines()[-1]))
-    print(f"# {args.mode}, {args.dim}D, N = {args.n}, {args.rounds} rounds of {args.chunk} collisions, "
+    sheared = f", sheared at a = {args.shear}" if args.shear > 0.0 else ""
+    print(f"# {args.mode}{sheared}, {args.dim}D, N = {args.n}, {args.rounds} rounds of {args.chunk} collisions, "
           f"CPU time; B/A = speed of B over A")
     print(f"# A = {args.tree_a}, B = {args.tree_b}")
     print(f"{'packing':>8} {'A M/s':>8} {'B M/s':>8} {'B/A (A first)':>14} {'B/A (B first)':>14} "

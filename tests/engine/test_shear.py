@@ -255,6 +255,38 @@ def test_bad_boundaries_under_shear():
         Shear(1.0, temperature=1.0)
 
 
+@pytest.mark.parametrize("nx", [3, 4, 5, 8, 13])
+def test_y_crossing_scans_every_column_that_becomes_adjacent(nx):
+    """A crossing of a y face keeps the stored best pair and scans the columns of
+    engine._shear._y_layer only. Every column of the new neighbourhood (3 of the own row, 4 of
+    each adjacent row's window) that was not in the old one must be among them: for every
+    column, slide offset m and direction, and for the landing column expected from the
+    geometry (cx - m - 1 or cx - m up, cx + m or cx + m + 1 down) as well as one beyond on
+    either side (round-off at a face). In the expected case the scan is the row ahead and one
+    column of the row left behind, not both windows."""
+    from granulargas.engine._shear import _y_layer
+
+    def run(c0, n):
+        return {(c0 + u) % nx for u in range(max(n, 0))}
+
+    for o in (1, -1):
+        for m in range(nx):
+            for cx in range(nx):
+                expected = (cx - m - 1, cx - m) if o > 0 else (cx + m, cx + m + 1)
+                for landed in range(expected[0] - 1, expected[1] + 2):
+                    cxn = landed % nx
+                    own0, own_n, back0, back_n, ahead0 = _y_layer(cx, cxn, o, m, nx)
+                    old_entered = run(cx - 2 - m, 4) if o > 0 else run(cx - 1 + m, 4)  # old window of the row entered
+                    old_own = run(cx - 1, 3)
+                    new_back = run(cxn - 1 + m, 4) if o > 0 else run(cxn - 2 - m, 4)
+                    new_ahead = run(cxn - 2 - m, 4) if o > 0 else run(cxn - 1 + m, 4)
+                    assert run(cxn - 1, 3) - old_entered <= run(own0, own_n)
+                    assert new_back - old_own <= run(back0, back_n)
+                    assert new_ahead <= run(ahead0, 4)
+                    if landed in expected and nx >= 8:
+                        assert own_n <= 0 and back_n == 1
+
+
 @pytest.mark.parametrize("mode", ["lists", "cells"])
 @pytest.mark.parametrize("dim", [2, 3])
 def test_two_spheres_at_rest_in_sliding_rows_collide(mode, dim):
