@@ -469,17 +469,17 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
                 xs = -1 if k < 0 else (1 if k >= sh.nx else 0)
                 c = _wrap(k, sh.nx) + ncell[0] * (g + ncell[1] * kz)
                 prefetch(cell_ids, c)
-                stencil[ns] = 64 * c + (o + 1) + 3 * (xs + 1) + 9 * (zs + 1)
+                stencil[ns] = 32 * c + (o + 1) + 3 * (xs + 1) + 9 * (zs + 1)
                 ns += 1
     if centre.shape[0] > PREFETCH_CENTRES_FROM:
         for k in range(ns):
-            c = stencil[k] >> 6
+            c = stencil[k] >> 5
             for q in range(cell_n[c]):
                 prefetch(centre, cell_ids[c, q])
     count = 0
     for k in range(ns):
-        c = stencil[k] >> 6
-        code = stencil[k] & 63
+        c = stencil[k] >> 5
+        code = stencil[k] & 31
         o = code % 3 - 1
         ys = ym if o < 0 else (yp if o > 0 else yq)
         qx = xm if o < 0 else (xp if o > 0 else xo)
@@ -697,21 +697,16 @@ def predict_crossing_le(i, t, rec, grid, space, sh):
                                 cell[i, 0], grid.width[0], space.ncell[0], sh.lx)
     face = side
     # the axis chosen without a branch, as in granulargas.engine._crossing.predict_crossing
-    g, v, sd = face_gap(rec[i, 1] - sh.ly, rec[i, 4], r, grid.width[1], space.ncell[1], sh.ly)
-    take = ((g * speed < gap * v) | (speed == 0.0)) & (v > 0.0)
-    s = np.float64(take)
-    q = 1.0 - s
-    gap = g * s + gap * q
-    speed = v * s + speed * q
-    face = 2 + sd if take else face
-    if space.dims == 3:
-        g, v, sd = face_gap(rec[i, 2], rec[i, 5], cell[i, 2], grid.width[2], space.ncell[2], space.period[2])
+    for a in range(1, space.dims):
+        sheared = a == 1  # y: through the sheared boundary (stored + L_y, period L_y)
+        g, v, sd = face_gap(rec[i, a] - (sh.ly if sheared else 0.0), rec[i, 3 + a], cell[i, a], grid.width[a],
+                            space.ncell[a], sh.ly if sheared else space.period[a])
         take = ((g * speed < gap * v) | (speed == 0.0)) & (v > 0.0)
         s = np.float64(take)
         q = 1.0 - s
         gap = g * s + gap * q
         speed = v * s + speed * q
-        face = 4 + sd if take else face
+        face = 2 * a + sd if take else face
     if speed == 0.0:
         return math.inf, face
     return t + gap / speed, face
