@@ -264,7 +264,7 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
     than reach these are the only ones i can overlap at its new place (triangle
     inequality), so the new overlaps are found without a second scan of the cells.
     """
-    m = 0
+    m = np.int64(0)  # not the literal 0: _overlap_partners(..., m) would be compiled for it too
     cap = near.shape[0]
     for k in range(idx.shape[0]):
         i = idx[k]
