@@ -60,8 +60,8 @@ is kept: passing ``np.int64(3)`` instead saves the copy but measured 3-4 % slowe
 paired comparison of the cell-crossing loop (``scripts/ab/paired.py``). A variable that
 starts as a constant and changes later (``m = 0`` ... ``m += 1``) is typed as that
 literal in type inference's first pass, so a compiled function it is passed to is
-compiled for the literal too, a copy no call uses: such variables start as
-``np.int64(0)``.
+compiled for the literal too, a copy no call uses (``compile_profile.py`` lists the
+functions compiled with several signatures); ``np.int64(0)`` as the start avoids it.
 
 Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function
