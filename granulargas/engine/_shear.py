@@ -104,7 +104,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from granulargas._numba import inlined, kernel
+from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._calendar import cal_update
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, PREFETCH_CENTRES_FROM, slot_insert, slot_remove
 from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, face_gap, grid_insert, grid_remove
@@ -439,7 +439,7 @@ def _col_entry(k, nx):
     return k, 3
 
 
-@kernel(python=False)
+@inlined_ir
 def collect_le(i, xo, yq, zq, r, phi, ri, rmax, m, shell, rec, lists, cells, space, sh):
     """Particles j != i whose centre (through the sheared images) comes within R_i + R_j +
     shell of the query point ((xo, yq, zq): x in the frame of its row r; ``phi`` =
