@@ -584,7 +584,7 @@ def collect_le(i, xo, yq, zq, r, phi, ri, rmax, m, shell, rec, lists, cells, spa
     return found
 
 
-@kernel(python=False)
+@inlined_ir
 def rebuild_list_le(i, t, rec, lists, cells, space, rmax, shell, sh):
     """:func:`granulargas.engine._cells.rebuild_list` with list centres that move with their
     rows (i at time t, inside [0, L_y)): new centre (x - s_r(t), y, z) in float32, its
