@@ -904,6 +904,8 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
     for k in range(nbn[i1]):
         prefetch(rec, nbl[i1, k])
     prefetch(cal.where, i1)
+    if prm.space.shear is not None:  # the list's build time, read by the expiry's prediction
+        prefetch(prm.space.shear.built, i1)
     i2 = cal_after_next(cal, p1)
     if i2 >= 0:
         prefetch(rec, i2)
@@ -912,6 +914,8 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
         prefetch(ev.partner, i2)
         prefetch(ev.tag, i2)
         prefetch(lists.centre, i2)
+        if prm.space.shear is not None:
+            prefetch(prm.space.shear.built, i2)
     return i2
 
 
