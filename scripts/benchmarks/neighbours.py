@@ -183,7 +183,6 @@ def main(argv=None):
 def record(results, args, argv, load, commit):
     """Write the engine's, the C code's and the chart's records into the results file; rewrite the page."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-    import performance_page
     import results as results_file
 
     words, skip = [], False
@@ -212,8 +211,7 @@ def record(results, args, argv, load, commit):
             records.append(dict(table="dilute", id=f"{r['mode']} packing {r['packing']:g} N={r['n']}", n=r["n"],
                                 packing=r["packing"], mode=r["mode"], width=round(width, 1),
                                 rate_cpu=round(r["rate"], 4), events_per_collision=round(r["events"], 2)))
-    results_file.record(records, command, load_average=load, commit=commit)
-    performance_page.main([])
+    results_file.record_and_render(records, command, load_average=load, commit=commit)
 
 
 def plot(results, path, title):

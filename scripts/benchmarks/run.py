@@ -337,13 +337,11 @@ def main(argv=None):
         records.append(rec)
         print(_show(rec), flush=True)
     if args.record and records:
-        import performance_page
         import results
 
         command = "python scripts/benchmarks/run.py " + " ".join(args.sets) + (
             f" --only {args.only!r}" if args.only else "")
-        results.record(records, command, load_average=max(load, os.getloadavg()[0]), commit=commit)
-        performance_page.main([])
+        results.record_and_render(records, command, load_average=max(load, os.getloadavg()[0]), commit=commit)
     return 0
 
 

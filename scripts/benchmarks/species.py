@@ -93,18 +93,15 @@ def main():
         import sys
 
         sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-        import performance_page
         import results
 
         scene = "mixture, one law for every pair" if args.law == "identical" else "mixture, a law per pair"
-        results.record([dict(table="scene_cost", id=f"{scene} {args.dim}D {args.mode} packing {args.packing:g} "
-                             f"N={args.n}", scene=scene, reference="polydisperse gas of the same particles",
-                             dim=args.dim, n=args.n, packing=args.packing, neighbours=args.mode,
-                             ratio=round(float(med), 3), quartiles=[round(float(q1), 3), round(float(q3), 3)],
-                             rounds=args.rounds)],
-                       "python scripts/benchmarks/species.py " + " ".join(sys.argv[1:]),
-                       load_average=max(load, os.getloadavg()[0]))
-        performance_page.main([])
+        rec = dict(table="scene_cost", id=f"{scene} {args.dim}D {args.mode} packing {args.packing:g} N={args.n}",
+                   scene=scene, reference="polydisperse gas of the same particles", dim=args.dim, n=args.n,
+                   packing=args.packing, neighbours=args.mode, ratio=round(float(med), 3),
+                   quartiles=[round(float(q1), 3), round(float(q3), 3)], rounds=args.rounds)
+        results.record_and_render([rec], "python scripts/benchmarks/species.py " + " ".join(sys.argv[1:]),
+                                  load_average=max(load, os.getloadavg()[0]))
 
 
 if __name__ == "__main__":

@@ -231,7 +231,6 @@ def main(argv=None):
 def record(args, rows, first, cached, argv, load, commit):
     """The medians as records of the results file (tables ``startup`` and ``compile``); rewrite the page."""
     sys.path.insert(0, HERE)
-    import performance_page
     import results
 
     records = []
@@ -249,9 +248,8 @@ def record(args, rows, first, cached, argv, load, commit):
         records.append(dict(table="compile", id=f"3D {mode}", neighbours=mode,
                             first_seconds=round(statistics.median(x[0] for x in f), 1),
                             cached_seconds=round(statistics.median(x[0] for x in cached[(tree, mode)]), 2)))
-    results.record(records, "python scripts/benchmarks/startup.py " + " ".join(argv), load_average=load,
-                   commit=commit)
-    performance_page.main([])
+    results.record_and_render(records, "python scripts/benchmarks/startup.py " + " ".join(argv), load_average=load,
+                              commit=commit)
 
 
 def _commit():
