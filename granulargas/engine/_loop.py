@@ -847,7 +847,7 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm, shear):
 
 
 @inlined_ir
-def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
+def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm, shear):
     """Prefetch hints for the next event, particle i1 (no effect on results).
 
     The rows of its partner, the records of its neighbours, for a list expiry the
@@ -880,6 +880,8 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
     for k in range(nbn[i1]):
         prefetch(rec, nbl[i1, k])
     prefetch(cal.where, i1)
+    if shear is not None:  # the list's build time, read by the expiry's prediction
+        prefetch(shear.built, i1)
     i2 = cal_after_next(cal, p1)
     if i2 >= 0:
         prefetch(rec, i2)
@@ -888,6 +890,8 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm):
         prefetch(ev.partner, i2)
         prefetch(ev.tag, i2)
         prefetch(lists.centre, i2)
+        if shear is not None:
+            prefetch(shear.built, i2)
     return i2
 
 
@@ -1034,7 +1038,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         guess = -1
         if i1 >= 0:
             if onlists is not None:
-                guess = prefetch_next_lists(i1, p, ev, lists, cells, cal, prm)
+                guess = prefetch_next_lists(i1, p, ev, lists, cells, cal, prm, shear)
             if oncells is not None:
                 guess = prefetch_next_cells(i1, p, ev, lists, cal, prm, shear)
         clock = tick(probe, PREFETCH, clock)

@@ -104,7 +104,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from granulargas._numba import inlined, kernel
+from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._calendar import cal_update
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, PREFETCH_CENTRES_FROM, slot_insert, slot_remove
 from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, face_gap, grid_insert, grid_remove
@@ -396,22 +396,67 @@ def _centre_cell(centre, i, sh, ncell, box):
                                                             + ncell[1] * cz)
 
 
-@kernel(python=False)
-def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space, sh):
-    """Particles j != i whose centre (at t, through the sheared images) comes within
-    R_i + R_j + shell of the query point (laboratory (xq, yq, zq) at t, in row r) while the
-    rows slide by the margin D (:func:`slid`, eq. 3), into ``lists.scratch``: 3 columns of
-    its own row and 4 of rows r - 1 and r + 1 (in their frames), times 3 along z (none
-    beyond a wall on z). Returns the number, or -1 if more than m or the scratch is short.
+@inlined
+def row_step(t, sh):
+    """phi = a w_y t mod L_x in [0, L_x): s_(r+1)(t) - s_r(t) (mod L_x) for every row r, the
+    image of row 0 above the box (r + 1 = n_y) included (eq. 2 is linear in r)."""
+    return _reduce(sh.rate * sh.wy * t, sh.lx)
+
+
+@inlined
+def _sq_gap(g):
+    return g * g if g > 0.0 else 0.0
+
+
+@inlined
+def _row_columns(xr, o, sh):
+    """The columns of row r + o that a list search scans around the query point ``xr`` (in
+    that row's frame): first column (unwrapped) and the squared x gaps of up to 4
+    columns, inf for a column not scanned. Own row (o = 0): 3 columns; row r + 1: the 4
+    from cut behind to cut + D ahead (the two behind come D nearer while the rows slide,
+    :func:`slid`), row r - 1 the mirror image; a row of 3 columns whole, once."""
+    w = sh.wx
+    c0 = col_of(xr, sh)
+    lo = xr - c0 * w
+    hi = (c0 + 1) * w - xr
+    if o == 0:
+        return c0 - 1, _sq_gap(lo), 0.0, _sq_gap(hi), math.inf
+    if sh.nx < 4:
+        return 0, 0.0, 0.0, 0.0, math.inf
+    d = sh.margin
+    if o > 0:
+        return c0 - 2, _sq_gap(lo + w - d), _sq_gap(lo - d), 0.0, _sq_gap(hi)
+    return c0 - 1, _sq_gap(lo), 0.0, _sq_gap(hi - d), _sq_gap(hi + w - d)
+
+
+@inlined
+def _col_entry(k, nx):
+    """Wrapped column of unwrapped column k and its code 3 (x shift + 1) (stencil entries)."""
+    if k < 0:
+        return k + nx, 0
+    if k >= nx:
+        return k - nx, 6
+    return k, 3
+
+
+@inlined_ir
+def collect_le(i, xo, yq, zq, r, phi, ri, rmax, m, shell, rec, lists, cells, space, sh):
+    """Particles j != i whose centre (through the sheared images) comes within R_i + R_j +
+    shell of the query point ((xo, yq, zq): x in the frame of its row r; ``phi`` =
+    :func:`row_step` at the present time) while the rows slide by the margin D
+    (:func:`slid`, eq. 3), into ``lists.scratch``: 3 columns of its own row and 4 of rows
+    r - 1 and r + 1 (in their frames), times 3 along z (none beyond a wall on z). Returns
+    the number, or -1 if more than m or the scratch is short.
 
     Passes, as :func:`granulargas.engine._cells._collect`: (1) the cells the slid cut-off can
     reach into ``lists.stencil`` (cell, row, and the periodic shifts of its column and
-    layer), each cell's row of ids prefetched; (2) a prefetch of every candidate's centre
-    (large systems); (3) the branch-free distance tests, with the query point shifted by
-    the cell's periodic offset (no minimum image: a scanned column or layer is the nearest
+    layer), branch-free (every cell written, the count advancing on a reach), then each
+    cell's row of ids prefetched; (2) a prefetch of every candidate's centre (large
+    systems); (3) the branch-free distance tests, with the query point shifted by the
+    cell's periodic offset (no minimum image: a scanned column or layer is the nearest
     image when the row has at least 6 columns and z at least 4 layers, or none to wrap;
-    otherwise the minimum image is taken); (4) the hits compacted, with the exact cut-off for partners
-    smaller than R_max."""
+    otherwise the minimum image is taken); (4) the hits compacted, with the exact cut-off
+    for partners smaller than R_max."""
     scratch = lists.scratch
     stencil = lists.stencil
     centre = lists.centre
@@ -432,45 +477,53 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
     wz = box[2] / ncell[2]
     lim = cut_max * (1.0 + 1e-9) + 1e-12 * (sh.lx + sh.ly + box[2])
     lim2 = lim * lim
-    # the query point in the frames of rows r - 1, r, r + 1 (x) and through the sheared
-    # boundary (y)
-    xm = _reduce(xq - row_offset(r - 1, t, sh), sh.lx)
-    xo = _reduce(xq - row_offset(r, t, sh), sh.lx)
-    xp = _reduce(xq - row_offset(r + 1, t, sh), sh.lx)
+    # the query point in the frames of rows r - 1 and r + 1 (x: s_(r+-1) = s_r +- phi) and
+    # through the sheared boundary (y)
+    xp = xo - phi
+    xp = xp + sh.lx if xp < 0.0 else xp
+    xm = xo + phi
+    xm = xm - sh.lx if xm >= sh.lx else xm
     ym = yq + (sh.ly if r - 1 < 0 else 0.0)
     yp = yq - (sh.ly if r + 1 >= sh.ny else 0.0)
+    # z layers: squared gaps, wrapped layer offsets and codes 9 (z shift + 1); none beyond a wall
+    nxy = ncell[0] * ncell[1]
+    zwall = period[2] == math.inf
+    gzl = _sq_gap(zq - cz * wz)
+    gzh = _sq_gap((cz + 1) * wz - zq)
+    gzl = math.inf if zwall and cz == 0 else gzl
+    gzh = math.inf if zwall and cz == ncell[2] - 1 else gzh
+    kzl = nxy * (cz - 1 + (ncell[2] if cz == 0 else 0))
+    kzh = nxy * (cz + 1 - (ncell[2] if cz == ncell[2] - 1 else 0))
+    czl = 9 if cz > 0 else 0
+    czh = 9 if cz < ncell[2] - 1 else 18
     ns = 0
     for o in range(-1, 2):
         rho = r + o
         g = _wrap(rho, sh.ny)
         ys = ym if o < 0 else (yp if o > 0 else yq)
         gy = _gap(ys, g * sh.wy, sh.wy)
-        xi = xm if o < 0 else (xp if o > 0 else xo)
-        c0 = col_of(xi, sh)
-        x0, ncol = _columns(c0, o, sh.nx)
+        gy2 = gy * gy
+        xr = xm if o < 0 else (xp if o > 0 else xo)
+        x0, g0, g1, g2, g3 = _row_columns(xr, o, sh)
+        k0, s0 = _col_entry(x0, sh.nx)
+        k1, s1 = _col_entry(x0 + 1, sh.nx)
+        k2, s2 = _col_entry(x0 + 2, sh.nx)
+        k3, s3 = _col_entry(x0 + 3, sh.nx)
         for oz in range(-zr, zr + 1):
-            kz = cz + oz
-            gz = _gap(zq, kz * wz, wz) if zr > 0 else 0.0
-            zs = 0
-            if kz < 0 or kz >= ncell[2]:
-                if period[2] == math.inf:
-                    continue
-                zs = -1 if kz < 0 else 1
-                kz = _wrap(kz, ncell[2])
-            for ox in range(ncol):
-                gx = 0.0
-                k = x0 + ox
-                if o == 0 or sh.nx >= 4:  # distinct unwrapped columns: their gaps hold
-                    gx = _gap(xi, k * sh.wx, sh.wx)
-                    if (o > 0 and k < c0) or (o < 0 and k > c0):
-                        gx = gx - sh.margin if gx > sh.margin else 0.0
-                if gx * gx + gy * gy + gz * gz >= lim2:
-                    continue
-                xs = -1 if k < 0 else (1 if k >= sh.nx else 0)
-                c = _wrap(k, sh.nx) + ncell[0] * (g + ncell[1] * kz)
-                prefetch(cell_ids, c)
-                stencil[ns] = 32 * c + (o + 1) + 3 * (xs + 1) + 9 * (zs + 1)
-                ns += 1
+            gz = gzl if oz < 0 else (gzh if oz > 0 else 0.0)
+            kz = kzl if oz < 0 else (kzh if oz > 0 else nxy * cz)
+            code = 32 * (kz + ncell[0] * g) + (o + 1) + (czl if oz < 0 else (czh if oz > 0 else 9))
+            gyz = gy2 + gz
+            stencil[ns] = code + 32 * k0 + s0
+            ns += g0 + gyz < lim2
+            stencil[ns] = code + 32 * k1 + s1
+            ns += g1 + gyz < lim2
+            stencil[ns] = code + 32 * k2 + s2
+            ns += g2 + gyz < lim2
+            stencil[ns] = code + 32 * k3 + s3
+            ns += g3 + gyz < lim2
+    for k in range(ns):
+        prefetch(cell_ids, stencil[k] >> 5)
     if centre.shape[0] > PREFETCH_CENTRES_FROM:
         for k in range(ns):
             c = stencil[k] >> 5
@@ -517,8 +570,8 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
                 if _wrap(rho, sh.ny) != g:
                     continue
                 ys = ym if o < 0 else (yp if o > 0 else yq)
-                xi = xm if o < 0 else (xp if o > 0 else xo)
-                dx = slid(min_image(xi - centre[j, 0], sh.lx), o, sh.margin)
+                xr = xm if o < 0 else (xp if o > 0 else xo)
+                dx = slid(min_image(xr - centre[j, 0], sh.lx), o, sh.margin)
                 dy = ys - centre[j, 1]
                 dz = min_image(zq - centre[j, 2], period[2])
                 best = min(best, dx * dx + dy * dy + dz * dz)
@@ -531,7 +584,7 @@ def collect_le(i, t, xq, yq, zq, r, ri, rmax, m, shell, rec, lists, cells, space
     return found
 
 
-@kernel(python=False)
+@inlined_ir
 def rebuild_list_le(i, t, rec, lists, cells, space, rmax, shell, sh):
     """:func:`granulargas.engine._cells.rebuild_list` with list centres that move with their
     rows (i at time t, inside [0, L_y)): new centre (x - s_r(t), y, z) in float32, its
@@ -554,14 +607,13 @@ def rebuild_list_le(i, t, rec, lists, cells, space, rmax, shell, sh):
     if xi >= sh.lx:
         xi = 0.0
         xi32 = np.float32(0.0)
-    xq = _reduce(xi + row_offset(r, t, sh), sh.lx)
     cz = int(zq * (ncell[2] / space.box[2]))
     cz = min(max(cz, 0), ncell[2] - 1)
     c = col_of(xi, sh) + ncell[0] * (r + ncell[1] * cz)
     if c != was and cell_n[c] >= cell_ids.shape[1]:
         return CELL_OVERFLOW
     m = nbl.shape[1]
-    count = collect_le(i, t, xq, yq, zq, r, rec[i, 7], rmax, m, shell, rec, lists, cells, space, sh)
+    count = collect_le(i, xi, yq, zq, r, row_step(t, sh), rec[i, 7], rmax, m, shell, rec, lists, cells, space, sh)
     if count < 0:
         return OVERFLOW
     nold = nbn[i]

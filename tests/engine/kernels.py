@@ -156,3 +156,16 @@ def rough_wall(v, w, n, mi, ki, ri, eps, model, beta, mu):
     w[1] += si * cy
     w[2] += si * cz
     return loss, momentum
+
+
+# ---- the Lees-Edwards list rebuild (granulargas.engine._shear)
+from granulargas.engine import _shear  # noqa: E402
+
+
+@jit
+def rebuild_list_le_now(i, t, rec, img, lists, cells, space, flight, rmax, shell, sh):
+    """Particle i streamed to t, back inside the box through the sheared boundary, and its list
+    rebuilt there (what a list expiry does)."""
+    _flight.stream(i, t, rec, img, space.period, flight)
+    _shear.le_wrap(i, t, rec, img, sh)
+    return _shear.rebuild_list_le(i, t, rec, lists, cells, space, rmax, shell, sh)
