@@ -31,7 +31,19 @@ whose code only its caller needs, that is work done twice, and IR inlining
 does it once. At several call sites (or nested several levels deep) the copies
 and the typing repeat at each and cost more than the library saves: the loop's
 per-event steps (one call site in each build of the loop) are of this kind,
-the shared helpers are :func:`inlined` or plain kernels.
+the shared helpers are :func:`inlined` or plain kernels. The copy is made in
+Python (numba deep-copies the callee's IR blocks and runs its untyped passes,
+its own IR inlining included), so a large callee with IR-inlined callees of its
+own can cost more to inline than to compile once more as a library: the list
+rebuild, inlined this way into the list loop, added 1.3 s to the loop's
+inlining pass against 0.8-1.2 s for its own library, and stays a real call.
+
+Features switched off by a None-typed argument (contacts, spins, species, the
+profiler's probe) are small :func:`inlined` kernels that branch on
+``x is None`` for their own argument, which numba prunes before typing. Numba
+overloads would do the same, but their implementations (lambdas made when the
+overload is resolved) cannot be cached: every process that compiles a loop
+compiled them again.
 
 No function here has numba's C-callable wrapper (``no_cfunc_wrapper``): it serves a
 function passed as a first-class function value (``FunctionType``), which the package
@@ -45,7 +57,11 @@ and compiled once per distinct constant and once more for a variable argument: a
 of the cell scans' and the calendar's kernels are compiled twice for that reason
 (``scripts/profiling/compile_profile.py`` lists them). Their constant-specialised code
 is kept: passing ``np.int64(3)`` instead saves the copy but measured 3-4 % slower in a
-paired comparison of the cell-crossing loop (``scripts/ab/paired.py``).
+paired comparison of the cell-crossing loop (``scripts/ab/paired.py``). A variable that
+starts as a constant and changes later (``m = 0`` ... ``m += 1``) is typed as that
+literal in type inference's first pass, so a compiled function it is passed to is
+compiled for the literal too, a copy no call uses (``compile_profile.py`` lists the
+functions compiled with several signatures); ``np.int64(0)`` as the start avoids it.
 
 Every function here is compiled with ``forceinline`` set explicitly (False
 unless :func:`inlined`): numba otherwise inherits the flag from the function

@@ -32,8 +32,8 @@ part is bit-identical).
 Cache: tables are stored as ``.npz`` in ``$GRANULARGAS_CACHE_DIR`` (default
 ``~/.cache/granulargas``), keyed by a hash of the build parameters (end, grid,
 integrator order and tolerance, format version). The file holds the largest table
-built so far for that key; smaller requests are slices of it, larger ones rebuild
-and replace it. An unreadable or mismatching file is rebuilt.
+built so far for that key; smaller requests are slices of it, larger ones build the
+missing intervals only and replace it. An unreadable or mismatching file is rebuilt.
 """
 
 from __future__ import annotations
@@ -156,9 +156,13 @@ def _hermite(f0, f1, d0, d1):
     return c
 
 
-def _build(n: int, h: float, end: str):
-    """Coefficients for n intervals of width h in s, plus midpoint errors."""
-    s = np.arange(n + 1) * h
+def _build(n: int, h: float, end: str, first: int = 0):
+    """Coefficients for intervals ``first`` .. n - 1 of width h in s, plus midpoint errors.
+
+    Every node is solved on its own (:mod:`granulargas.contact._taylor_np`), so the rows of
+    intervals ``first`` .. n - 1 are bit for bit those of a build from 0 (a cached table is
+    extended by building its new intervals only)."""
+    s = np.arange(first, n + 1) * h
     rows = solve_many(s * s, end, backend="numpy")
     eps, tau = rows[:, 0], rows[:, 1]
     deps = 2.0 * s * rows[:, 2] * h  # d/dt = h d/ds = 2 s h d/dbeta
@@ -166,7 +170,7 @@ def _build(n: int, h: float, end: str):
     c_eps = _hermite(eps[:-1], eps[1:], deps[:-1], deps[1:])
     c_tau = _hermite(tau[:-1], tau[1:], dtau[:-1], dtau[1:])
     # verify at interval midpoints (where the Hermite error peaks) against the ODE
-    mid = solve_many(((np.arange(n) + 0.5) * h) ** 2, end, backend="numpy")
+    mid = solve_many(((np.arange(first, n) + 0.5) * h) ** 2, end, backend="numpy")
     half = np.array([1.0, 0.5, 0.25, 0.125])
     err_eps = np.abs(c_eps @ half - mid[:, 0])
     err_tau = np.abs(c_tau @ half - mid[:, 1]) / np.maximum(1.0, mid[:, 1])
@@ -215,8 +219,9 @@ def save_cached(path: Path, key_params: dict, **arrays) -> None:
 
 
 def _load(path: Path, key_params: dict, n: int):
+    """The cached table's first n intervals, or all of them when it has fewer (None: no table)."""
     data = load_cached(path, key_params)
-    if data is None or "coeffs" not in data or data["coeffs"].shape[0] < n:
+    if data is None or "coeffs" not in data:
         return None
     try:
         return (np.ascontiguousarray(data["coeffs"][:n]), np.ascontiguousarray(data["duration_coeffs"][:n]),
@@ -262,8 +267,10 @@ def restitution_table(beta_max: float, end: str = "overlap",
     key_params = _key_parameters(end, intervals_per_unit)
     path = _cache_file(key_params)
     built = _load(path, key_params, n) if use_cache else None
-    if built is None:
-        built = _build(n, h, end)
+    have = 0 if built is None else built[0].shape[0]
+    if have < n:  # the cached table's intervals and the new ones (bit for bit a build from 0)
+        more = _build(n, h, end, first=have)
+        built = more if built is None else tuple(np.concatenate(pair) for pair in zip(built, more))
         if use_cache:
             _save(path, key_params, *built)
     c_eps, c_tau, err_eps, err_tau = built

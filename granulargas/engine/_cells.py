@@ -279,7 +279,7 @@ def _collect(i, x, y, z, ri, rmax, m, shell, rec, lists, cells, space):
     return found
 
 
-@kernel(python=False)
+@inlined_ir
 def prefetch_cells(x, y, z, cut, space, cells, stencil):
     """Prefetch hints for the cell rows a list rebuild around (x, y, z) will read.
 

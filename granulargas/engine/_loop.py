@@ -79,8 +79,6 @@ simultaneous events than the event calendar's window holds.
 import math
 
 import numpy as np
-from numba import types
-from numba.extending import overload
 
 from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._calendar import (
@@ -253,76 +251,54 @@ def predict_pair_except(i, t, before, rec, nbl, nbn, period, contacts, flight):
     return best, p
 
 
+@inlined
 def in_contact(contacts, i, t):
     """Whether particle i's contact is under way at t (always False without contacts:
     ``contacts`` is None for the instantaneous rules, so that their loop compiles
     without any of the resolved rule's code)."""
+    if contacts is None:
+        return False
+    return contacts.until[i] > t
 
 
+@inlined
 def predict_pair_contact(i, t, before, rec, lists, period, contacts, flight):
     """:func:`predict_pair_except` (``contacts`` None: never called, returns (before, -1))."""
+    if contacts is None:
+        return before, np.int64(-1)
+    return predict_pair_except(i, t, before, rec, lists.nbl, lists.nbn, period, contacts, flight)
 
 
+@inlined
 def collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
     """:func:`granulargas.engine._resolved.resolved_pair` (``contacts`` None: never called)."""
+    if contacts is None:
+        return 0
+    return resolved_pair(i, j, te, dx, dy, dz, p, contacts, c, rule, period)
 
 
-@overload(in_contact)
-def _in_contact(contacts, i, t):
-    if isinstance(contacts, types.NoneType):
-        return lambda contacts, i, t: False
-    return lambda contacts, i, t: contacts.until[i] > t
-
-
-@overload(predict_pair_contact)
-def _predict_pair_contact(i, t, before, rec, lists, period, contacts, flight):
-    if isinstance(contacts, types.NoneType):
-        return lambda i, t, before, rec, lists, period, contacts, flight: (before, np.int64(-1))
-    return lambda i, t, before, rec, lists, period, contacts, flight: predict_pair_except(
-        i, t, before, rec, lists.nbl, lists.nbn, period, contacts, flight)
-
-
-@overload(collide_resolved)
-def _collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period):
-    if isinstance(contacts, types.NoneType):
-        return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: 0
-    return lambda i, j, te, dx, dy, dz, p, contacts, c, rule, period: resolved_pair(
-        i, j, te, dx, dy, dz, p, contacts, c, rule, period)
-
-
+@inlined
 def collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
     """:func:`granulargas.engine._spin.rough_pair` (``spins`` None: never called)."""
+    if spins is None:
+        return 0.0, 0.0, 0.0
+    return rough_pair(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic)
 
 
+@inlined
 def bounce_rough(i, a, side, eps, rec, mass, spins, elastic):
     """:func:`granulargas.engine._spin.rough_wall` (``spins`` None: never called)."""
+    if spins is None:
+        return 0.0, 0.0, 0.0
+    return rough_wall(i, a, side, eps, rec, mass, spins, elastic)
 
 
+@inlined
 def kick_rough(rec, mass, ident, dims, spins, seed, step):
     """:func:`granulargas.engine._spin.kick_spins` (``spins`` None: never called)."""
-
-
-@overload(collide_rough)
-def _collide_rough(i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic):
-    if isinstance(spins, types.NoneType):
-        return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
-    return lambda i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic: rough_pair(
-        i, j, nx, ny, nz, un, eps, rec, mass, spins, elastic)
-
-
-@overload(bounce_rough)
-def _bounce_rough(i, a, side, eps, rec, mass, spins, elastic):
-    if isinstance(spins, types.NoneType):
-        return lambda i, a, side, eps, rec, mass, spins, elastic: (0.0, 0.0, 0.0)
-    return lambda i, a, side, eps, rec, mass, spins, elastic: rough_wall(i, a, side, eps, rec, mass, spins,
-                                                                         elastic)
-
-
-@overload(kick_rough)
-def _kick_rough(rec, mass, ident, dims, spins, seed, step):
-    if isinstance(spins, types.NoneType):
-        return lambda rec, mass, ident, dims, spins, seed, step: 0.0
-    return lambda rec, mass, ident, dims, spins, seed, step: kick_spins(rec, mass, ident, dims, spins, seed, step)
+    if spins is None:
+        return 0.0
+    return kick_spins(rec, mass, ident, dims, spins, seed, step)
 
 
 @inlined
@@ -870,7 +846,7 @@ def prefetch_next_cells(i1, p, ev, grid, cal, prm, shear):
     return i2
 
 
-@inlined
+@inlined_ir
 def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm, shear):
     """Prefetch hints for the next event, particle i1 (no effect on results).
 

@@ -2,8 +2,8 @@
 
 The loop takes an argument ``probe``: ``None`` in production, or an int64 array
 (:data:`PROBE_SIZE`) in the profiler (``scripts/profiling/profile_loop.py``). The
-functions here are numba overloads whose code depends on that argument's
-*type*: for ``None`` they compile to nothing, so the production build of the
+functions here branch on ``probe is None``, which numba resolves by the argument's
+*type* before it types the function: for ``None`` they compile to nothing, so the production build of the
 loop is the loop without counters; for an array they read the CPU cycle counter
 (``llvm.readcyclecounter``) and add the cycles since the previous probe to the
 part of the event that just ended. The same source thus gives two builds, and
@@ -16,7 +16,9 @@ the calls of part k):
 from llvmlite import ir
 from numba import types
 from numba.core import cgutils
-from numba.extending import intrinsic, overload
+from numba.extending import intrinsic
+
+from granulargas._numba import inlined
 
 POP, COLLIDE, REBUILD, WALL, STALE, PREDICT, UPDATE, PREFETCH, PEEK, GLOBAL = range(10)
 PART_NAMES = ["pop + validate", "collide (+ partner)", "list rebuild", "wall", "stale",
@@ -40,47 +42,30 @@ def _cycles(typingctx):
     return types.int64(), codegen
 
 
+@inlined
 def probe_start(probe):
     """Cycle counter now (0 without a probe array)."""
+    if probe is None:
+        return 0
+    return _cycles()
 
 
+@inlined
 def probe(probe, part, clock):
     """Add the cycles since ``clock`` to ``part``; returns the new clock (no-op without probe)."""
+    if probe is None:
+        return clock
+    now = _cycles()
+    probe[part] += now - clock
+    probe[PARTS + part] += 1
+    return now
 
 
+@inlined
 def probe_guess(probe, right):
     """Count one guess of the event after next, and whether it was ``right``."""
-
-
-@overload(probe_start)
-def _probe_start(probe):
-    if isinstance(probe, types.NoneType):
-        return lambda probe: 0
-    return lambda probe: _cycles()
-
-
-@overload(probe)
-def _probe(probe, part, clock):
-    if isinstance(probe, types.NoneType):
-        return lambda probe, part, clock: clock
-
-    def impl(probe, part, clock):
-        now = _cycles()
-        probe[part] += now - clock
-        probe[PARTS + part] += 1
-        return now
-
-    return impl
-
-
-@overload(probe_guess)
-def _probe_guess(probe, right):
-    if isinstance(probe, types.NoneType):
-        return lambda probe, right: None
-
-    def impl(probe, right):
-        probe[GUESSES] += 1
-        if right:
-            probe[GUESSED] += 1
-
-    return impl
+    if probe is None:
+        return
+    probe[GUESSES] += 1
+    if right:
+        probe[GUESSED] += 1

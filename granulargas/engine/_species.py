@@ -10,74 +10,49 @@ a lookup is one multiply-add and one load), per species the wall's ``wall_eps[s]
 ``wall_prefactor[s]``, and the pair collision counts ``pairs[q]`` (both orders; the driver
 adds q and its transpose).
 
-Every function here takes ``species`` as None or a ``Species`` record and is resolved
-by its type when the loop is compiled (numba ``overload``), like the contacts of the
-resolved rule: with None the lookup returns the one law's own scalars -- the very values
+Every function here takes ``species`` as None or a ``Species`` record and branches on
+``species is None``, which numba resolves by the argument's type before it types the
+function (as for the contacts of the resolved rule): with None the lookup returns the one law's own scalars -- the very values
 the one-component loop reads -- the weight is 1 and the count does nothing, so a run
 without species compiles to the loop it had without this module. The restitution itself
 then comes from :func:`granulargas.engine._collide.restitution` with the pair's values,
 for the engine and the DSMC alike.
 """
 
-from numba import types
-from numba.extending import overload
+from granulargas._numba import inlined
 
 
+@inlined
 def pair_law(eps, prefactor, species, i, j):
     """(eps, prefactor) of the pair of slots i, j: the one law's constant restitution ``eps``
     and viscoelastic ``prefactor``, or the pair's entries of the species table."""
+    if species is None:
+        return eps, prefactor
+    q = species.of[i] * species.count + species.of[j]
+    return species.eps[q], species.prefactor[q]
 
 
+@inlined
 def wall_law(eps, prefactor, species, i):
     """(eps, prefactor) of a collision of slot i with a wall: the one law's wall restitution
     ``eps`` and ``prefactor``, or those of i's species."""
+    if species is None:
+        return eps, prefactor
+    s = species.of[i]
+    return species.wall_eps[s], species.wall_prefactor[s]
 
 
+@inlined
 def pair_weight(species, i, j):
     """The DSMC's acceptance weight chi_ij / max chi of the pair (1.0 without species)."""
+    if species is None:
+        return 1.0
+    return species.weight[species.of[i] * species.count + species.of[j]]
 
 
+@inlined
 def count_pair(species, i, j):
     """Count a collision of slots i and j in the species-pair table (None: nothing)."""
-
-
-@overload(pair_law)
-def _pair_law(eps, prefactor, species, i, j):
-    if isinstance(species, types.NoneType):
-        return lambda eps, prefactor, species, i, j: (eps, prefactor)
-
-    def impl(eps, prefactor, species, i, j):
-        q = species.of[i] * species.count + species.of[j]
-        return species.eps[q], species.prefactor[q]
-    return impl
-
-
-@overload(wall_law)
-def _wall_law(eps, prefactor, species, i):
-    if isinstance(species, types.NoneType):
-        return lambda eps, prefactor, species, i: (eps, prefactor)
-
-    def impl(eps, prefactor, species, i):
-        s = species.of[i]
-        return species.wall_eps[s], species.wall_prefactor[s]
-    return impl
-
-
-@overload(pair_weight)
-def _pair_weight(species, i, j):
-    if isinstance(species, types.NoneType):
-        return lambda species, i, j: 1.0
-
-    def impl(species, i, j):
-        return species.weight[species.of[i] * species.count + species.of[j]]
-    return impl
-
-
-@overload(count_pair)
-def _count_pair(species, i, j):
-    if isinstance(species, types.NoneType):
-        return lambda species, i, j: None
-
-    def impl(species, i, j):
-        species.pairs[species.of[i] * species.count + species.of[j]] += 1
-    return impl
+    if species is None:
+        return
+    species.pairs[species.of[i] * species.count + species.of[j]] += 1

@@ -31,7 +31,7 @@ import math
 import numba
 import numpy as np
 
-from granulargas._numba import inlined, jit
+from granulargas._numba import inlined, inlined_ir, jit
 from granulargas.engine._cells import _wrap, cell_coord, cell_index, cell_insert, cell_remove
 from granulargas.engine._geometry import min_image
 
@@ -210,7 +210,7 @@ def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of,
     return overlapping
 
 
-@jit
+@inlined_ir
 def _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, out, m):
     """Append i's overlap partners to out[m:], return the new length."""
     cx = cell_coord(x, box[0], ncell[0])

@@ -543,13 +543,23 @@ def _equivalent_prefactor(gas: V.Gas, eps: float) -> float | None:
         return V.effective_inelasticity(g, gas.temperature) - target
 
     # bracket in beta = b g^(1/5) at the thermal impact speed g ~ sqrt(2 T / m) of the gas's
-    # particles, b = k (R_eff / m_eff^2)^(1/5) their pair constant
+    # particles, b = k (R_eff / m_eff^2)^(1/5) their pair constant. The upper end grows from
+    # beta = 0.25 (eps_eff ~ 0.77) to 20 until it brackets the root (f grows with k): each f
+    # needs the restitution table up to the largest beta of the quadrature nodes, and building
+    # it up to beta ~ 30 for a mildly inelastic gas would cost more than the rest of the advice.
     g_thermal = math.sqrt(2.0 * gas.temperature / gas.mass)
     scale = replace(gas, model="viscoelastic", prefactor=1.0).pair_constant * g_thermal**0.2
-    lo, hi = math.log(1e-8 / scale), math.log(20.0 / scale)
-    if not (math.isfinite(lo) and math.isfinite(hi)) or f(lo) * f(hi) > 0:
+    lo = math.log(1e-8 / scale)
+    if not math.isfinite(lo):
         return None
-    return math.exp(brentq(f, lo, hi, xtol=1e-10))
+    f_lo = f(lo)
+    for beta_hi in (0.25, 2.0, 20.0):
+        hi = math.log(beta_hi / scale)
+        if not math.isfinite(hi):
+            return None
+        if f_lo * f(hi) <= 0:
+            return math.exp(brentq(f, lo, hi, xtol=1e-10))
+    return None
 
 
 def _curve_through(gas: V.Gas, curve: V.CoolingCurve, t_end: float) -> V.CoolingCurve:

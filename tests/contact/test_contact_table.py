@@ -52,6 +52,30 @@ def test_built_fresh_equals_cached_slice(cache_dir, tmp_path, monkeypatch):
     np.testing.assert_array_equal(from_cache.duration_coeffs, big.duration_coeffs[: fresh.n_intervals])
 
 
+def test_cached_table_extended_by_its_new_intervals_only(cache_dir, tmp_path, monkeypatch):
+    """A larger request solves the ODE at the new nodes only and gives, bit for bit, the
+    table a build from 0 gives."""
+    from granulargas.contact import table as T
+
+    small = restitution_table(1.0)
+    solved = []
+    solve = T.solve_many
+
+    def counting(beta, *args, **kwargs):
+        solved.append(len(beta))
+        return solve(beta, *args, **kwargs)
+
+    monkeypatch.setattr(T, "solve_many", counting)
+    extended = restitution_table(4.0)
+    new = extended.n_intervals - small.n_intervals
+    assert solved == [new + 1, new]  # the new nodes (the shared one again) and midpoints
+    monkeypatch.setenv("GRANULARGAS_CACHE_DIR", str(tmp_path / "other"))
+    fresh = restitution_table(4.0)
+    np.testing.assert_array_equal(extended.coeffs, fresh.coeffs)
+    np.testing.assert_array_equal(extended.duration_coeffs, fresh.duration_coeffs)
+    assert extended.parameters == fresh.parameters
+
+
 def test_cache_keyed_by_parameters_and_rebuilt_when_bad(cache_dir):
     restitution_table(1.0)
     restitution_table(1.0, intervals_per_unit=64)

@@ -61,6 +61,36 @@ def test_best_constant_lies_inside_the_spread():
         assert A.constant_error(gas, adv.eps_best + de, curve, adv.t_end) > adv.error
 
 
+@pytest.mark.parametrize("eps, beta_limit", [(0.95, 0.5), (0.6, 4.0), (0.1, 40.0)])
+def test_equivalent_damping_needs_the_restitution_table_only_near_its_root(monkeypatch, eps, beta_limit):
+    """The root search asks for the table up to a beta of the order of the root's, not up to the
+    end of the search range (building the table to beta ~ 30 takes seconds), and finds the same
+    root as a search over the whole range."""
+    import granulargas.theory.gas as gas_theory
+    from scipy.optimize import brentq
+
+    gas = V.gas_from_config(config(f'model = "constant"\nrestitution = {eps}'))
+    asked = []
+    table = gas_theory.restitution_table
+
+    def recording(beta_max, *args, **kwargs):
+        asked.append(beta_max)
+        return table(beta_max, *args, **kwargs)
+
+    monkeypatch.setattr(gas_theory, "restitution_table", recording)
+    k = A._equivalent_prefactor(gas, eps)
+    assert max(asked) < beta_limit
+
+    def f(log_k):  # the search over the whole range, independently
+        g = A.replace(gas, model="viscoelastic", prefactor=math.exp(log_k))
+        return V.effective_inelasticity(g, gas.temperature) - (1 - eps**2)
+
+    unit = A.replace(gas, model="viscoelastic", prefactor=1.0)
+    scale = unit.pair_constant * math.sqrt(2 * gas.temperature / gas.mass) ** 0.2
+    assert k == pytest.approx(math.exp(brentq(f, math.log(1e-8 / scale), math.log(20 / scale), xtol=1e-12)),
+                              rel=1e-9)
+
+
 def test_constant_config_equivalent_damping():
     adv = A.advise(config('model = "constant"\nrestitution = 0.9'))
     # leading order: 1 - eps^2 = 2 C1 b Gamma(21/10) 4^(1/10) at T0 = 1
