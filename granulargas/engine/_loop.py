@@ -580,24 +580,37 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     return DONE
 
 
-@inlined_ir
-def execute_expiry(i, te, p, lists, cells, c, prm, shear):
-    """List expiry of i at te: a new list centre and neighbour list (OVERFLOW/CELL_OVERFLOW
-    if a list or a cell is full: nothing changed, the driver enlarges and calls again).
-    ``shear``: i first back inside [0, L_y) through the sheared boundary, the centre in its
-    row's frame (:func:`granulargas.engine._shear.rebuild_list_le`)."""
-    stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
-    if shear is not None:
-        c.sum_mv2 += p.mass[i] * le_wrap(i, te, p.rec, p.img, shear)
-        st = rebuild_list_le(i, te, p.rec, lists, cells, prm.space, prm.rmax, prm.shell, shear)
-    else:
-        st = rebuild_list(i, p.rec, lists, cells, prm.space, prm.rmax, prm.shell)
+@inlined
+def _expired(i, st, c):
+    """Count a list expiry whose rebuild returned ``st`` (0, or the error with i noted)."""
     if st != 0:
         c.err_i = i
         c.err_j = -1
         return st
     c.expiries += 1
     return DONE
+
+
+@inlined_ir
+def execute_expiry(i, te, p, lists, cells, c, prm):
+    """List expiry of i at te: a new list centre and neighbour list (OVERFLOW/CELL_OVERFLOW
+    if a list or a cell is full: nothing changed, the driver enlarges and calls again)."""
+    stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
+    return _expired(i, rebuild_list(i, p.rec, lists, cells, prm.space, prm.rmax, prm.shell), c)
+
+
+@inlined_ir
+def execute_expiry_le(i, te, p, lists, cells, c, prm, shear):
+    """:func:`execute_expiry` under Lees-Edwards boundaries: i first back inside [0, L_y)
+    through the sheared boundary, the centre in its row's frame
+    (:func:`granulargas.engine._shear.rebuild_list_le`, inlined at the level of its IR).
+    A function of its own, called under the loop's own ``shear is not None``: numba prunes
+    that branch of an unsheared loop before it inlines IR, whereas a branch on the argument
+    of an IR-inlined callee is pruned only after the inlining, and the sheared rebuild and
+    search would be copied and typed into every list loop (about 6 s of compile)."""
+    stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
+    c.sum_mv2 += p.mass[i] * le_wrap(i, te, p.rec, p.img, shear)
+    return _expired(i, rebuild_list_le(i, te, p.rec, lists, cells, prm.space, prm.rmax, prm.shell, shear), c)
 
 
 @inlined_ir
@@ -992,7 +1005,10 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
                 break
         elif j == EXPIRY or j == CROSS:  # the one of the two this mode has
             if onlists is not None:
-                status = execute_expiry(i, te, p, lists, cells, c, prm, shear)
+                if shear is not None:
+                    status = execute_expiry_le(i, te, p, lists, cells, c, prm, shear)
+                else:
+                    status = execute_expiry(i, te, p, lists, cells, c, prm)
             if oncells is not None:
                 status = execute_crossing(i, ev.tag[i], te, p, lists, c, prm, shear)
             clock = tick(probe, REBUILD, clock)
