@@ -887,23 +887,28 @@ class Simulation:
             self._engine = None
         return self
 
-    def _synchronised(self):
-        """Positions, images and velocities at ``time``, wrapped (particle-id order)."""
+    def _streamed(self):
+        """Positions, images and velocities at ``time``, wrapped, each (N, 3), in the engine's
+        (memory) order."""
         e = self._engine
-        n, d = self._positions.shape
+        n = self.n
         r = np.empty((n, 3))
         img = np.empty((n, 3), dtype=np.int32)
-        vel = np.empty((n, d))
+        v = np.empty((n, 3))
         if self.shear is None:
-            v = np.empty((n, 3))
             _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, self._flight(), r,
                                img, v)
-            vel[self._order] = v[:, :d]
         else:
-            v3 = np.empty((n, 3))
             _shear.synchronised_le(e.particles.rec, e.particles.img, self._space.period, self.time,
-                                   self._space.shear, r, img, v3)
-            vel[self._order] = v3[:, :d]
+                                   self._space.shear, r, img, v)
+        return r, img, v
+
+    def _synchronised(self):
+        """Positions, images and velocities at ``time``, wrapped (particle-id order)."""
+        r, img, v = self._streamed()
+        n, d = self._positions.shape
+        vel = np.empty((n, d))
+        vel[self._order] = v[:, :d]
         pos = np.empty((n, d))
         pos[self._order] = r[:, :d]
         im = np.empty((n, d), dtype=np.int64)
@@ -1103,18 +1108,10 @@ class Simulation:
         chunk of a sheared or gravity run more than the streaming itself."""
         if not self._built or (self.shear is None and self._flight() is None):
             return self._vm()
-        e, n = self._engine, self.n
-        r = np.empty((n, 3))
-        img = np.empty((n, 3), dtype=np.int32)
-        v = np.empty((n, 3))
-        if self.shear is None:
-            _loop.synchronised(e.particles.rec, e.particles.img, self._space.period, self.time, self._flight(), r,
-                               img, v)
-        else:
-            _shear.synchronised_le(e.particles.rec, e.particles.img, self._space.period, self.time,
-                                   self._space.shear, r, img, v)
+        r, _, v = self._streamed()
+        if self.shear is not None:
             v[:, 0] -= self.shear.rate * (r[:, 1] - 0.5 * self._box[1])
-        return v[:, : self.dimension], e.particles.mass
+        return v[:, : self.dimension], self._engine.particles.mass
 
     def _vm(self):
         if self.shear is not None:
