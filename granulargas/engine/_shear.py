@@ -107,7 +107,7 @@ import numpy as np
 from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._calendar import cal_update
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, PREFETCH_CENTRES_FROM, slot_insert, slot_remove
-from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, face_gap, grid_insert, grid_remove
+from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, earlier_face, face_gap, grid_insert, grid_remove
 from granulargas.engine._flight import stream
 from granulargas.engine._geometry import collision_delay, min_image
 from granulargas.engine._prefetch import prefetch
@@ -748,17 +748,12 @@ def predict_crossing_le(i, t, rec, grid, space, sh):
     gap, speed, side = face_gap(_reduce(rec[i, 0] - row_offset(r, t, sh), sh.lx), rec[i, 3] - row_speed(r, sh),
                                 cell[i, 0], grid.width[0], space.ncell[0], sh.lx)
     face = side
-    # the axis chosen without a branch, as in granulargas.engine._crossing.predict_crossing
+    # the earliest face, as in granulargas.engine._crossing.predict_crossing
     for a in range(1, space.dims):
         sheared = a == 1  # y: through the sheared boundary (stored + L_y, period L_y)
         g, v, sd = face_gap(rec[i, a] - (sh.ly if sheared else 0.0), rec[i, 3 + a], cell[i, a], grid.width[a],
                             space.ncell[a], sh.ly if sheared else space.period[a])
-        take = ((g * speed < gap * v) | (speed == 0.0)) & (v > 0.0)
-        s = np.float64(take)
-        q = 1.0 - s
-        gap = g * s + gap * q
-        speed = v * s + speed * q
-        face = 2 * a + sd if take else face
+        gap, speed, face = earlier_face(gap, speed, face, g, v, 2 * a + sd)
     if speed == 0.0:
         return math.inf, face
     return t + gap / speed, face
