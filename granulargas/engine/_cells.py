@@ -7,13 +7,15 @@ its list expires (an event). Invariant: for every pair with nearest-image
 Two particles not in each other's lists are therefore at least R_i + R_j apart
 at all times: they cannot touch. The argument holds for any point c_i within
 shell/2 of particle i, so rounding the centres costs nothing as long as every
-test (the full build, each rebuild, the expiry time) uses the same stored
-centres; it halves their memory (12 bytes per particle). When the list of i expires only i's list is rebuilt, from a
+test (each rebuild, the expiry time) uses the same stored centres; it halves
+their memory (12 bytes per particle). When the list of i expires only i's list is rebuilt, from a
 cell grid that holds the list centres (a row of slots per cell, one cache line
 for up to 16), and i is added to / removed from the lists of the neighbours
 that join or leave (Smallenburg, Eur. Phys. J. E 45, 22 (2022)). Cells are at
 least 2 R_max + shell wide, so the 27 (2D: 9) cells around c_i hold every
-candidate.
+candidate. A full build is every list expiring at once: the lists start empty and each
+rebuild adds its particle to the lists of its new neighbours
+(:meth:`granulargas.engine.simulation.Simulation._expire_all_lists`).
 
 Particle data come as one record per particle, ``rec[i] = (x, y, z, vx, vy,
 vz, t_i, R_i)`` (64 bytes, one cache line): positions at the particle's own
@@ -55,27 +57,6 @@ def cell_index(x, y, z, box, ncell):
     cy = cell_coord(y, box[1], ncell[1])
     cz = cell_coord(z, box[2], ncell[2])
     return cx + ncell[0] * (cy + ncell[1] * cz)
-
-
-@inlined
-def stencil_size(ncell):
-    """Cells around a point: 27 in 3D, 9 with a single layer in z (2D)."""
-    return 27 if ncell[2] >= 3 else 9
-
-
-@inlined
-def stencil_cell(cx, cy, cz, k, ncell):
-    """Flat index of the k-th cell around cell (cx, cy, cz), periodic.
-
-    k runs over ``stencil_size(ncell)`` cells with x fastest, then y, then z
-    (offsets -1, 0, 1; z offset 0 in 2D). No integer division by the grid size
-    (a run-time divisor costs ~30 cycles, three per cell): one conditional wrap.
-    """
-    zr = 1 if ncell[2] >= 3 else 0
-    kx = _wrap(cx + k % 3 - 1, ncell[0])
-    ky = _wrap(cy + (k // 3) % 3 - 1, ncell[1])
-    kz = _wrap(cz + k // 9 - zr, ncell[2])
-    return kx + ncell[0] * (ky + ncell[1] * kz)
 
 
 @inlined
@@ -392,68 +373,4 @@ def rebuild_list(i, rec, lists, cells, space, rmax, shell):
     centre[i, 0] = x
     centre[i, 1] = y
     centre[i, 2] = z
-    return 0
-
-
-@kernel
-def build_all_lists(r, rec, lists, cells, space, shell):
-    """Centres = positions ``r`` (= rec[:, :3], stored as float32), cells and all lists from scratch.
-
-    Returns 0, CELL_OVERFLOW if some cell holds more than ``cells.ids.shape[1]``
-    particles, or OVERFLOW if some list exceeds ``lists.nbl.shape[1]``.
-    """
-    centre = lists.centre
-    nbl = lists.nbl
-    nbn = lists.nbn
-    cell_ids = cells.ids
-    cell_n = cells.n
-    box = space.box
-    ncell = space.ncell
-    period = space.period
-    zr = 1 if ncell[2] >= 3 else 0
-    n = r.shape[0]
-    m = nbl.shape[1]
-    cell_n[:] = 0
-    for i in range(n):
-        centre[i, 0] = r[i, 0]
-        centre[i, 1] = r[i, 1]
-        centre[i, 2] = r[i, 2]
-        c = cell_index(np.float64(centre[i, 0]), np.float64(centre[i, 1]),
-                       np.float64(centre[i, 2]), box, ncell)
-        if cell_n[c] >= cell_ids.shape[1]:
-            return CELL_OVERFLOW
-        slot_insert(i, c, cell_ids, cell_n)
-    nbn[:] = 0
-    for i in range(n):
-        # every test uses the stored (float32) centres, as every later rebuild does
-        xi = np.float64(centre[i, 0])
-        yi = np.float64(centre[i, 1])
-        zi = np.float64(centre[i, 2])
-        cx = cell_coord(xi, box[0], ncell[0])
-        cy = cell_coord(yi, box[1], ncell[1])
-        cz = cell_coord(zi, box[2], ncell[2])
-        for k in range(stencil_size(ncell)):
-            # the k-th neighbour cell (stencil_cell), or none beyond a wall
-            ux = cx + k % 3 - 1
-            uy = cy + (k // 3) % 3 - 1
-            uz = cz + k // 9 - zr
-            if ((ux < 0 or ux >= ncell[0]) and period[0] == math.inf
-                    or (uy < 0 or uy >= ncell[1]) and period[1] == math.inf
-                    or (uz < 0 or uz >= ncell[2]) and period[2] == math.inf):
-                continue
-            c = _wrap(ux, ncell[0]) + ncell[0] * (_wrap(uy, ncell[1]) + ncell[1] * _wrap(uz, ncell[2]))
-            for q in range(cell_n[c]):
-                j = cell_ids[c, q]
-                if j > i:
-                    dx = min_image(xi - centre[j, 0], period[0])
-                    dy = min_image(yi - centre[j, 1], period[1])
-                    dz = min_image(zi - centre[j, 2], period[2])
-                    cut = rec[i, 7] + rec[j, 7] + shell
-                    if dx * dx + dy * dy + dz * dz < cut * cut:
-                        if nbn[i] >= m or nbn[j] >= m:
-                            return OVERFLOW
-                        nbl[i, nbn[i]] = j
-                        nbn[i] += 1
-                        nbl[j, nbn[j]] = i
-                        nbn[j] += 1
     return 0

@@ -24,8 +24,8 @@ from granulargas.contact.material import pair_constant
 from granulargas.contact.oblique import pair_compression_constant
 from granulargas.engine import _loop, _shear, _state
 from granulargas.engine._resolved import OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE
-from granulargas.engine._calendar import allocate_calendar, cal_build, cal_width
-from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, build_all_lists
+from granulargas.engine._calendar import PER_WINDOW, allocate_calendar, cal_build, cal_width
+from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW
 from granulargas.engine._crossing import FRESH_SIZE, MARGIN, build_grid, particle_rows
 from granulargas.engine._drive import kick_scale
 from granulargas.engine.driving import WhiteNoise
@@ -472,8 +472,10 @@ class Simulation:
         mean = n / volume * vol
         return int(min(n - 1, max(8, math.ceil(mean + 5.0 * math.sqrt(mean) + 4))))
 
-    def _build(self):
-        """Internal state from the public state (a pure function of it)."""
+    def _build(self, target=_INT_MAX):
+        """Internal state from the public state (a pure function of it). ``target``: the
+        collision count at which the present run stops (the lists mode's build runs the loop,
+        :meth:`_expire_all_lists`)."""
         n, d = self._positions.shape
         spc = self._space
         p3 = np.zeros((n, 3))
@@ -520,48 +522,131 @@ class Simulation:
         partner, tag, where, qt = _state.event_rows(n)
         events = _state.Events(partner=partner, tag=tag)
         centre = np.empty((n, 3), dtype=np.float32)  # list centres: see _cells
-        pos = np.ascontiguousarray(rec[:, :3])
         stencil = np.empty(27 if sh is None else 36, dtype=np.int64)  # (sheared: 3 + 4 + 4 columns x 3)
+        if sh is None:
+            centre[:] = rec[:, :3]
+            cells = self._centre_cells(centre, ncells)
+            lists = _state.Lists(centre=centre, nbl=np.empty((n, self._nb_width), dtype=np.int32),
+                                 nbn=np.zeros(n, dtype=np.int32), scratch=self._new_scratch(),
+                                 stencil=stencil, mark=np.zeros(n, dtype=np.uint8))
+            partner[:] = _loop.EXPIRY
+            tag[:] = 0
+            qt[:] = self._time
+            self._finish_build(particles, events, lists, cells, order, qt=qt, where=where, expired=True)
+            self._expire_all_lists(target)
+            return
         while True:
             lists = _state.Lists(centre=centre, nbl=np.empty((n, self._nb_width), dtype=np.int32),
                                  nbn=np.zeros(n, dtype=np.int32), scratch=np.empty(1, np.int32),
                                  stencil=stencil, mark=np.zeros(n, dtype=np.uint8))
             cells = _state.Cells(ids=_aligned_int_rows(ncells, self._cell_width),
                                  n=np.zeros(ncells, dtype=np.int32))
-            if sh is None:
-                st = build_all_lists(pos, rec, lists, cells, spc, self.shell)
-            else:
-                st = _shear.build_all_lists_le(self._time, rec, lists, cells, spc, self.shell, sh)
+            st = _shear.build_all_lists_le(self._time, rec, lists, cells, spc, self.shell, sh)
             if st == OVERFLOW:
                 self._nb_width = min(n - 1, max(self._nb_width + 4, int(self._nb_width * 1.5)))
             elif st == CELL_OVERFLOW:
                 self._cell_width += 16
             else:
                 break
-        # compact the lists to what this state needs (+ a margin; they grow on demand)
-        width = min(n - 1, int(lists.nbn.max()) + LIST_SLACK)
-        nbl = lists.nbl
+        lists = lists._replace(nbl=self._compact_lists(lists.nbl, lists.nbn))
+        cells = self._compact_cells(cells)
+        lists = lists._replace(scratch=self._new_scratch())
+        self._finish_build(particles, events, lists, cells, order, qt=qt, where=where)
+
+    def _centre_cells(self, centre, ncells):
+        """The cells of the list centres (as :func:`granulargas.engine._cells.cell_index` assigns
+        them, slots in particle order), rows as wide as the fullest cell plus a margin."""
+        spc = self._space
+        box, ncell = spc.box, spc.ncell
+        flat = np.zeros(len(centre), dtype=np.int64)
+        for a in (2, 1, 0):
+            ca = (centre[:, a].astype(np.float64) * (ncell[a] / box[a])).astype(np.int64)
+            flat = flat * ncell[a] + np.clip(ca, 0, ncell[a] - 1)
+        fill = np.bincount(flat, minlength=ncells).astype(np.int32)
+        while self._cell_width < fill.max():
+            self._cell_width += 16
+        self._cell_width = min(self._cell_width, int(fill.max()) + CELL_SLACK)
+        ids = _aligned_int_rows(ncells, self._cell_width)
+        by_cell = np.argsort(flat, kind="stable")
+        start = np.cumsum(fill) - fill
+        ids[flat[by_cell], np.arange(len(flat)) - start[flat[by_cell]]] = by_cell
+        return _state.Cells(ids=ids, n=fill)
+
+    def _compact_lists(self, nbl, nbn):
+        """The list table cut to what this state needs (+ a margin; the lists grow on demand)."""
+        width = min(self.n - 1, int(nbn.max()) + LIST_SLACK)
         if width < self._nb_width:
             nbl = np.ascontiguousarray(nbl[:, :width])
             self._nb_width = width
-        # and the cells' rows to the fullest cell (+ a margin)
+        return nbl
+
+    def _compact_cells(self, cells):
+        """The cells' rows cut to the fullest cell (+ a margin)."""
         slots = int(cells.n.max()) + CELL_SLACK
         if slots < self._cell_width:
-            ids = _aligned_int_rows(ncells, slots)
+            ids = _aligned_int_rows(cells.ids.shape[0], slots)
             ids[:] = cells.ids[:, :slots]
             cells = cells._replace(ids=ids)
             self._cell_width = slots
-        lists = lists._replace(nbl=nbl, scratch=self._new_scratch())
-        self._finish_build(particles, events, lists, cells, order, qt=qt, where=where)
+        return cells
 
-    def _finish_build(self, particles, events, lists, cells, order, qt=None, where=None):
+    def _expire_all_lists(self, target=_INT_MAX):
+        """The neighbour lists and every particle's first event, by the event loop itself: every
+        list expires at the present time (``_build`` sets the centres, the cells, empty lists and
+        these expiries), and the loop rebuilds each list and predicts its particle's event as at
+        any expiry. A particle's prediction follows its own rebuild, so it sees its whole list
+        (the lists of the particles not yet rebuilt are partial, but every pair is predicted by
+        its later-rebuilt particle). The build's expiries are not counted as events of the run;
+        the calendar is then placed anew, its width matched to the predicted events.
+
+        A pair that overlaps and approaches collides at once, during the build; if that
+        collision is the run's last (``target``), the build's remaining expiries stay in the
+        calendar as ordinary events at this time (and count as events when they are executed).
+        """
+        c = self._counters
+        expiries = int(c["expiries"])
+        # every expiry is in the calendar's first window; the predictions to come need windows
+        # of the width the events will have: 48 events per window among N, each some half
+        # shell's flight away (far smaller or larger widths put the next events beyond the
+        # window count's integer range, or all of them into the first window)
+        rec = self._engine.particles.rec
+        v2 = float(np.mean(np.sum(rec[:, 3:6] ** 2, axis=1)))
+        g = 0.0 if self._flight() is None else float(np.sqrt(np.sum(self._flight() ** 2)))
+        flight = 0.5 * self.shell / math.sqrt(v2) if v2 > 0 else (math.sqrt(self.shell / g) if g > 0 else 1.0)
+        self._engine.calendar.state["width"][0] = PER_WINDOW * flight / self.n
+        prm = self._params()
+        while True:
+            e = self._engine
+            status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, self._time, 4 * self.n + 1000, target,
+                                   None, None, e.stress)
+            if self._served(status):
+                prm = self._params()
+            elif status in (_loop.DONE, _loop.MAX_COLLISIONS):
+                break
+            elif status != _loop.BUDGET:
+                self._raise(status)
+        c = self._counters
+        built = int(c["expiries"]) - expiries
+        c["events"] = int(c["events"]) - built
+        c["expiries"] = expiries
+        if status == _loop.MAX_COLLISIONS:
+            return
+        e = self._engine
+        cal = allocate_calendar(self.n, qt=e.calendar.qt, where=e.calendar.where)
+        self._engine = e._replace(lists=e.lists._replace(nbl=self._compact_lists(e.lists.nbl, e.lists.nbn),
+                                                         scratch=self._new_scratch()),
+                                  calendar=cal)
+        self._place_events(self._time)
+
+    def _finish_build(self, particles, events, lists, cells, order, qt=None, where=None, expired=False):
         """Contacts, every particle's event, counters and the calendar (after the neighbour search;
         ``qt``, ``where``: the calendar's per-particle arrays, views into the mode's per-particle
-        rows)."""
+        rows). ``expired``: the events are set already, every list expiring now
+        (:meth:`_expire_all_lists`); the calendar's window holds them all."""
         n = self.n
         spc = self._space
         rec = particles.rec
-        calendar = allocate_calendar(n, qt=qt, where=where)
+        calendar = allocate_calendar(n, capacity=n if expired else None, qt=qt, where=where)
         slot = np.empty(n, dtype=np.int64)
         slot[order] = np.arange(n)
         cp = self._contact_partner[order]
@@ -569,9 +654,10 @@ class Simulation:
         contacts = _state.contacts(n, self._contact_until[order],
                                    np.where(cp >= 0, slot[np.maximum(cp, 0)], -1).astype(np.int32)
                                    ) if self.rule.resolved else None
-        _loop.predict_all(self._time, rec, particles.count, events, lists, *_loop.mode_flags(cells), spc,
-                          0.5 * self.shell * (1.0 - 1e-9), contacts, self._flight(), self._wallkinds(),
-                          spc.shear, calendar.qt)
+        if not expired:
+            _loop.predict_all(self._time, rec, particles.count, events, lists, *_loop.mode_flags(cells), spc,
+                              0.5 * self.shell * (1.0 - 1e-9), contacts, self._flight(), self._wallkinds(),
+                              spc.shear, calendar.qt)
         counters = np.zeros(1, dtype=_state.COUNTERS)
         c = counters[0]
         with np.errstate(over="ignore", under="ignore"):
@@ -707,15 +793,17 @@ class Simulation:
         if math.isinf(until) and max_collisions is None:
             raise ValueError("run(until=inf) needs max_collisions")
         self._remove_drift()
-        if not self._built:
-            self._build()
-        start_time, start_coll = self.time, self.collisions
-        target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
-        vmax = float(np.max(np.abs(self._engine.particles.rec[:, 3:6])))
+        # before a build, whose first events the loop predicts
+        velocities = self._engine.particles.rec[:, 3:6] if self._built else self._velocities
+        vmax = float(np.max(np.abs(velocities)))
         if not (vmax < 1e150) or (0.0 < vmax < 1e-150):
             raise SimulationError(f"velocities out of range at t = {self.time:.12g} (max |v_a| = "
                                   f"{vmax:.3g}): squared speeds must stay within float64; rescale "
                                   f"the units")
+        start_time, start_coll = self.time, self.collisions
+        target = _INT_MAX if max_collisions is None else start_coll + int(max_collisions)
+        if not self._built:
+            self._build(target)
         prm = self._params()
         chunk = max(1_000_000, 2 * self.n)
         if self._calendar_time != self.time:
@@ -728,34 +816,40 @@ class Simulation:
         advance = _loop.advance if self.driving is None else _loop.advance_driven
         if self.shear is not None:
             advance = _loop.advance_sheared
-        while True:
+        while self.collisions < target:  # (a build's collisions at its own time count)
             e = self._engine
             status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None, prm.space.shear, e.stress)
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
                 if self._remove_drift() or not self._built:
-                    self._build()
+                    self._build(target)
                     prm = self._params()
                 continue
-            if status == OVERFLOW:
-                self._grow_lists()
-                continue
-            if status == CELL_OVERFLOW:
-                self._grow_cells()
+            if self._served(status):
+                prm = self._params()
                 continue
             if status in (_loop.DONE, _loop.MAX_COLLISIONS):
                 break
-            if status in (OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE):
-                self._extend_oblique_table()
-                prm = self._params()
-                continue
             self._raise(status)
         dt = self.time - start_time
         self._rate = 2.0 * (self.collisions - start_coll) / (self.n * dt) if dt > 0 else float("nan")
         if progress is not None:
             progress(self)
         return self
+
+    def _served(self, status) -> bool:
+        """Serve a status by which the loop asks for more room: a wider list or cell table, an
+        oblique-contact table that reaches further. True if served (call the loop again)."""
+        if status == OVERFLOW:
+            self._grow_lists()
+        elif status == CELL_OVERFLOW:
+            self._grow_cells()
+        elif status in (OBLIQUE_BETA_RANGE, OBLIQUE_DELTA_RANGE):
+            self._extend_oblique_table()
+        else:
+            return False
+        return True
 
     def _remove_drift(self) -> bool:
         """Subtract the centre-of-mass velocity on periodic axes once it exceeds
