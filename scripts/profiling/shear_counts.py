@@ -13,14 +13,12 @@ particle, then ``--repeats`` alternated rounds of ``--per-run`` collisions per p
 prints the median CPU time per collision of each, the median over rounds of the ratios
 (sheared / periodic, tiny / periodic, sheared / tiny) and the events per collision by kind
 from the engine's own counters: ``expiry`` (list expiries; the list mode), ``crossing`` (cell
-crossings; the cell mode), ``stale`` (invalidated events popped), ``wall`` and ``global``
-(the slides of the cell mode's sliding rows, one event each), and the mean list length (list
-mode) or the particle scans the slides make per collision (cell mode: a slide scans every
-particle's new column). ``--margin`` sets the lists' sliding margin (in shells) before the
-gases are built.
-Read: tiny / periodic is what the sheared code costs by its own instructions; sheared / tiny
-is what the flow itself adds (more events per collision, memory order destroyed by the
-sliding rows).
+crossings; the cell mode), ``stale`` (invalidated events popped), ``wall``, and the mean list
+length (list mode) or the slides of the cell mode's sliding rows (global events) with the
+particle scans they make (a slide scans every particle's new column). ``--margin`` sets the
+lists' sliding margin (in shells) before the gases are built. Read: tiny / periodic is what
+the sheared code costs by itself; sheared / tiny is what the flow adds (more events per
+collision, a memory order that the sliding rows scatter).
 
 ``cachegrind``: for each size, mode and gas, a native process builds the gas and warms it up
 (``--warmup`` collisions per particle) and saves its state with its memory order (the
@@ -28,15 +26,19 @@ engine's slot of each particle); then ``valgrind --tool=cachegrind`` runs two pr
 rebuild that state in the same memory order (every kernel loaded from the numba cache) and run
 ``--lengths`` K1 and K2 collisions per particle. The difference of the two runs' totals over
 the difference of their collisions is the count per collision of the loop alone (start-up,
-cache loads, the build and the first K1 collisions cancel): Ir (instructions), D1 misses (L1
-data, reads + writes) and LL misses (last level, reads + writes; ``--LL`` is the simulated
-size, fixed so that the figures do not depend on this host: 16 MB, and 1 MB for a cache the
-size of one core's L2). numba compiles for the CPU that valgrind shows (its name and features: no AVX-512), with a
-cache folder of its own (``--cache-dir``), in the native processes too, so that the valgrind
-ones load it. Read: Ir per collision sheared / periodic against the CPU-time ratio of
+cache loads, the build and the first K1 collisions cancel): ``Ir`` (instructions), ``D1
+miss`` (L1 data, reads + writes), ``LL miss`` (last level, reads + writes; ``--LL`` is the
+simulated size, fixed so that the figures do not depend on this host: 16 MB, and 1 MB for a
+cache the size of one core's L2) and ``D refs`` (data reads + writes); ``events`` is the
+events per collision and ``native us`` the same difference of the CPU time of the native runs
+(one process each, not alternated, code compiled for valgrind's CPU: a rough figure; take
+the ratios of time from ``events``). numba compiles for the CPU that valgrind shows (its name
+and features: no AVX-512), into a cache folder of its own (``--cache-dir``), in the native
+processes too, so that the valgrind ones load it (the first call compiles every loop once
+more, some minutes). Read: Ir per collision sheared / periodic against the time ratio of
 ``events`` tells how much of the extra cost is instructions; the misses per collision tell
-how much is memory. One valgrind process at a time (it is single-threaded): about 1-3 minutes
-each at N = 1e5.
+how much is memory. One valgrind process at a time: about 0.5 minute each at N = 1e4, 1-2 at
+N = 1e5.
 
     python scripts/profiling/shear_counts.py events --sizes 1e4 1e5 --modes lists cells
     python scripts/profiling/shear_counts.py cachegrind --sizes 1e5 --modes lists --LL 16777216,16,64 8388608,16,64
@@ -199,7 +201,11 @@ def cachegrind(args):
     me = os.path.abspath(__file__)
     env = dict(os.environ, NUMBA_CACHE_DIR=args.cache_dir)
     env["NUMBA_CPU_NAME"], env["NUMBA_CPU_FEATURES"] = _valgrind_cpu()
-    work = tempfile.mkdtemp(prefix="shear_counts.")
+    with tempfile.TemporaryDirectory(prefix="shear_counts.") as work:
+        _cachegrind(args, me, env, work)
+
+
+def _cachegrind(args, me, env, work):
     k1, k2 = args.lengths
     print(f"cachegrind, D1 default; counts per collision from the runs of {k1:g} and {k2:g} collisions per "
           f"particle after a native warm-up of {args.warmup:g}; 3D, eps = {EPS}, packing {args.packing}")
@@ -237,7 +243,8 @@ def cachegrind(args):
                     cg = {e: (b["cg"][e] - a["cg"][e]) / dc for e in b["cg"]}
                     native = (res[gas, k2, "native"]["cpu"] - res[gas, k1, "native"]["cpu"]) / dc
                     rows[gas] = r = dict(Ir=cg["Ir"], D1=cg["D1mr"] + cg["D1mw"], LL=cg["DLmr"] + cg["DLmw"],
-                                         D=cg["Dr"] + cg["Dw"], events=(b["after"]["events"] - a["after"]["events"]) / dc,
+                                         D=cg["Dr"] + cg["Dw"],
+                                         events=(b["after"]["events"] - a["after"]["events"]) / dc,
                                          native=native)
                     print(f"{n:>7} {mode:>6} {ll.split(',')[0]:>9} {gas:>10} {r['Ir']:>9.0f} {r['D1']:>8.2f} "
                           f"{r['LL']:>8.2f} {r['D']:>8.0f} {r['events']:>7.3f} {1e6 * r['native']:>9.3f}")
@@ -270,7 +277,7 @@ def main(argv=None):
     e.add_argument("--per-run", type=float, default=2.0, help="collisions per particle per timed round")
     e.add_argument("--repeats", type=int, default=5)
     e.add_argument("--margin", type=float, default=1.0,
-                   help="the lists' sliding margin in shells (granulargas.engine._shear.MARGIN, the engine's default 1)")
+                   help="the lists' sliding margin in shells (granulargas.engine._shear.MARGIN; the engine's: 1)")
     c = sub.choices["cachegrind"]
     c.add_argument("--gases", nargs="*", choices=GASES, default=["periodic", "sheared"])
     c.add_argument("--lengths", type=float, nargs=2, default=[1.0, 3.0], help="collisions per particle of the two runs")
