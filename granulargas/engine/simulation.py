@@ -615,6 +615,9 @@ class Simulation:
         flight = 0.5 * self.shell / math.sqrt(v2) if v2 > 0 else (math.sqrt(self.shell / g) if g > 0 else 1.0)
         self._engine.calendar.state["width"][0] = PER_WINDOW * flight / self.n
         prm = self._params()
+        # the loop stops right after any event once the count has reached its target: the build
+        # stops early only for a collision of its own that reaches the run's target
+        target = max(target, int(c["collisions"]) + 1)
         while True:
             e = self._engine
             status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, self._time, 4 * self.n + 1000, target,

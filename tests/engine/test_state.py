@@ -139,6 +139,15 @@ def test_max_collisions_stops_right_after_that_collision():
     assert sim.collisions == 250
 
 
+def test_a_run_of_no_collisions_builds_the_whole_state():
+    # the lists mode builds its lists with the event loop (every list expiring at once):
+    # a run with no collisions to go must still finish that build
+    sim = make_sim(n=300, packing=0.2, seed=1, neighbours="lists")
+    sim.run(np.inf, max_collisions=0)
+    assert sim.time == 0.0 and sim.events == 0 and sim.collisions == 0
+    assert check(sim) == []
+
+
 @pytest.mark.parametrize("kwargs, match", [
     (dict(box=[2.0, 2.0, 2.0]), "too small"),
     (dict(radii=-1.0), "radii"),
