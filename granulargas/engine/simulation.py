@@ -62,9 +62,11 @@ SHEAR_FRESH_SIZE = 34
 #: neighbour search: neighbour lists with a shell, cell crossings (no lists), or the
 #: faster of the two for the packing fraction (:func:`neighbour_mode`)
 NEIGHBOURS = ("lists", "cells", "auto")
-#: "auto" uses cell crossings below this packing fraction (measured faster than the lists at
-#: N = 10^4 and 10^5 with ``scripts/benchmarks/neighbours.py``; in 2D they are not faster at 10^5)
-CELLS_BELOW = {3: 0.2, 2: 0.0}
+#: "auto" uses cell crossings below this packing fraction, where they were measured faster than
+#: the lists at both N = 10^4 and 10^5 (``scripts/benchmarks/neighbours.py``, elastic gases): in
+#: 3D up to 0.2 (at 0.25 the lists are faster at 10^5), in 2D up to 0.3 (at 0.4 the two are as
+#: fast at 10^5, at 0.5 the lists faster)
+CELLS_BELOW = {3: 0.2, 2: 0.4}
 #: cell-crossing mode: at most this many cells per particle (wider cells in very dilute gases)
 CELLS_PER_PARTICLE = 8
 

@@ -32,7 +32,13 @@ Usage::
 (``scripts/benchmarks/results.py``) and rewrites the performance page: the engine's rate per
 case for the default ``lists`` and ``cells`` modes, the ratio to the C code where it ran,
 and, when several modes ran on an elastic 3D gas, every mode's rate and events per collision
-(the page's chart of speed against events per collision).
+(the page's chart of speed against events per collision). With ``--crossover`` it writes
+instead, per dimension, N and packing, the rates of the default ``lists`` and ``cells`` modes
+side by side (the page's table of the crossover that ``neighbours = "auto"`` follows,
+:data:`granulargas.engine.simulation.CELLS_BELOW`)::
+
+    python scripts/benchmarks/neighbours.py --dimension 2 --n 1e4 1e5 --packings 0.05 0.1 0.2 0.3 0.4 0.5 \
+        --modes cells lists --rounds 3 --record --crossover
 
 ``--plot FILE`` draws the rate against the events per collision, one panel per
 N and packing, one point per mode (the C codes' rates as horizontal lines):
@@ -125,6 +131,9 @@ def main(argv=None):
     p.add_argument("--plot", help="PNG file: rate against events per collision")
     p.add_argument("--record", action="store_true",
                    help="write the figures into docs/performance/results.json and rewrite the performance page")
+    p.add_argument("--crossover", action="store_true",
+                   help="with --record: write the lists' and the cells' rates side by side (the crossover "
+                        "table) instead of the engine's records")
     args = p.parse_args(argv)
     load = os.getloadavg()[0]
     commit = _commit()
@@ -191,6 +200,21 @@ def record(results, args, argv, load, commit):
         skip = w in ("--c-cell", "--c-single")
     command = "python scripts/benchmarks/neighbours.py " + " ".join(words)
     ours = [r for r in results if not r["mode"].startswith("C ")]
+    if args.crossover:
+        rate = {(r["mode"], r["n"], r["packing"]): r for r in ours}
+        records = []
+        for (mode, n, eta), r in sorted(rate.items()):
+            other = rate.get(("lists", n, eta))
+            if mode == "cells" and other:
+                records.append(dict(table="crossover", id=f"{args.dimension}D {args.rule} packing {eta:g} N={n}",
+                                    dim=args.dimension, rule=args.rule, n=n, packing=eta,
+                                    cells_rate_cpu=round(r["rate"], 4), lists_rate_cpu=round(other["rate"], 4),
+                                    cells_events=round(r["events"], 2), lists_events=round(other["events"], 2),
+                                    rounds=args.rounds))
+        if not records:
+            raise SystemExit("--crossover: needs both --modes cells and lists")
+        results_file.record_and_render(records, command, load_average=load, commit=commit)
+        return
     records = []
     for r in ours:
         if r["mode"] in ("lists", "cells"):

@@ -155,6 +155,18 @@ def block_dilute(data):
     return t.markdown()
 
 
+def block_crossover(data):
+    from granulargas.engine.simulation import CELLS_BELOW
+
+    t = Table(["d", "packing", "N", "cells: M collisions/s (CPU)", "lists", "cells / lists", "auto uses"],
+              ["--:", "--:", "--:", "--:", "--:", "--:", "---"])
+    for r in sorted(by_table(data, "crossover"), key=lambda r: (r["dim"], r["packing"], r["n"])):
+        t.add([str(r["dim"]), fmt(r["packing"]), power(r["n"]), fmt(r["cells_rate_cpu"], 3),
+               fmt(r["lists_rate_cpu"], 3), f"**×{r['cells_rate_cpu'] / r['lists_rate_cpu']:.2f}**",
+               "cells" if r["packing"] < CELLS_BELOW[r["dim"]] else "lists"], r)
+    return t.markdown()
+
+
 def block_memory(data):
     t = Table(["what", "d", "packing", "bytes / particle"], ["---", "--:", "--:", "--:"])
     for r in sorted(by_table(data, "memory"), key=lambda r: (r["what"], r["dim"], str(r["packing"]))):

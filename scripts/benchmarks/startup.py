@@ -58,7 +58,7 @@ VARIANT_RUNS = [
 #: the rows of the performance page's start-up table: (id in the results file, text) per row name
 PAGE_ROWS = {
     "quickstart (fresh install)": ("0", "quickstart on a fresh install (empty numba and table caches)"),
-    "after the quickstart: 2D": ("1", "then a 2D run (neighbour lists)"),
+    "after the quickstart: 2D": ("1", "then a 2D run (cell crossings)"),
     "after the quickstart: driven": ("2", "then a driven run (the driving step)"),
     "after the quickstart: walls": ("3", "then a run with walls"),
     "after the quickstart: DSMC": ("4", "then a DSMC run"),
