@@ -64,9 +64,9 @@ SHEAR_FRESH_SIZE = 34
 NEIGHBOURS = ("lists", "cells", "auto")
 #: "auto" uses cell crossings below this packing fraction, where they were measured faster than
 #: the lists at both N = 10^4 and 10^5 (``scripts/benchmarks/neighbours.py``, elastic gases): in
-#: 3D up to 0.2 (at 0.25 the lists are faster at 10^5), in 2D up to 0.3 (at 0.4 the two are as
-#: fast at 10^5, at 0.5 the lists faster)
-CELLS_BELOW = {3: 0.2, 2: 0.4}
+#: 3D up to 0.2 (at 0.25 the lists are faster at 10^5), in 2D up to 0.3 (at 0.4 the lists are
+#: as fast or faster at 10^5)
+CELLS_BELOW = {3: 0.2, 2: 0.35}
 #: cell-crossing mode: at most this many cells per particle (wider cells in very dilute gases)
 CELLS_PER_PARTICLE = 8
 

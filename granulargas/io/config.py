@@ -854,7 +854,7 @@ SCHEMA: tuple[Key, ...] = (
         'How the event-driven engine finds collision partners: `"lists"` neighbour lists with a shell '
         '(list expiries are events), `"cells"` cell crossings without lists (each particle is predicted '
         "against the particles of its own and the neighbouring cells; a cell crossing is an event), "
-        '`"auto"` cells below packing 0.2 in 3D and 0.4 in 2D, where they were measured faster (see the '
+        '`"auto"` cells below packing 0.2 in 3D and 0.35 in 2D, where they were measured faster (see the '
         "performance page), lists otherwise. The choice changes which events run, so trajectories of the "
         "two agree only up to round-off; both are exact event-driven dynamics.",
         default="auto", choices=NEIGHBOURS),
