@@ -9,7 +9,8 @@ changes far less than the wall clock, with the run's own start-up and compile fi
   and an empty table cache (``NUMBA_CACHE_DIR``, ``GRANULARGAS_CACHE_DIR`` fresh
   folders): what the README's first command costs on a fresh install;
 * ``variants``: from a copy of the cache the quickstart left, one short run of each
-  further kind (2D, driven, walls, DSMC, constant eps, dense 3D with neighbour lists),
+  further kind (2D, driven, walls, DSMC, constant eps, dense 3D with neighbour lists, 2D with
+  neighbour lists),
   each from its own copy: what the first run of that kind adds;
 * ``warm``: a small 2D run (400 disks, 5 collisions per particle) with everything
   cached (compiled code, tables, the run's predictions, :mod:`granulargas.run.predictions`),
@@ -54,6 +55,7 @@ VARIANT_RUNS = [
     ("DSMC", "hcs_dsmc_3d.toml", SHORT),
     ("constant eps", "haff_3d.toml", SHORT),
     ("lists 3D", "elastic_3d.toml", SHORT),
+    ("lists 2D", "haff_2d.toml", SHORT + ["--set", 'run.neighbours="lists"']),
 ]
 #: the rows of the performance page's start-up table: (id in the results file, text) per row name
 PAGE_ROWS = {
@@ -64,6 +66,7 @@ PAGE_ROWS = {
     "after the quickstart: DSMC": ("4", "then a DSMC run"),
     "after the quickstart: constant eps": ("5", "then a constant-ε run"),
     "after the quickstart: lists 3D": ("6", "then dense 3D (neighbour lists, placement with pushes)"),
+    "after the quickstart: lists 2D": ("6a", "then a 2D run with neighbour lists (no pushes)"),
     "warm small 2D run (400 disks)": ("7", "a warm run (everything cached), 400 disks"),
 }
 WARM = ("haff_2d.toml", ["--set", "system.particles=400", "--set", "run.collisions_per_particle=5"])

@@ -25,22 +25,22 @@ ROOT = Path(__file__).resolve().parents[2]
 #: the variants each example config compiles on its first run
 EXAMPLES = {
     "quickstart.toml": ["placement", "cells"],
-    "haff_2d.toml": ["placement", "lists"],
+    "haff_2d.toml": ["placement", "cells"],
     "haff_3d.toml": ["placement", "cells"],
     "driven_3d.toml": ["placement", "cells", "cells-driven"],
     "walls_3d.toml": ["placement", "cells"],
     "elastic_3d.toml": ["placement", "lists"],
     "hcs_dsmc_3d.toml": ["dsmc"],
-    "clustering_2d_constant.toml": ["placement", "placement-large", "lists"],
-    "vibrated_bed_2d.toml": ["placement", "lists-gravity-walls"],
+    "clustering_2d_constant.toml": ["placement", "placement-large", "cells"],
+    "vibrated_bed_2d.toml": ["placement", "cells-gravity-walls"],
     "vibrated_bed_3d.toml": ["placement", "cells-gravity-walls"],
     "shaken_cell_3d.toml": ["placement", "cells-walls"],
     "rough_hcs_3d.toml": ["placement", "cells-rough"],
-    "rough_driven_2d.toml": ["placement", "lists-rough", "lists-rough-driven"],
+    "rough_driven_2d.toml": ["placement", "cells-rough", "cells-rough-driven"],
     "rough_mpemba_hot.toml": ["placement", "cells-rough", "cells-rough-driven"],
     "mixture_hcs_3d.toml": ["dsmc-mixture"],
     "glass_steel_3d.toml": ["placement", "cells-mixture"],
-    "shear_2d.toml": ["placement", "lists-shear"],
+    "shear_2d.toml": ["placement", "cells-shear"],
     "shear_3d.toml": ["placement", "cells-shear"],
     "shear_elastic_3d.toml": ["placement", "cells-shear"],
     "shear_dsmc_3d.toml": ["dsmc-shear"],
@@ -145,7 +145,7 @@ def test_compiling_is_announced_once_before_it_starts(tmp_path, monkeypatch):
     monkeypatch.setattr(Simulation, "run", compiling_run)
     summary = runner.run_config(cfg, log=order.append)
     lines = [x for x in order if x.startswith("compiling")]
-    assert lines == [f"compiling the neighbour-list engine (once; cached in {_numba.cache_location()})"]
+    assert lines == [f"compiling the cell-crossing engine (once; cached in {_numba.cache_location()})"]
     assert order.index(lines[0]) < order.index("first compile done")
     assert summary.compile_time >= 0.02
     assert "of it compiling, once" in summary.lines()[2]
