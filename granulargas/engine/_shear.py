@@ -107,16 +107,7 @@ import numpy as np
 from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._calendar import cal_update
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, PREFETCH_CENTRES_FROM, slot_insert, slot_remove
-from granulargas.engine._crossing import (
-    NEXT,
-    PAIR_J,
-    PAIR_TAG,
-    _scan_listed,
-    earlier_face,
-    face_gap,
-    grid_insert,
-    grid_remove,
-)
+from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, _scan_listed, earlier_face, face_gap, grid_insert, grid_remove
 from granulargas.engine._flight import stream
 from granulargas.engine._geometry import collision_delay, min_image
 from granulargas.engine._prefetch import prefetch
@@ -822,59 +813,21 @@ def _windows(cx, m, nx):
 
 
 @inlined
-def _straight(c0, n, nx):
-    """Whether the run of columns c0 .. c0 + n - 1 lies inside the row (no wrap; true if empty)."""
-    return n <= 0 or (c0 >= 0 and c0 + n <= nx)
-
-
-@inlined
-def _heads_straight(first, k, head, b, n, nz, sz):
-    """:func:`_list_heads` for a run of n columns that does not wrap, in nz layers that do not
-    wrap: the cells of flat index b + w sz + v (w < nz, v < n), in the same order."""
-    for w in range(nz):
-        c = b + w * sz
-        for v in range(n):
-            j = head[c + v]
-            first[k] = j
-            k += 1 if j >= 0 else 0
-    return k
-
-
-@inlined
 def scan_le(i, t, before, rec, grid, space, sh, own0, own_n, up0, up_n, down0, down_n, z0, z1):
     """Earliest collision of i (streamed to t), before ``before``, with the particles of:
     columns own0 .. own0 + own_n - 1 of its own row, up0 .. of the row above, down0 .. of the
     row below (through the sheared boundary), z layers z0 .. z1 around its cell. (time,
-    partner) or (``before``, -1).
-
-    Two fast paths that give the same cells in the same order and the same times: when no run
-    of columns and no z layer wraps, the cells are read with straight strides (as
-    :func:`granulargas.engine._crossing.scan_block`); when i's row is not next to the sheared
-    boundary and there are at least 7 rows, every candidate lies in rows r - 1 .. r + 1 of the
-    box, less than 3 w_y + round-off < L_y / 2 away along y, so its nearest image is k = 0 and
-    the pair times are those of the periodic box (:func:`granulargas.engine._crossing._scan_listed`,
-    the sheared axis of period inf), without the image terms of :func:`le_pair_delay`."""
+    partner) or (``before``, -1)."""
     cell = grid.cell
     first = grid.fresh
     ncell = space.ncell
-    nx = sh.nx
     r = cell[i, 1]
     cz = cell[i, 2]
-    up = _wrap(r + 1, sh.ny)
-    down = _wrap(r - 1, sh.ny)
     k = 1
-    if (_straight(own0, own_n, nx) and _straight(up0, up_n, nx) and _straight(down0, down_n, nx)
-            and cz + z0 >= 0 and cz + z1 < ncell[2]):
-        sz = nx * ncell[1]
-        zb = sz * (cz + z0)
-        nz = z1 - z0 + 1
-        k = _heads_straight(first, k, grid.head, own0 + nx * r + zb, own_n, nz, sz)
-        k = _heads_straight(first, k, grid.head, up0 + nx * up + zb, up_n, nz, sz)
-        k = _heads_straight(first, k, grid.head, down0 + nx * down + zb, down_n, nz, sz)
-    else:
-        k = _list_heads(first, k, grid.head, r, own0, own_n, cz, z0, z1, ncell, space.period[2], nx)
-        k = _list_heads(first, k, grid.head, up, up0, up_n, cz, z0, z1, ncell, space.period[2], nx)
-        k = _list_heads(first, k, grid.head, down, down0, down_n, cz, z0, z1, ncell, space.period[2], nx)
+    k = _list_heads(first, k, grid.head, r, own0, own_n, cz, z0, z1, ncell, space.period[2], sh.nx)
+    k = _list_heads(first, k, grid.head, _wrap(r + 1, sh.ny), up0, up_n, cz, z0, z1, ncell, space.period[2], sh.nx)
+    k = _list_heads(first, k, grid.head, _wrap(r - 1, sh.ny), down0, down_n, cz, z0, z1, ncell, space.period[2],
+                    sh.nx)
     if r >= 1 and r <= sh.ny - 2 and sh.ny >= 7:
         return _scan_listed(first, k, t, before, rec[i, 0], rec[i, 1], rec[i, 2], rec[i, 3], rec[i, 4], rec[i, 5],
                             rec[i, 7], rec, cell, space.period, None)
