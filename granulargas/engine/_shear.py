@@ -107,7 +107,16 @@ import numpy as np
 from granulargas._numba import inlined, inlined_ir, kernel
 from granulargas.engine._calendar import cal_update
 from granulargas.engine._cells import CELL_OVERFLOW, OVERFLOW, PREFETCH_CENTRES_FROM, slot_insert, slot_remove
-from granulargas.engine._crossing import NEXT, PAIR_J, PAIR_TAG, earlier_face, face_gap, grid_insert, grid_remove
+from granulargas.engine._crossing import (
+    NEXT,
+    PAIR_J,
+    PAIR_TAG,
+    _scan_listed,
+    earlier_face,
+    face_gap,
+    grid_insert,
+    grid_remove,
+)
 from granulargas.engine._flight import stream
 from granulargas.engine._geometry import collision_delay, min_image
 from granulargas.engine._prefetch import prefetch
@@ -817,7 +826,13 @@ def scan_le(i, t, before, rec, grid, space, sh, own0, own_n, up0, up_n, down0, d
     """Earliest collision of i (streamed to t), before ``before``, with the particles of:
     columns own0 .. own0 + own_n - 1 of its own row, up0 .. of the row above, down0 .. of the
     row below (through the sheared boundary), z layers z0 .. z1 around its cell. (time,
-    partner) or (``before``, -1)."""
+    partner) or (``before``, -1).
+
+    When i's row is not next to the sheared boundary and there are at least 7 rows, every
+    candidate lies in rows r - 1 .. r + 1 of the box, less than 3 w_y + round-off < L_y / 2
+    away along y: its nearest image is k = 0, and the pair times are those of the periodic
+    box (:func:`granulargas.engine._crossing._scan_listed`, the sheared axis of period inf),
+    the same numbers as :func:`le_pair_delay` gives without its image terms."""
     cell = grid.cell
     first = grid.fresh
     ncell = space.ncell
@@ -828,6 +843,9 @@ def scan_le(i, t, before, rec, grid, space, sh, own0, own_n, up0, up_n, down0, d
     k = _list_heads(first, k, grid.head, _wrap(r + 1, sh.ny), up0, up_n, cz, z0, z1, ncell, space.period[2], sh.nx)
     k = _list_heads(first, k, grid.head, _wrap(r - 1, sh.ny), down0, down_n, cz, z0, z1, ncell, space.period[2],
                     sh.nx)
+    if r >= 1 and r <= sh.ny - 2 and sh.ny >= 7:
+        return _scan_listed(first, k, t, before, rec[i, 0], rec[i, 1], rec[i, 2], rec[i, 3], rec[i, 4], rec[i, 5],
+                            rec[i, 7], rec, cell, space.period, None)
     return _scan_listed_le(first, k, t, before, rec, i, cell, space.period, sh)
 
 

@@ -412,6 +412,23 @@ thermostat_interval = 0.05
 [run]
 neighbours = "cells"
 """, 10.0),
+    "shear-3d-cells": ("""
+[system]
+dimension = 3
+particles = 1000
+packing_fraction = 0.1
+seed = 26
+boundary = ["periodic", "lees-edwards", "periodic"]
+[collision]
+model = "constant"
+restitution = 0.8
+[shear]
+rate = 0.5
+thermostat_temperature = 1.0
+thermostat_interval = 0.05
+[run]
+neighbours = "cells"
+""", 10.0),
     "shear-dsmc-3d": ("""
 [system]
 dimension = 3
