@@ -613,7 +613,7 @@ class Simulation:
         # window count's integer range, or all of them into the first window)
         rec = self._engine.particles.rec
         v2 = float(np.mean(np.sum(rec[:, 3:6] ** 2, axis=1)))
-        g = 0.0 if self._flight() is None else float(np.sqrt(np.sum(self._flight() ** 2)))
+        g = 0.0 if self.gravity is None else float(np.sqrt(np.sum(np.square(self.gravity))))
         flight = 0.5 * self.shell / math.sqrt(v2) if v2 > 0 else (math.sqrt(self.shell / g) if g > 0 else 1.0)
         self._engine.calendar.state["width"][0] = PER_WINDOW * flight / self.n
         prm = self._params()

@@ -156,14 +156,14 @@ def block_dilute(data):
 
 
 def block_crossover(data):
-    from granulargas.engine.simulation import CELLS_BELOW
+    from granulargas.engine.simulation import neighbour_mode
 
     t = Table(["d", "packing", "N", "cells: M collisions/s (CPU)", "lists", "cells / lists", "auto uses"],
               ["--:", "--:", "--:", "--:", "--:", "--:", "---"])
     for r in sorted(by_table(data, "crossover"), key=lambda r: (r["dim"], r["packing"], r["n"])):
         t.add([str(r["dim"]), fmt(r["packing"]), power(r["n"]), fmt(r["cells_rate_cpu"], 3),
                fmt(r["lists_rate_cpu"], 3), f"**×{r['cells_rate_cpu'] / r['lists_rate_cpu']:.2f}**",
-               "cells" if r["packing"] < CELLS_BELOW[r["dim"]] else "lists"], r)
+               neighbour_mode("auto", r["packing"], r["dim"])], r)
     return t.markdown()
 
 
