@@ -616,7 +616,9 @@ def execute_expiry_le(i, te, p, lists, cells, c, prm, shear):
     of an IR-inlined callee is pruned only after the inlining, and the sheared rebuild and
     search would be copied and typed into every list loop (about 6 s of compile)."""
     stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
-    c.sum_mv2 += p.mass[i] * le_wrap(i, te, p.rec, p.img, shear)
+    dv2 = le_wrap(i, te, p.rec, p.img, shear)
+    if dv2 != 0.0:  # (the mass row only when i went through the sheared boundary)
+        c.sum_mv2 += p.mass[i] * dv2
     return _expired(i, rebuild_list_le(i, te, p.rec, lists, cells, prm.space, prm.rmax, prm.shell, shear), c)
 
 
@@ -629,7 +631,9 @@ def execute_crossing(i, face, te, p, grid, c, prm, shear):
     stream(i, te, p.rec, p.img, prm.space.period, prm.flight)
     if shear is not None:
         cx_old = grid.cell[i, 0]
-        c.sum_mv2 += p.mass[i] * cross_le(i, face, te, p.rec, p.img, grid, prm.space, shear)
+        dv2 = cross_le(i, face, te, p.rec, p.img, grid, prm.space, shear)
+        if dv2 != 0.0:  # (the mass row only when i went through the sheared boundary)
+            c.sum_mv2 += p.mass[i] * dv2
         scan_new_layer_le(i, te, face, cx_old, p.rec, p.count, grid, prm.space, shear)
     else:
         cross(i, face, grid, prm.space)
