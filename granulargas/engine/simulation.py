@@ -543,6 +543,7 @@ class Simulation:
                 self.shear.temperature or 1.0, rescales=self._rescale_step, lists=self.neighbours == "lists",
                 shell=self.shell, cut=2.0 * float(self._radii.max()) + self.shell)
             sh.slide[0] = int(math.floor(self._time / sh.slide_time))
+            sh.slide[1] = sh.slide[0] % sh.nx
             spc = spc._replace(shear=sh)
             self._space = spc
             rec[:, 1] += sh.ly  # the compiled state keeps y + L_y (engine._shear)
