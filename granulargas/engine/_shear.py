@@ -142,9 +142,11 @@ XX, YY, ZZ, XY, XZ, YZ = 0, 1, 2, 3, 4, 5
 
 #: The lists' sliding margin D in shells (eq. 3): a wider margin lists more pairs of
 #: adjacent rows, a narrower one ends lists sooner (lifetime D / (a w_y)). In the gas of
-#: ``scripts/benchmarks/shear.py`` (N = 10^4, packing 0.1, this constant set before the
-#: ``Simulation`` is built) 0.5 and 1 cost within 2 % of each other (2.7 and 2.2 list
-#: expiries per collision, lists of 12.8 and 13.9), 1.5 some 5 % more.
+#: ``scripts/benchmarks/shear.py`` (N = 10^4, packing 0.1, the periodic shell 1.47, this
+#: constant set before the ``Simulation`` is built) 0.5 and 1 cost within 2 % of each other
+#: (2.7 and 2.2 list expiries per collision, lists of 12.8 and 13.9), 1.5 some 5 % more. The
+#: default shell of a sheared gas counts the margin
+#: (:func:`granulargas.engine.simulation.sheared_shell`).
 MARGIN = 1.0
 
 
