@@ -126,8 +126,8 @@ from granulargas.engine._prefetch import prefetch
 #: ``ny`` (the list-centre grid in the list mode, the crossing grid in the cell mode),
 #: ``speed`` = a L_y (the image velocity), ``margin`` D and ``lifetime`` D / (a w_y) of the
 #: lists (list mode, eq. 3; 0 and inf otherwise), ``slide_time``
-#: = w_x / (a w_y) (cell mode: time between slides), ``slide`` (1,) i8 the index k of the
-#: last slide (m = k mod n_x), ``built`` (N,) f8 the build time of each particle's list
+#: = w_x / (a w_y) (cell mode: time between slides), ``slide`` (2,) i8 the index k of the
+#: last slide and m = k mod n_x (kept, so that the scans need no integer division), ``built`` (N,) f8 the build time of each particle's list
 #: (list mode; (1,) otherwise), ``thermostat`` (2,) f8: interval and temperature of the
 #: velocity rescaling (interval inf: none), ``rescales`` (1,) i8 the index of the next one.
 ShearGeometry = namedtuple("ShearGeometry", ["rate", "lx", "ly", "wx", "wy", "nx", "ny", "speed", "margin",
@@ -142,9 +142,11 @@ XX, YY, ZZ, XY, XZ, YZ = 0, 1, 2, 3, 4, 5
 
 #: The lists' sliding margin D in shells (eq. 3): a wider margin lists more pairs of
 #: adjacent rows, a narrower one ends lists sooner (lifetime D / (a w_y)). In the gas of
-#: ``scripts/benchmarks/shear.py`` (N = 10^4, packing 0.1, this constant set before the
-#: ``Simulation`` is built) 0.5 and 1 cost within 2 % of each other (2.7 and 2.2 list
-#: expiries per collision, lists of 12.8 and 13.9), 1.5 some 5 % more.
+#: ``scripts/benchmarks/shear.py`` (N = 10^4, packing 0.1, the periodic shell 1.47, this
+#: constant set before the ``Simulation`` is built) 0.5 and 1 cost within 2 % of each other
+#: (2.7 and 2.2 list expiries per collision, lists of 12.8 and 13.9), 1.5 some 5 % more. The
+#: default shell of a sheared gas counts the margin
+#: (:func:`granulargas.engine.simulation.sheared_shell`).
 MARGIN = 1.0
 
 
@@ -166,7 +168,7 @@ def shear_geometry(rate, box3, ncell, n, thermostat_interval=math.inf, thermosta
     margin = list_margin(float(shell), float(cut), wx, lx) if lists else 0.0
     lifetime = margin / (a * wy) if lists else math.inf
     return ShearGeometry(a, lx, ly, wx, wy, nx, ny, a * ly, margin, lifetime, wx / (a * wy),
-                         np.array([slide], dtype=np.int64),
+                         np.array([slide, slide % nx], dtype=np.int64),
                          np.zeros(n if lists else 1), np.array([thermostat_interval, thermostat_temperature]),
                          np.array([rescales], dtype=np.int64))
 
@@ -225,6 +227,17 @@ def _wrap(c, n):
         return c + n
     if c >= n:
         return c - n
+    return c
+
+
+@inlined
+def _wrap_far(c, n):
+    """c mod n without an integer division, for the column runs of the cell scans, which
+    start at most a few n_x outside [0, n_x)."""
+    while c < 0:
+        c += n
+    while c >= n:
+        c -= n
     return c
 
 
@@ -774,7 +787,7 @@ def _list_heads(first, k, head, g, c0, ncol, cz, z0, z1, ncell, period_z, nx):
     (wrapped), z layers cz + z0 .. cz + z1 (none beyond a wall); returns the new count."""
     if ncol <= 0:
         return k
-    start = c0 % nx  # one division per row; the columns then step with a compare
+    start = _wrap_far(c0, nx)
     for oz in range(z0, z1 + 1):
         kz = cz + oz
         if kz < 0 or kz >= ncell[2]:
@@ -860,7 +873,7 @@ def predict_pair_cells_le(i, t, before, rec, count, grid, space, sh):
     else:
         zr = 1 if space.ncell[2] >= 3 else 0
         cx = grid.cell[i, 0]
-        up0, down0 = _windows(cx, sh.slide[0] % sh.nx, sh.nx)
+        up0, down0 = _windows(cx, sh.slide[1], sh.nx)
         pt, pj = scan_le(i, t, math.inf, rec, grid, space, sh, cx - 1, 3, up0, 4, down0, 4, -zr, zr)
         grid.pair_t[i] = pt
         grid.cell[i, PAIR_J] = pj
@@ -923,7 +936,11 @@ def _y_layer(cx, cxn, o, m, nx):
     outside the old run in integers is outside it modulo n_x too)."""
     old0 = cx - 2 - m if o > 0 else cx - 1 + m
     d = cxn - (old0 + 2)
-    d -= nx * ((d + nx // 2) // nx)  # into [-n_x/2, n_x/2)
+    h = nx >> 1
+    while d >= nx - h:  # into [-h, n_x - h), h = n_x // 2 (|d| < 2 n_x)
+        d -= nx
+    while d < -h:
+        d += nx
     c = old0 + 2 + d  # cxn unwrapped
     own0, own_n = _minus(c - 1, 3, old0, 4)
     back0 = c - 1 + m if o > 0 else c - 2 - m  # the window of the row left behind
@@ -947,7 +964,7 @@ def scan_new_layer_le(i, t, face, cx_old, rec, count, grid, space, sh):
     o = 1 if face & 1 else -1
     cx = grid.cell[i, 0]
     zr = 1 if space.ncell[2] >= 3 else 0
-    m = sh.slide[0] % sh.nx
+    m = sh.slide[1]
     up0, down0 = _windows(cx, m, sh.nx)
     if a == 0:
         # the columns entering on the side of motion: own cx + o; above up0 + (3 if o > 0
@@ -981,11 +998,11 @@ def prefetch_around_le(i, grid, space, sh):
     cx = grid.cell[i, 0]
     r = grid.cell[i, 1]
     cz = grid.cell[i, 2]
-    m = sh.slide[0] % nx
+    m = sh.slide[1]
     up = _wrap(r + 1, sh.ny)
     down = _wrap(r - 1, sh.ny)
-    cu = (cx - m) % nx  # column 2 of the upper window
-    cd = (cx + m) % nx  # column 1 of the lower window
+    cu = _wrap(cx - m, nx)  # column 2 of the upper window
+    cd = _wrap(cx + m, nx)  # column 1 of the lower window
     zr = 1 if ncell[2] >= 3 else 0
     for oz in range(-zr, zr + 1):
         kz = cz + oz
@@ -1119,7 +1136,9 @@ def slide_scan(t, rec, img, count, events, grid, space, cal, sh):
     if earlier than its event (and its stored best pair, if that is current). Returns False
     on a calendar overflow."""
     sh.slide[0] += 1
-    m = sh.slide[0] % sh.nx
+    m = sh.slide[1] + 1
+    m = 0 if m == sh.nx else m
+    sh.slide[1] = m
     zr = 1 if space.ncell[2] >= 3 else 0
     period = space.period
     for i in range(rec.shape[0]):

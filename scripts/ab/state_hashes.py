@@ -395,6 +395,21 @@ thermostat_temperature = 1.0
 [run]
 neighbours = "lists"
 """, 10.0),
+    "shear-3d-lists-rows": ("""
+[system]
+dimension = 3
+particles = 2000
+packing_fraction = 0.1
+seed = 23
+boundary = ["periodic", "lees-edwards", "periodic"]
+[collision]
+model = "constant"
+restitution = 0.8
+[shear]
+rate = 0.59
+[run]
+neighbours = "lists"
+""", 4.0),
     "shear-2d-cells": ("""
 [system]
 dimension = 2

@@ -18,6 +18,7 @@ Usage::
 
     python scripts/profiling/perf_loop.py 10976 --packing 0.05 --neighbours cells
     python scripts/profiling/perf_loop.py 1e5 --collisions 2e6 --lines 40
+    python scripts/profiling/perf_loop.py 1e5 --packing 0.1 --eps 0.8 --shear 0.5905
 """
 
 from __future__ import annotations
@@ -48,8 +49,17 @@ def child(args, out):
     from granulargas.engine import CollisionRule, Simulation
     from granulargas.initial import random_state
 
-    st = random_state(int(float(args.n)), args.packing, 3, seed=1)
-    sim = Simulation(st, CollisionRule.elastic(), neighbours=args.neighbours)
+    n = int(float(args.n))
+    rule = CollisionRule.elastic() if args.eps is None else CollisionRule.constant(args.eps)
+    if args.shear:
+        from granulargas.engine.shear import Shear
+
+        st = random_state(n, args.packing, 3, seed=1, boundary=("periodic", "lees-edwards", "periodic"),
+                          shear=args.shear)
+        sim = Simulation(st, rule, neighbours=args.neighbours, shear=Shear(args.shear))
+    else:
+        sim = Simulation(random_state(n, args.packing, 3, seed=1), rule, neighbours=args.neighbours,
+                         stress=args.eps is not None)
     sim.run(np.inf, max_collisions=2 * sim.n)
     t0 = time.process_time()
     sim.run(np.inf, max_collisions=int(float(args.collisions)))
@@ -153,6 +163,11 @@ def main(argv=None):
     p.add_argument("n", help="number of spheres (3D, elastic, random state, seed 1)")
     p.add_argument("--packing", type=float, default=0.3)
     p.add_argument("--neighbours", choices=("lists", "cells"), default="lists")
+    p.add_argument("--eps", type=float, help="constant coefficient of restitution (default: elastic); "
+                   "an inelastic periodic gas keeps the stress sums on, as a sheared one")
+    p.add_argument("--shear", type=float, default=0.0,
+                   help="Lees-Edwards shear rate (flow x, gradient y; with --eps 0.8 and packing 0.1 the "
+                        "steady rate is 0.5905, the gas of scripts/benchmarks/shear.py)")
     p.add_argument("--collisions", default="2e6", help="collisions of the sampled run")
     p.add_argument("--lines", type=int, default=30, help="rows of each table")
     p.add_argument("--child", help=argparse.SUPPRESS)

@@ -356,6 +356,23 @@ def test_list_rebuild_lists_what_the_sliding_margin_defines(dim, n, packing, pol
     assert checked > 3 * n
 
 
+@pytest.mark.parametrize("dim,packing", [(3, 0.1), (3, 0.3), (2, 0.2)])
+def test_sheared_lists_are_as_long_as_the_periodic_ones(dim, packing):
+    """The default shell of a sheared gas (engine.simulation.sheared_shell) counts the centres
+    that the sliding margin lists, so that its lists hold as many centres as the periodic
+    box's at its default shell; with the periodic shell they hold a fifth more."""
+    n = 3000 if dim == 3 else 2000
+    periodic = Simulation(random_state(n, packing, dim, seed=5), CollisionRule.elastic(), neighbours="lists")
+    own = sheared(n, packing, dim, 0.5, seed=5)
+    wide = sheared(n, packing, dim, 0.5, seed=5, shell=periodic.shell)
+    for sim in (periodic, own, wide):
+        sim.run(np.inf, max_collisions=n)
+    lp, lo, lw = (float(sim._engine.lists.nbn.mean()) for sim in (periodic, own, wide))
+    assert own.shell < periodic.shell and wide.shell == periodic.shell
+    assert abs(lo / lp - 1.0) < 0.05, (lo, lp)
+    assert lw / lp > 1.1, (lw, lp)
+
+
 @pytest.mark.parametrize("mode", ["lists", "cells"])
 @pytest.mark.parametrize("dim", [2, 3])
 def test_two_spheres_at_rest_in_sliding_rows_collide(mode, dim):
