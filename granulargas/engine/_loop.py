@@ -108,6 +108,7 @@ from granulargas.engine._resolved import resolved_pair
 from granulargas.engine._shear import (
     cross_le,
     integrate_stress,
+    interior_row,
     le_separation,
     le_wrap,
     next_rescale,
@@ -361,10 +362,7 @@ def predict_sheared(i, t, rec, count, events, lists, onlists, oncells, space, ha
     p = np.int64(-1)
     if onlists is not None:
         best = predict_expiry_le(i, t, rec, lists.centre, space.period, half_shell, shear)
-        r = row_of(np.float64(lists.centre[i, 1]), shear)
-        if shear.ny >= 7 and 1 <= r <= shear.ny - 2:
-            # no neighbour of a list centre in an interior row is listed through the sheared
-            # images (module doc of granulargas.engine._shear): the periodic pair times
+        if interior_row(row_of(np.float64(lists.centre[i, 1]), shear), shear):
             best, p = predict_pair(i, t, best, rec, lists.nbl, lists.nbn, space.period, None)
         else:
             best, p = predict_pair_le(i, t, best, rec, lists.nbl, lists.nbn, space.period, shear)

@@ -127,8 +127,8 @@ from granulargas.engine._prefetch import prefetch
 #: ``speed`` = a L_y (the image velocity), ``margin`` D and ``lifetime`` D / (a w_y) of the
 #: lists (list mode, eq. 3; 0 and inf otherwise), ``slide_time``
 #: = w_x / (a w_y) (cell mode: time between slides), ``slide`` (2,) i8 the index k of the
-#: last slide and m = k mod n_x (kept, so that the scans need no integer division), ``built`` (N,) f8 the build time of each particle's list
-#: (list mode; (1,) otherwise), ``thermostat`` (2,) f8: interval and temperature of the
+#: last slide and m = k mod n_x (kept, so that the scans need no integer division),
+#: ``built`` (N,) f8 the build time of each particle's list (list mode; (1,) otherwise), ``thermostat`` (2,) f8: interval and temperature of the
 #: velocity rescaling (interval inf: none), ``rescales`` (1,) i8 the index of the next one.
 ShearGeometry = namedtuple("ShearGeometry", ["rate", "lx", "ly", "wx", "wy", "nx", "ny", "speed", "margin",
                                              "lifetime", "slide_time", "slide", "built", "thermostat", "rescales"])
@@ -239,6 +239,15 @@ def _wrap_far(c, n):
     while c >= n:
         c -= n
     return c
+
+
+@inlined
+def interior_row(r, sh):
+    """Row r is not next to the sheared boundary and the box has at least 7 rows: every
+    neighbour of a particle (list mode: of a list centre) in row r lies in rows r - 1 .. r + 1
+    of the box, less than 3 w_y + round-off < L_y / 2 away along y, so its nearest image is
+    k = 0 and the pair times are those of the periodic box."""
+    return sh.ny >= 7 and 1 <= r <= sh.ny - 2
 
 
 @inlined
@@ -856,7 +865,7 @@ def scan_le(i, t, before, rec, grid, space, sh, own0, own_n, up0, up_n, down0, d
     k = _list_heads(first, k, grid.head, _wrap(r + 1, sh.ny), up0, up_n, cz, z0, z1, ncell, space.period[2], sh.nx)
     k = _list_heads(first, k, grid.head, _wrap(r - 1, sh.ny), down0, down_n, cz, z0, z1, ncell, space.period[2],
                     sh.nx)
-    if r >= 1 and r <= sh.ny - 2 and sh.ny >= 7:
+    if interior_row(r, sh):
         return _scan_listed(first, k, t, before, rec[i, 0], rec[i, 1], rec[i, 2], rec[i, 3], rec[i, 4], rec[i, 5],
                             rec[i, 7], rec, cell, space.period, None)
     return _scan_listed_le(first, k, t, before, rec, i, cell, space.period, sh)
@@ -937,10 +946,7 @@ def _y_layer(cx, cxn, o, m, nx):
     old0 = cx - 2 - m if o > 0 else cx - 1 + m
     d = cxn - (old0 + 2)
     h = nx >> 1
-    while d >= nx - h:  # into [-h, n_x - h), h = n_x // 2 (|d| < 2 n_x)
-        d -= nx
-    while d < -h:
-        d += nx
+    d = _wrap_far(d + h, nx) - h  # into [-h, n_x - h), h = n_x // 2
     c = old0 + 2 + d  # cxn unwrapped
     own0, own_n = _minus(c - 1, 3, old0, 4)
     back0 = c - 1 + m if o > 0 else c - 2 - m  # the window of the row left behind

@@ -149,7 +149,8 @@ def sheared_shell(packing: float, dimension: int = 3) -> float:
     c = 1.0 + periodic
     for _ in range(50):
         f = c ** dimension + k * c ** (dimension - 1) * (c - 1.0) - target
-        df = dimension * c ** (dimension - 1) + k * (dimension * c ** (dimension - 1) - (dimension - 1) * c ** (dimension - 2))
+        df = (dimension * c ** (dimension - 1)
+              + k * (dimension * c ** (dimension - 1) - (dimension - 1) * c ** (dimension - 2)))
         step = f / df
         c -= step
         if abs(step) < 1e-14 * c:
