@@ -79,6 +79,7 @@ contact values (:func:`granulargas.theory.contact_value` with ``form="closed"``)
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Callable
@@ -161,9 +162,12 @@ def mixture_contact_values(diameters, densities, dim: int = 3) -> np.ndarray:
     return first + 9.0 / 16.0 * phi / (1.0 - phi) ** 2 * (si * sj * m1) / (0.5 * (si + sj) * m2)
 
 
+@functools.lru_cache(maxsize=None)
 def _laguerre(nodes: int = _LAGUERRE_NODES):
-    """Nodes and weights of integral_0^inf e^-x f(x) dx."""
-    return np.polynomial.laguerre.laggauss(nodes)
+    """Nodes and weights of integral_0^inf e^-x f(x) dx (computed once, read-only)."""
+    x, w = np.polynomial.laguerre.laggauss(nodes)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
 
 
 def mixture_cooling_rates(temperatures, masses, diameters, densities, restitution, dim: int = 3,
@@ -402,10 +406,15 @@ class Mixture:
             return table.restitution(beta)
         return eps
 
+    @functools.cached_property
+    def _law(self):
+        """:meth:`restitution_law`, made once (its table is loaded once and grows as needed)."""
+        return self.restitution_law()
+
     def _args(self):
         chi = None if self.chi is None else np.asarray(self.chi, dtype=float)
         return (np.asarray(self.masses, dtype=float), np.asarray(self.diameters, dtype=float), self.densities,
-                self.restitution_law(), self.dimension, chi)
+                self._law, self.dimension, chi)
 
     def cooling_rates(self, temperatures) -> np.ndarray:
         """zeta_i (S,) at the species' temperatures (:func:`mixture_cooling_rates`)."""
