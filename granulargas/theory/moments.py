@@ -58,14 +58,15 @@ where u_j are quadrature nodes of ``c_n`` on (0, inf) and M_p[j, k, l] is the
 average, at ``c_n = u_j``, of the coefficient of ``eps^k a2^l`` over the 2d - 1
 other Gaussian variables (C and the transverse part of c). That average is of a
 polynomial of degree <= 8 (S2 of degree 4 times the change (10) of degree 4),
-computed exactly by Gauss-Hermite quadrature with 5 nodes per variable; the eps-coefficients are read off (3) itself, evaluated at
-five values of eps (the change (10) is a polynomial of degree 4 in eps), not
-typed in. The transverse variables enter only through ``|C_t + c_t/2|^2`` and
-``|C_t - c_t/2|^2`` (C_t the part of C across e), and the product grid repeats
-their pairs (sign flips and exchanges of the axes), so points with equal pairs are
-merged: 5^5 = 3125 points become 225 in 3D, 125 become 45 in 2D. The c_n-integral uses ``u^2/2 = y^20`` and Gauss-Legendre in y (eps
-depends on ``g^(1/5)``, and on its square root for the ``force`` end, both smooth
-in y); relative error ~1e-12 (tests).
+computed exactly by Gauss-Hermite quadrature with 5 nodes per variable; the
+eps-coefficients are read off (3) itself, evaluated at five values of eps (the
+change (10) is a polynomial of degree 4 in eps), not typed in. The transverse
+variables enter only through ``|C_t + c_t/2|^2`` and ``|C_t - c_t/2|^2`` (C_t the
+part of C across e), and the product grid repeats their pairs (sign flips and
+exchanges of the axes), so points with equal pairs are merged: 5^5 = 3125 points
+become 225 in 3D, 125 become 45 in 2D. The c_n-integral uses ``u^2/2 = y^20`` and
+Gauss-Legendre in y (eps depends on ``g^(1/5)``, and on its square root for the
+``force`` end, both smooth in y); relative error ~1e-12 (tests).
 
 Truncation: the moments are linear in a2 when the a2^2 term of ``f1 f2`` is
 dropped, the usual first Sonine approximation (van Noije & Ernst 1998); with
