@@ -127,7 +127,7 @@ def _pair_matrix(value, size: int, name: str) -> np.ndarray:
         return np.full((size, size), float(a))
     if a.shape != (size, size):
         raise ValueError(f"{name}: shape {a.shape}, expected ({size}, {size}) or one number")
-    if not np.allclose(a, a.T, rtol=0.0, atol=0.0):
+    if not np.array_equal(a, a.T):
         raise ValueError(f"{name}: must be symmetric (a property of the pair)")
     return a
 
@@ -400,9 +400,10 @@ class Mixture:
             # may lie beyond it, and get its end value
             beta = np.minimum(b[i, j] * np.asarray(u, dtype=float) ** 0.2, 39.0)
             top = float(np.max(beta)) if np.size(beta) else 0.0
-            table = cache.get("table")
-            if table is None or table.beta_limit <= top:
-                table = cache["table"] = restitution_table(min(max(top * 1.5, 1.0), 39.5), end=self.end)
+            table, limit = cache.get("table", (None, 0.0))
+            if limit <= top:
+                table = restitution_table(min(max(top * 1.5, 1.0), 39.5), end=self.end)
+                cache["table"] = table, table.beta_limit
             return table.restitution(beta)
         return eps
 
