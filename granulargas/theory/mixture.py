@@ -202,17 +202,20 @@ def mixture_cooling_rates(temperatures, masses, diameters, densities, restitutio
     zeta = np.zeros(size)
     if callable(restitution):
         x, w = _laguerre()
-        for i in range(size):
-            for j in range(size):
-                mu = m[j] / (m[i] + m[j])
-                s2 = temp[i] / m[i] + temp[j] / m[j]
-                # u = s sqrt(2 x): integral_0^inf u^3 phi_s(u) F(u) du = s^3 sqrt(2/pi) * int e^-x x F dx
-                u = np.sqrt(2.0 * s2 * x)
-                a = np.asarray(restitution(i, j, u), dtype=float)
-                bracket = (temp[i] - temp[j]) / ((m[i] + m[j]) * s2) + 0.5 * mu * (1.0 - a)
-                mean = float(np.sum(w * x * (1.0 + a) * bracket))
-                zeta[i] += (n[j] * chi_m[i, j] * sij[i, j] ** (dim - 1) * mu * m[i] / temp[i]
-                            * s2 ** 1.5 * mean)
+        # every pair (i, j) at once, axes (i, j, node)
+        mu = m[None, :] / (m[:, None] + m[None, :])
+        s2 = (temp / m)[:, None] + (temp / m)[None, :]
+        # u = s sqrt(2 x): integral_0^inf u^3 phi_s(u) F(u) du = s^3 sqrt(2/pi) * int e^-x x F dx
+        u = np.sqrt(2.0 * s2[..., None] * x)
+        a = np.array([[np.asarray(restitution(i, j, u[i, j]), dtype=float) for j in range(size)]
+                      for i in range(size)])
+        bracket = ((temp[:, None] - temp[None, :]) / ((m[:, None] + m[None, :]) * s2))[..., None] \
+            + (0.5 * mu)[..., None] * (1.0 - a)
+        mean = np.sum(w * x * (1.0 + a) * bracket, axis=-1)
+        # float_power: pow() as for one pair (an array's ** 1.5 rounds differently)
+        terms = n[None, :] * chi_m * sij ** (dim - 1) * mu * m[:, None] / temp[:, None] * np.float_power(s2, 1.5) * mean
+        for j in range(size):
+            zeta += terms[:, j]
         return math.sqrt(2.0) * pref * zeta
     alpha = _pair_matrix(restitution, size, "restitution")
     for i in range(size):
