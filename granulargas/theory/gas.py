@@ -104,6 +104,7 @@ per species (non-equipartition); it is not attempted.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -204,18 +205,19 @@ class Gas:
     end_time: float | None = None
     collisions_per_particle: float | None = None
 
-    @property
+    # computed once per gas (the ODE right-hand sides ask for them at every step)
+    @functools.cached_property
     def chi(self) -> float:
         """Enskog pair correlation at contact of the packing fraction (:func:`granulargas.theory.contact_value`)."""
         return float(contact_value(self.packing_fraction, self.dimension))
 
-    @property
+    @functools.cached_property
     def collision_frequency(self):
         """Enskog collision frequency per particle at T0 (Maxwellian)."""
         return float(collision_frequency(self.density, self.temperature, self.dimension, self.sigma, self.mass,
                                          chi=self.chi))
 
-    @property
+    @functools.cached_property
     def pair_constant(self) -> float:
         """b of two particles, beta = b g^(1/5) (:func:`granulargas.contact.material.pair_constant`);
         0 unless viscoelastic."""
