@@ -148,8 +148,10 @@ _NODES = 96
 REFERENCES = ("best", "first_sonine")
 
 
+@functools.lru_cache(maxsize=None)
 def _kernel_nodes(power: int, nodes: int = _NODES):
-    """Nodes u = g / s and normalised weights for averages over ``g^power exp(-g^2/(2 s^2)) dg``.
+    """Nodes u = g / s and normalised weights for averages over ``g^power exp(-g^2/(2 s^2)) dg``
+    (computed once, read-only).
 
     eps depends on g through g^(1/5) (and on sqrt of that for the ``force`` end), so
     Gauss-Laguerre in x = g^2/(2 s^2) converges slowly (x^(1/10) is not smooth at 0).
@@ -162,7 +164,9 @@ def _kernel_nodes(power: int, nodes: int = _NODES):
     w = 0.5 * y_max * w
     x = y**10
     w = w * x ** (0.5 * (power - 1)) * np.exp(-x) * 10.0 * y**9
-    return np.sqrt(2.0 * x), w / w.sum()
+    u, w = np.sqrt(2.0 * x), w / w.sum()
+    u.flags.writeable = w.flags.writeable = False
+    return u, w
 
 
 @dataclass(frozen=True)
