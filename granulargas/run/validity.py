@@ -661,8 +661,14 @@ def check_run(config) -> RunValidity:
 def _mixture_end(config, gas) -> tuple[float, float]:
     """(t_end, ln T_end) of a mixture: its own Maxwellian theory, every species cooling at its
     rate (:meth:`granulargas.theory.mixture.Mixture.predicted_end`); T = sum x_i T_i."""
-    mix = mixture_of_config(config)
-    t_end, temps = mix.predicted_end(gas.temperature, gas.end_time, gas.collisions_per_particle)
+    return _mixture_prediction(mixture_of_config(config), gas.temperature, gas.end_time, gas.collisions_per_particle)
+
+
+@functools.lru_cache(maxsize=16)
+def _mixture_prediction(mix, temperature: float, end_time, collisions_per_particle) -> tuple[float, float]:
+    """:func:`_mixture_end`, solved once per process for each mixture and stop condition (the
+    run's checks and the advice both predict with it)."""
+    t_end, temps = mix.predicted_end(temperature, end_time, collisions_per_particle)
     return float(t_end), math.log(float(mix.fractions @ temps))
 
 
