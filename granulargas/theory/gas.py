@@ -378,15 +378,14 @@ def _rates_at(gas: Gas, restitution=None, table=None):
     nu, weights = flat_weights(d)
     nu = nu.tolist()
     b = gas.pair_constant
-    if restitution is not None or not (gas.model == "viscoelastic" and b):
+    if restitution is None and not (gas.model == "viscoelastic" and b):  # eps does not depend on T
+        fixed = restitution_at_nodes(gas, gas.temperature)
+
+        def eps_at(T):
+            return fixed
+    elif restitution is not None:
         def eps_at(T):
             return restitution_at_nodes(gas, T, restitution)
-
-        if restitution is None:  # eps does not depend on T
-            fixed = eps_at(gas.temperature)
-
-            def eps_at(T):
-                return fixed
     else:
         u = speed_quadrature(d).u
 

@@ -85,7 +85,8 @@ import numpy as np
 from numpy.polynomial.hermite_e import hermegauss
 from numpy.polynomial.legendre import leggauss
 
-__all__ = ["SpeedQuadrature", "speed_quadrature", "moment_coefficients", "collision_moments", "solid_angle"]
+__all__ = ["SpeedQuadrature", "speed_quadrature", "moment_coefficients", "collision_moments", "solid_angle",
+           "eps_powers", "flat_weights"]
 
 #: Gauss-Legendre nodes for the normal impact speed c_n (u^2/2 = y^20, y in [0, 60^(1/20)])
 NORMAL_NODES = 96
