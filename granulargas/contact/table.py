@@ -34,6 +34,8 @@ Cache: tables are stored as ``.npz`` in ``$GRANULARGAS_CACHE_DIR`` (default
 integrator order and tolerance, format version). The file holds the largest table
 built so far for that key; smaller requests are slices of it, larger ones build the
 missing intervals only and replace it. An unreadable or mismatching file is rebuilt.
+A process reads a file once and keeps its arrays while the file stays the same (inode,
+size and modification time; a replaced file is read again).
 """
 
 from __future__ import annotations
@@ -218,9 +220,30 @@ def save_cached(path: Path, key_params: dict, **arrays) -> None:
         warnings.warn(f"could not cache the table in {path.parent}: {exc}", RuntimeWarning, stacklevel=3)
 
 
+#: table files read by this process: path -> (file identity, key, arrays)
+_READ: dict = {}
+
+
+def _read(path: Path, key_params: dict) -> dict | None:
+    """:func:`load_cached`, read once per process while the file stays the same (its identity:
+    inode, size, modification time; a rewritten file is read again)."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    ident = (st.st_ino, st.st_size, st.st_mtime_ns)
+    seen = _READ.get(path)
+    if seen is not None and seen[0] == ident and seen[1] == key_params:
+        return seen[2]
+    data = load_cached(path, key_params)
+    if data is not None:
+        _READ[path] = (ident, key_params, data)
+    return data
+
+
 def _load(path: Path, key_params: dict, n: int):
     """The cached table's first n intervals, or all of them when it has fewer (None: no table)."""
-    data = load_cached(path, key_params)
+    data = _read(path, key_params)
     if data is None or "coeffs" not in data:
         return None
     try:

@@ -509,9 +509,19 @@ def _haff(gas: V.Gas, eps: float, t):
 
 def constant_error(gas: V.Gas, eps: float, curve: V.CoolingCurve, t_end: float) -> float:
     """``max_t |T_const(t) / T_visco(t) - 1|`` over ``0 <= t <= t_end``."""
+    return _max_error(gas, eps, *_error_grid(curve, t_end))
+
+
+def _error_grid(curve: V.CoolingCurve, t_end: float):
+    """The times of :func:`constant_error` and the curve's T there."""
     t = curve.time[curve.time <= t_end]
     t = np.append(t, t_end)
-    return float(np.max(np.abs(_haff(gas, eps, t) / curve.temperature_at(t) - 1.0)))
+    return t, curve.temperature_at(t)
+
+
+def _max_error(gas: V.Gas, eps: float, t, temperature) -> float:
+    """:func:`constant_error` on the grid of :func:`_error_grid`."""
+    return float(np.max(np.abs(_haff(gas, eps, t) / temperature - 1.0)))
 
 
 def best_constant(gas: V.Gas, curve: V.CoolingCurve, t_end: float):
@@ -522,10 +532,11 @@ def best_constant(gas: V.Gas, curve: V.CoolingCurve, t_end: float):
     q_ref = float(V.effective_inelasticity(gas, gas.temperature))
     qs = q_ref * np.geomspace(0.05, 1.5, 80)
     qs = qs[qs < 1.0]
-    errs = [constant_error(gas, math.sqrt(1 - q), curve, t_end) for q in qs]
+    grid = _error_grid(curve, t_end)
+    errs = [_max_error(gas, math.sqrt(1 - q), *grid) for q in qs]
     k = int(np.argmin(errs))
     lo, hi = qs[max(k - 1, 0)], qs[min(k + 1, len(qs) - 1)]
-    res = minimize_scalar(lambda q: constant_error(gas, math.sqrt(1 - q), curve, t_end), bounds=(lo, hi),
+    res = minimize_scalar(lambda q: _max_error(gas, math.sqrt(1 - q), *grid), bounds=(lo, hi),
                           method="bounded", options={"xatol": 1e-7 * q_ref})
     q = float(res.x) if res.fun <= errs[k] else float(qs[k])
     return math.sqrt(1.0 - q), min(float(res.fun), float(errs[k]))

@@ -419,7 +419,17 @@ def rough_gas_from_config(config):
 
 def rough_end(rough, t_end: float | None, collisions: float | None):
     """(t_end, ln T_tr at t_end) of a rough gas by the two-temperature theory: the first of
-    ``t_end`` and the time its collisions per particle reach ``collisions``."""
+    ``t_end`` and the time its collisions per particle reach ``collisions`` (solved once per
+    process for each gas and stop condition: the run's checks and the advice both ask)."""
+    try:
+        hash(rough)
+    except TypeError:  # a gas with an unhashable field: solved each time
+        return _rough_end.__wrapped__(rough, t_end, collisions)
+    return _rough_end(rough, t_end, collisions)
+
+
+@functools.lru_cache(maxsize=16)
+def _rough_end(rough, t_end: float | None, collisions: float | None):
     t = t_end if t_end is not None else 1.0 / rough.gas.collision_frequency
     for _ in range(200):
         curve = rough_theory.two_temperature_curve(rough, t, points=50)
@@ -661,8 +671,14 @@ def check_run(config) -> RunValidity:
 def _mixture_end(config, gas) -> tuple[float, float]:
     """(t_end, ln T_end) of a mixture: its own Maxwellian theory, every species cooling at its
     rate (:meth:`granulargas.theory.mixture.Mixture.predicted_end`); T = sum x_i T_i."""
-    mix = mixture_of_config(config)
-    t_end, temps = mix.predicted_end(gas.temperature, gas.end_time, gas.collisions_per_particle)
+    return _mixture_prediction(mixture_of_config(config), gas.temperature, gas.end_time, gas.collisions_per_particle)
+
+
+@functools.lru_cache(maxsize=16)
+def _mixture_prediction(mix, temperature: float, end_time, collisions_per_particle) -> tuple[float, float]:
+    """:func:`_mixture_end`, solved once per process for each mixture and stop condition (the
+    run's checks and the advice both predict with it)."""
+    t_end, temps = mix.predicted_end(temperature, end_time, collisions_per_particle)
     return float(t_end), math.log(float(mix.fractions @ temps))
 
 

@@ -104,6 +104,7 @@ per species (non-equipartition); it is not attempted.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -112,9 +113,10 @@ from numpy.polynomial.legendre import leggauss
 
 from granulargas.contact import restitution_table
 from granulargas.contact.material import pair_constant
+from granulargas.errors import TableRangeError
 from granulargas.theory.enskog import collision_frequency, contact_value, enskog_cooling_rate, instability_length
 from granulargas.theory.hcs import FIRST_SONINE, HCSReference, first_sonine, hcs_reference
-from granulargas.theory.moments import moment_coefficients, speed_quadrature
+from granulargas.theory.moments import eps_powers, flat_weights, moment_coefficients, speed_quadrature
 
 __all__ = [
     "THERMAL_QUANTILES",
@@ -146,8 +148,10 @@ _NODES = 96
 REFERENCES = ("best", "first_sonine")
 
 
+@functools.lru_cache(maxsize=None)
 def _kernel_nodes(power: int, nodes: int = _NODES):
-    """Nodes u = g / s and normalised weights for averages over ``g^power exp(-g^2/(2 s^2)) dg``.
+    """Nodes u = g / s and normalised weights for averages over ``g^power exp(-g^2/(2 s^2)) dg``
+    (computed once, read-only).
 
     eps depends on g through g^(1/5) (and on sqrt of that for the ``force`` end), so
     Gauss-Laguerre in x = g^2/(2 s^2) converges slowly (x^(1/10) is not smooth at 0).
@@ -160,7 +164,9 @@ def _kernel_nodes(power: int, nodes: int = _NODES):
     w = 0.5 * y_max * w
     x = y**10
     w = w * x ** (0.5 * (power - 1)) * np.exp(-x) * 10.0 * y**9
-    return np.sqrt(2.0 * x), w / w.sum()
+    u, w = np.sqrt(2.0 * x), w / w.sum()
+    u.flags.writeable = w.flags.writeable = False
+    return u, w
 
 
 @dataclass(frozen=True)
@@ -203,18 +209,19 @@ class Gas:
     end_time: float | None = None
     collisions_per_particle: float | None = None
 
-    @property
+    # computed once per gas (the ODE right-hand sides ask for them at every step)
+    @functools.cached_property
     def chi(self) -> float:
         """Enskog pair correlation at contact of the packing fraction (:func:`granulargas.theory.contact_value`)."""
         return float(contact_value(self.packing_fraction, self.dimension))
 
-    @property
+    @functools.cached_property
     def collision_frequency(self):
         """Enskog collision frequency per particle at T0 (Maxwellian)."""
         return float(collision_frequency(self.density, self.temperature, self.dimension, self.sigma, self.mass,
                                          chi=self.chi))
 
-    @property
+    @functools.cached_property
     def pair_constant(self) -> float:
         """b of two particles, beta = b g^(1/5) (:func:`granulargas.contact.material.pair_constant`);
         0 unless viscoelastic."""
@@ -347,17 +354,56 @@ def cooling_rates(gas: Gas, temperature, a2, restitution=None, table=None):
         Cooling rate (dT/dt = -zeta T), rate of change of a2, and collision
         frequency per particle.
     """
-    d = gas.dimension
     eps = restitution_at_nodes(gas, temperature, restitution, table)
-    nu, mu2, mu4 = moment_coefficients(eps, d)
-    a = np.asarray(a2, dtype=float)
-    scale = _collision_scale(gas, temperature)
-    zeta = 2.0 / d * scale * (mu2[..., 0] + a * mu2[..., 1])
+    nu, mu2, mu4 = (np.moveaxis(c, -1, 0) for c in moment_coefficients(eps, gas.dimension))
+    return _rates(gas.dimension, _collision_scale(gas, temperature), nu, mu2, mu4, np.asarray(a2, dtype=float))
+
+
+def _rates(d, scale, nu, mu2, mu4, a):
+    """(G1)-(G3) from nu_c (``scale``), the moment coefficients ``(a2^0, a2^1)`` of nu_0, mu_2, mu_4
+    and a2."""
+    zeta = 2.0 / d * scale * (mu2[0] + a * mu2[1])
     # mu_2 (1 + a2) - mu_4 / (d + 2), linear in a2
-    source = mu2[..., 0] + (mu2[..., 0] + mu2[..., 1]) * a - (mu4[..., 0] + mu4[..., 1] * a) / (d + 2)
+    source = mu2[0] + (mu2[0] + mu2[1]) * a - (mu4[0] + mu4[1] * a) / (d + 2)
     da2 = 4.0 / d * scale * source
-    omega = scale * (nu[..., 0] + a * nu[..., 1])
+    omega = scale * (nu[0] + a * nu[1])
     return zeta, da2, omega
+
+
+def _rates_at(gas: Gas, restitution=None, table=None):
+    """:func:`cooling_rates` at one temperature and a2, as floats, with what does not depend on
+    them computed once (the ODE's right-hand side)."""
+    d, mass = gas.dimension, gas.mass
+    factor = gas.chi * gas.density * gas.sigma ** (d - 1)  # nu_c / sqrt(2T/m), eq. (G3)
+    nu, weights = flat_weights(d)
+    nu = nu.tolist()
+    b = gas.pair_constant
+    if restitution is None and not (gas.model == "viscoelastic" and b):  # eps does not depend on T
+        fixed = restitution_at_nodes(gas, gas.temperature)
+
+        def eps_at(T):
+            return fixed
+    elif restitution is not None:
+        def eps_at(T):
+            return restitution_at_nodes(gas, T, restitution)
+    else:
+        u = speed_quadrature(d).u
+
+        def eps_at(T):  # restitution_at_nodes
+            beta = b * (math.sqrt(2.0 * T / mass) * u) ** 0.2
+            if table is not None:
+                try:
+                    return table.restitution(beta)
+                except TableRangeError:
+                    pass
+            return _eps(beta, gas.end)
+
+    def rates(T, a2):
+        mu = (eps_powers(eps_at(T)).reshape(-1) @ weights).tolist()  # moment_coefficients
+        zeta, da2, omega = _rates(d, factor * math.sqrt(2.0 * T / mass), nu, mu[:2], mu[2:], a2)
+        return float(zeta), float(da2), float(omega)
+
+    return rates
 
 
 def pressure_factor(gas: Gas, temperature, a2=0.0, restitution=None):
@@ -517,11 +563,12 @@ def cooling_curve(gas: Gas, t_end: float | None = None, t_min_ratio: float | Non
         u_max = float(speed_quadrature(gas.dimension).u.max())
         table = restitution_table(float(gas.beta(math.sqrt(4.0 * T0 / gas.mass) * u_max)) * 1.01, end=gas.end)
 
+    rates = _rates_at(gas, restitution, table)
+
     def rhs(x, y):
         t_plus = t_free * math.exp(x)  # dt/dx = t + t_free
-        T = math.exp(y[0])
-        zeta, da2, omega = cooling_rates(gas, T, y[1], restitution, table)
-        return [-float(zeta) * t_plus, float(da2) * t_plus, float(omega) * t_plus]
+        zeta, da2, omega = rates(math.exp(y[0]), y[1])
+        return [-zeta * t_plus, da2 * t_plus, omega * t_plus]
 
     y0 = [math.log(T0), float(a2_initial), 0.0]
     atol = [1e-12, 1e-12, 1e-10]

@@ -79,6 +79,7 @@ contact values (:func:`granulargas.theory.contact_value` with ``form="closed"``)
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Callable
@@ -126,7 +127,7 @@ def _pair_matrix(value, size: int, name: str) -> np.ndarray:
         return np.full((size, size), float(a))
     if a.shape != (size, size):
         raise ValueError(f"{name}: shape {a.shape}, expected ({size}, {size}) or one number")
-    if not np.allclose(a, a.T, rtol=0.0, atol=0.0):
+    if not np.array_equal(a, a.T):
         raise ValueError(f"{name}: must be symmetric (a property of the pair)")
     return a
 
@@ -161,9 +162,12 @@ def mixture_contact_values(diameters, densities, dim: int = 3) -> np.ndarray:
     return first + 9.0 / 16.0 * phi / (1.0 - phi) ** 2 * (si * sj * m1) / (0.5 * (si + sj) * m2)
 
 
+@functools.lru_cache(maxsize=None)
 def _laguerre(nodes: int = _LAGUERRE_NODES):
-    """Nodes and weights of integral_0^inf e^-x f(x) dx."""
-    return np.polynomial.laguerre.laggauss(nodes)
+    """Nodes and weights of integral_0^inf e^-x f(x) dx (computed once, read-only)."""
+    x, w = np.polynomial.laguerre.laggauss(nodes)
+    x.flags.writeable = w.flags.writeable = False
+    return x, w
 
 
 def mixture_cooling_rates(temperatures, masses, diameters, densities, restitution, dim: int = 3,
@@ -198,17 +202,20 @@ def mixture_cooling_rates(temperatures, masses, diameters, densities, restitutio
     zeta = np.zeros(size)
     if callable(restitution):
         x, w = _laguerre()
-        for i in range(size):
-            for j in range(size):
-                mu = m[j] / (m[i] + m[j])
-                s2 = temp[i] / m[i] + temp[j] / m[j]
-                # u = s sqrt(2 x): integral_0^inf u^3 phi_s(u) F(u) du = s^3 sqrt(2/pi) * int e^-x x F dx
-                u = np.sqrt(2.0 * s2 * x)
-                a = np.asarray(restitution(i, j, u), dtype=float)
-                bracket = (temp[i] - temp[j]) / ((m[i] + m[j]) * s2) + 0.5 * mu * (1.0 - a)
-                mean = float(np.sum(w * x * (1.0 + a) * bracket))
-                zeta[i] += (n[j] * chi_m[i, j] * sij[i, j] ** (dim - 1) * mu * m[i] / temp[i]
-                            * s2 ** 1.5 * mean)
+        # every pair (i, j) at once, axes (i, j, node)
+        mu = m[None, :] / (m[:, None] + m[None, :])
+        s2 = (temp / m)[:, None] + (temp / m)[None, :]
+        # u = s sqrt(2 x): integral_0^inf u^3 phi_s(u) F(u) du = s^3 sqrt(2/pi) * int e^-x x F dx
+        u = np.sqrt(2.0 * s2[..., None] * x)
+        a = np.array([[np.asarray(restitution(i, j, u[i, j]), dtype=float) for j in range(size)]
+                      for i in range(size)])
+        bracket = ((temp[:, None] - temp[None, :]) / ((m[:, None] + m[None, :]) * s2))[..., None] \
+            + (0.5 * mu)[..., None] * (1.0 - a)
+        mean = np.sum(w * x * (1.0 + a) * bracket, axis=-1)
+        # float_power: pow() as for one pair (an array's ** 1.5 rounds differently)
+        terms = n[None, :] * chi_m * sij ** (dim - 1) * mu * m[:, None] / temp[:, None] * np.float_power(s2, 1.5) * mean
+        for j in range(size):
+            zeta += terms[:, j]
         return math.sqrt(2.0) * pref * zeta
     alpha = _pair_matrix(restitution, size, "restitution")
     for i in range(size):
@@ -396,16 +403,22 @@ class Mixture:
             # may lie beyond it, and get its end value
             beta = np.minimum(b[i, j] * np.asarray(u, dtype=float) ** 0.2, 39.0)
             top = float(np.max(beta)) if np.size(beta) else 0.0
-            table = cache.get("table")
-            if table is None or table.beta_limit <= top:
-                table = cache["table"] = restitution_table(min(max(top * 1.5, 1.0), 39.5), end=self.end)
+            table, limit = cache.get("table", (None, 0.0))
+            if limit <= top:
+                table = restitution_table(min(max(top * 1.5, 1.0), 39.5), end=self.end)
+                cache["table"] = table, table.beta_limit
             return table.restitution(beta)
         return eps
+
+    @functools.cached_property
+    def _law(self):
+        """:meth:`restitution_law`, made once (its table is loaded once and grows as needed)."""
+        return self.restitution_law()
 
     def _args(self):
         chi = None if self.chi is None else np.asarray(self.chi, dtype=float)
         return (np.asarray(self.masses, dtype=float), np.asarray(self.diameters, dtype=float), self.densities,
-                self.restitution_law(), self.dimension, chi)
+                self._law, self.dimension, chi)
 
     def cooling_rates(self, temperatures) -> np.ndarray:
         """zeta_i (S,) at the species' temperatures (:func:`mixture_cooling_rates`)."""

@@ -58,11 +58,15 @@ where u_j are quadrature nodes of ``c_n`` on (0, inf) and M_p[j, k, l] is the
 average, at ``c_n = u_j``, of the coefficient of ``eps^k a2^l`` over the 2d - 1
 other Gaussian variables (C and the transverse part of c). That average is of a
 polynomial of degree <= 8 (S2 of degree 4 times the change (10) of degree 4),
-computed exactly by Gauss-Hermite quadrature with 5 nodes per variable; the eps-coefficients are read off (3) itself, evaluated at
-five values of eps (the change (10) is a polynomial of degree 4 in eps), not
-typed in. The c_n-integral uses ``u^2/2 = y^20`` and Gauss-Legendre in y (eps
-depends on ``g^(1/5)``, and on its square root for the ``force`` end, both smooth
-in y); relative error ~1e-12 (tests).
+computed exactly by Gauss-Hermite quadrature with 5 nodes per variable; the
+eps-coefficients are read off (3) itself, evaluated at five values of eps (the
+change (10) is a polynomial of degree 4 in eps), not typed in. The transverse
+variables enter only through ``|C_t + c_t/2|^2`` and ``|C_t - c_t/2|^2`` (C_t the
+part of C across e), and the product grid repeats their pairs (sign flips and
+exchanges of the axes), so points with equal pairs are merged: 5^5 = 3125 points
+become 225 in 3D, 125 become 45 in 2D. The c_n-integral uses ``u^2/2 = y^20`` and
+Gauss-Legendre in y (eps depends on ``g^(1/5)``, and on its square root for the
+``force`` end, both smooth in y); relative error ~1e-12 (tests).
 
 Truncation: the moments are linear in a2 when the a2^2 term of ``f1 f2`` is
 dropped, the usual first Sonine approximation (van Noije & Ernst 1998); with
@@ -81,7 +85,8 @@ import numpy as np
 from numpy.polynomial.hermite_e import hermegauss
 from numpy.polynomial.legendre import leggauss
 
-__all__ = ["SpeedQuadrature", "speed_quadrature", "moment_coefficients", "collision_moments", "solid_angle"]
+__all__ = ["SpeedQuadrature", "speed_quadrature", "moment_coefficients", "collision_moments", "solid_angle",
+           "eps_powers", "flat_weights"]
 
 #: Gauss-Legendre nodes for the normal impact speed c_n (u^2/2 = y^20, y in [0, 60^(1/20)])
 NORMAL_NODES = 96
@@ -136,13 +141,30 @@ def _normal_nodes(nodes: int):
 
 def _transverse_grid(dim: int, hermite: int):
     """Gauss-Hermite points of C (d components, variance 1/4) and of the transverse
-    part of c (d - 1 components, variance 1); weights sum to 1."""
+    part of c (d - 1 components, variance 1), weights summing to 1, reduced to what the
+    integrand depends on: ``A1 = |C_t + c_t/2|^2``, ``A2 = |C_t - c_t/2|^2`` (C_t the d - 1
+    components of C across e) and ``C_n`` (its component along e). Points with equal
+    (A1, A2) are merged (their weights added): the sign flip of an axis and the exchange of
+    the transverse axes or of C_t and c_t/2 leave them unchanged, so 5^(2d-1) points become
+    a few hundred (3D) or a few dozen (2D)."""
     z, wz = hermegauss(hermite)
     wz = wz / math.sqrt(2.0 * math.pi)
-    k = 2 * dim - 1
-    pts = np.stack(np.meshgrid(*([z] * k), indexing="ij"), axis=-1).reshape(-1, k)
-    wts = np.prod(np.stack(np.meshgrid(*([wz] * k), indexing="ij"), axis=-1).reshape(-1, k), axis=1)
-    return 0.5 * pts[:, :dim], pts[:, dim:], wts
+    # one transverse axis: C_i = z_a / 2, c_i = z_b
+    ci, ti = (a.ravel() for a in np.meshgrid(0.5 * z, z, indexing="ij"))
+    wi = np.outer(wz, wz).ravel()
+    a1, a2, w = np.zeros(1), np.zeros(1), np.ones(1)
+    for _ in range(dim - 1):
+        p, q = ci + 0.5 * ti, ci - 0.5 * ti
+        a1 = (a1[:, None] + p * p).ravel()
+        a2 = (a2[:, None] + q * q).ravel()
+        w = (w[:, None] * wi).ravel()
+    pairs, index = np.unique(np.stack([a1, a2], axis=-1), axis=0, return_inverse=True)
+    w = np.bincount(index.ravel(), weights=w, minlength=pairs.shape[0])
+    # with C_n (variance 1/4): the reduced grid
+    a1 = np.repeat(pairs[:, 0], z.size)
+    a2 = np.repeat(pairs[:, 1], z.size)
+    cn = np.tile(0.5 * z, pairs.shape[0])
+    return a1, a2, cn, (w[:, None] * wz).ravel()
 
 
 @functools.lru_cache(maxsize=None)
@@ -151,36 +173,34 @@ def speed_quadrature(dim: int, nodes: int = NORMAL_NODES, hermite: int = HERMITE
     if dim not in (2, 3):
         raise ValueError(f"dim must be 2 or 3, got {dim!r}")
     u, wu = _normal_nodes(nodes)
-    C, ct, wt = _transverse_grid(dim, hermite)  # (G, d), (G, d-1), (G,)
-    G, J = wt.size, u.size
-    # relative velocity c = (c_t, u_j): shape (G, J, d); e is the last axis
-    c = np.empty((G, J, dim))
-    c[..., :-1] = ct[:, None, :]
-    c[..., -1] = u[None, :]
-    c1 = C[:, None, :] + 0.5 * c
-    c2 = C[:, None, :] - 0.5 * c
-    x1, x2 = (c1 * c1).sum(-1), (c2 * c2).sum(-1)
-    sonine = [np.ones((G, J)), sonine_s2(x1, dim) + sonine_s2(x2, dim)]  # f1 f2 = phi phi (1 + a2 (S2 + S2))
-    d2 = np.empty((_EPS_SAMPLES.size, G, J))
+    a1, a2, cn, wt = _transverse_grid(dim, hermite)  # (G,) each
+    # c1 = C + c/2, c2 = C - c/2 with c = (c_t, u_j), e the last axis: only the components
+    # along e depend on u_j (shape (G, J)); the transverse parts give a1, a2
+    n1 = cn[:, None] + 0.5 * u
+    n2 = cn[:, None] - 0.5 * u
+    x1, x2 = a1[:, None] + n1 * n1, a2[:, None] + n2 * n2
+    sonine = [np.ones_like(x1), sonine_s2(x1, dim) + sonine_s2(x2, dim)]  # f1 f2 = phi phi (1 + a2 (S2 + S2))
+    d2 = np.empty((_EPS_SAMPLES.size,) + x1.shape)
     d4 = np.empty_like(d2)
     for i, eps in enumerate(_EPS_SAMPLES):
         kick = 0.5 * (1.0 + eps) * u  # (J,): eq. (3) along e
-        p1, p2 = c1.copy(), c2.copy()
-        p1[..., -1] -= kick[None, :]
-        p2[..., -1] += kick[None, :]
-        y1, y2 = (p1 * p1).sum(-1), (p2 * p2).sum(-1)
+        p1, p2 = n1 - kick, n2 + kick
+        y1, y2 = a1[:, None] + p1 * p1, a2[:, None] + p2 * p2
         d2[i] = y1 + y2 - x1 - x2
         d4[i] = y1 * y1 + y2 * y2 - x1 * x1 - x2 * x2
     # eps-polynomial coefficients (degree 4) from the five samples
     inv_vander = np.linalg.inv(np.vander(_EPS_SAMPLES, 5, increasing=True))
-    d2 = np.einsum("ki,igj->kgj", inv_vander, d2)
-    d4 = np.einsum("ki,igj->kgj", inv_vander, d4)
     omega = solid_angle(dim)
     flux = wu * u  # Theta(c_n) c_n times the c_n density and weights
-    nu = np.stack([omega * flux * (wt @ s) for s in sonine], axis=-1)  # (J, 2)
-    mu2 = np.stack([-0.5 * omega * flux[:, None] * np.einsum("g,kgj,gj->jk", wt, d2, s) for s in sonine], axis=-1)
-    mu4 = np.stack([-0.5 * omega * flux[:, None] * np.einsum("g,kgj,gj->jk", wt, d4, s) for s in sonine], axis=-1)
-    return SpeedQuadrature(dim, u, nu, mu2, mu4)
+    weighted = [wt[:, None] * s for s in sonine]  # (G, J) each
+    nu = np.stack([omega * flux * w.sum(axis=0) for w in weighted], axis=-1)  # (J, 2)
+
+    def moment(d):  # (5, G, J) samples -> (J, 5, 2) weights
+        d = np.einsum("ki,igj->kgj", inv_vander, d, optimize=True)
+        return -0.5 * omega * flux[:, None, None] * np.stack([np.einsum("kgj,gj->jk", d, w, optimize=True)
+                                                              for w in weighted], axis=-1)
+
+    return SpeedQuadrature(dim, u, nu, moment(d2), moment(d4))
 
 
 def moment_coefficients(eps, dim: int):
@@ -196,11 +216,32 @@ def moment_coefficients(eps, dim: int):
     nu0, mu2, mu4 : arrays (..., 2)
         ``[..., 0]`` at a2 = 0, ``[..., 1]`` the coefficient of a2.
     """
-    q = speed_quadrature(dim)
+    nu, weights = flat_weights(dim)
     e = np.asarray(eps, dtype=float)
-    powers = np.stack([np.ones_like(e), e, e * e, e**3, e**4], axis=-1)  # (..., J, 5)
-    nu = q.nu.sum(axis=0) * np.ones(e.shape[:-1] + (1,))
-    return nu, np.einsum("...jk,jkl->...l", powers, q.mu2), np.einsum("...jk,jkl->...l", powers, q.mu4)
+    mu = eps_powers(e).reshape(e.shape[:-1] + (-1,)) @ weights
+    return nu * np.ones(e.shape[:-1] + (1,)), mu[..., :2], mu[..., 2:]
+
+
+def eps_powers(e):
+    """``e^k``, k = 0..4, along a new last axis (..., J, 5), the factors of eq. (11)."""
+    powers = np.empty(e.shape + (5,))
+    powers[..., 0] = 1.0
+    powers[..., 1] = e
+    powers[..., 2] = e * e
+    powers[..., 3] = e**3
+    powers[..., 4] = e**4
+    return powers
+
+
+@functools.lru_cache(maxsize=None)
+def flat_weights(dim: int):
+    """nu_0 summed over the nodes (2,) and the weights of mu_2, mu_4 as one (J * 5, 4) matrix
+    (columns: a2^0 and a2^1 of mu_2, then of mu_4), to multiply ``eps_powers(eps).reshape(..., -1)``."""
+    q = speed_quadrature(dim)
+    weights = np.concatenate([q.mu2, q.mu4], axis=-1).reshape(-1, 4)
+    nu = q.nu.sum(axis=0)
+    nu.flags.writeable = weights.flags.writeable = False
+    return nu, weights
 
 
 def collision_moments(eps, a2, dim: int):

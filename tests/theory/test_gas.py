@@ -31,6 +31,23 @@ def test_constant_eps_rates_are_enskog_with_van_noije_ernst(dim):
 
 
 @pytest.mark.parametrize("dim", [2, 3])
+def test_ode_right_hand_side_is_cooling_rates(dim):
+    # cooling_curve's right-hand side (T-independent parts computed once) against cooling_rates
+    from granulargas.contact import restitution_table
+    from granulargas.theory.gas import _rates_at
+
+    visco = gas(dim, 0.1, prefactor=0.3)
+    table = restitution_table(float(visco.beta(20.0)), end=visco.end)
+    cases = [(visco, None, table), (visco, None, None), (visco, lambda b: np.exp(-b), None),
+             (gas(dim, 0.1, model="constant", restitution=0.8), None, None),
+             (gas(dim, 0.1, model="elastic"), None, None)]
+    for g, law, tab in cases:
+        rates = _rates_at(g, law, tab)
+        for T, a2 in ((1.0, 0.0), (0.3, 0.01), (1e-4, -0.02)):
+            assert rates(T, a2) == tuple(float(x) for x in cooling_rates(g, T, a2, law, tab))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
 def test_constant_eps_curve_becomes_haff(dim):
     eps = 0.7
     g = gas(dim, 0.1, model="constant", restitution=eps)

@@ -1,6 +1,7 @@
 """Collision moments of the first Sonine approximation (granulargas.theory.moments) against
-closed forms for constant eps (van Noije & Ernst 1998; Brilliantov & Pöschel 2004) and a
-direct Monte Carlo average of the collision integral for the viscoelastic eps(g)."""
+closed forms for constant eps (van Noije & Ernst 1998; Brilliantov & Pöschel 2004), the full
+Gauss-Hermite product grid node by node, and a direct Monte Carlo average of the collision
+integral for the viscoelastic eps(g)."""
 
 import math
 
@@ -48,6 +49,40 @@ def test_elastic_gas_keeps_the_maxwellian_and_relaxes_a2(dim):
     assert abs(mu2[0]) < 1e-13 and abs(mu2[1]) < 1e-13
     assert abs(mu4[0]) < 1e-12
     assert mu4[1] > 0  # da2/dt = -(4/d) nu_c mu_4 / (d + 2): a2 decays
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_quadrature_is_the_product_grid(dim):
+    # speed_quadrature merges transverse grid points and reads the eps-polynomial off five
+    # samples; here the full 5^(2d-1)-point Gauss-Hermite product grid over C and the transverse
+    # part of c, with the collision rule (3) applied at each eps directly: the averages of
+    # Delta(c1^p + c2^p) at every node c_n = u_j, per unit nu_0 weight, with the a2 weight or not
+    q = speed_quadrature(dim)
+    z, wz = np.polynomial.hermite_e.hermegauss(5)
+    k = 2 * dim - 1
+    pts = np.stack(np.meshgrid(*[z] * k, indexing="ij"), axis=-1).reshape(-1, k)
+    wts = np.prod(np.stack(np.meshgrid(*[wz / math.sqrt(2 * math.pi)] * k, indexing="ij"), axis=-1).reshape(-1, k), 1)
+    C = 0.5 * pts[:, None, :dim]  # (G, 1, d)
+    c = np.concatenate([np.broadcast_to(pts[:, None, dim:], (wts.size, q.u.size, dim - 1)),
+                        np.broadcast_to(q.u[None, :, None], (wts.size, q.u.size, 1))], axis=-1)  # (G, J, d)
+    c1, c2 = C + 0.5 * c, C - 0.5 * c
+    x1, x2 = (c1 * c1).sum(-1), (c2 * c2).sum(-1)
+    s2 = sum(0.5 * x * x - 0.5 * (dim + 2) * x + dim * (dim + 2) / 8 for x in (x1, x2))
+    np.testing.assert_allclose(q.nu[:, 1] / q.nu[:, 0], wts @ s2, rtol=1e-12, atol=1e-12)
+    for eps in (0.0, 0.37, 0.8, 1.0):
+        e = np.zeros(dim)
+        e[-1] = 1.0
+        kick = (0.5 * (1 + eps) * q.u)[None, :, None] * e
+        y1, y2 = ((v * v).sum(-1) for v in (c1 - kick, c2 + kick))
+        powers = eps ** np.arange(5)
+        for name, p in (("mu2", 1), ("mu4", 2)):
+            change = y1**p + y2**p - x1**p - x2**p
+            size = y1**p + y2**p + x1**p + x2**p  # the round-off of the sum scales with its terms
+            ours = np.einsum("jkl,k->jl", getattr(q, name), powers) / q.nu[:, :1]
+            for col, weight in ((0, 1.0), (1, s2)):
+                direct = -0.5 * (wts @ (change * weight))
+                scale = 0.5 * (wts @ (size * np.abs(weight)))
+                assert np.all(np.abs(ours[:, col] - direct) <= 1e-13 * scale), (name, eps, col)
 
 
 def test_quadrature_converges():
