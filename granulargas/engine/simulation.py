@@ -662,7 +662,7 @@ class Simulation:
         while True:
             e = self._engine
             status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, self._time, 4 * self.n + 1000, target,
-                                   None, None, e.stress)
+                                   None, None, e.stress, self._walls_arg(e))
             if self._served(status):
                 prm = self._params()
             elif status in (_loop.DONE, _loop.MAX_COLLISIONS):
@@ -735,6 +735,11 @@ class Simulation:
                                      stress, spins, species)
         self._place_events(self._time)
         self._built = True
+
+    def _walls_arg(self, engine):
+        """The loop's ``walls`` argument: the walls' record in a box with wall axes, else None (the
+        loop is then compiled without the walls' code)."""
+        return engine.walls if self._space.wall_axes.size else None
 
     @property
     def _counters(self):
@@ -862,7 +867,8 @@ class Simulation:
             advance = _loop.advance_sheared
         while self.collisions < target:  # (a build's collisions at its own time count)
             e = self._engine
-            status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None, prm.space.shear, e.stress)
+            status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None, prm.space.shear, e.stress,
+                             self._walls_arg(e))
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)
