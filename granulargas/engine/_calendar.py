@@ -188,7 +188,7 @@ def _small_push(i, t, small, where, cs):
     return True
 
 
-@inlined
+@inlined_ir
 def _small_remove(k, small, where, cs):
     last = cs.size - 1
     cs.size = last
