@@ -31,7 +31,7 @@ import math
 import numba
 import numpy as np
 
-from granulargas._numba import inlined, inlined_ir, jit
+from granulargas._numba import inlined, inlined_ir, jit, kernel
 from granulargas.engine._cells import _wrap, cell_coord, cell_index, cell_insert, cell_remove
 from granulargas.engine._geometry import min_image
 
@@ -52,6 +52,10 @@ def splitmix_uniform(key, n):
     return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
+#: the axes as int64 constants: a Python int would be typed as its literal, one compile per axis
+_X, _Y, _Z = np.int64(0), np.int64(1), np.int64(2)
+
+
 @inlined
 def _uniform(key, u, i, a, dim):
     """Uniform a (axis) of particle i: u[i, a] if u holds a sweep's numbers, else from the key."""
@@ -64,9 +68,9 @@ def _uniform(key, u, i, a, dim):
 def _trial(r, i, step, key, u, dim, box):
     """Trial position r_i + step (2 u - 1) (u of particle i: :func:`_uniform`), wrapped
     into the box; x = box[0] flags a move to skip (-tiny + L rounded to L)."""
-    x = r[i, 0] + step * (2.0 * _uniform(key, u, i, 0, dim) - 1.0)
-    y = r[i, 1] + step * (2.0 * _uniform(key, u, i, 1, dim) - 1.0)
-    z = r[i, 2] + step * (2.0 * _uniform(key, u, i, 2, dim) - 1.0) if dim == 3 else r[i, 2]
+    x = r[i, 0] + step * (2.0 * _uniform(key, u, i, _X, dim) - 1.0)
+    y = r[i, 1] + step * (2.0 * _uniform(key, u, i, _Y, dim) - 1.0)
+    z = r[i, 2] + step * (2.0 * _uniform(key, u, i, _Z, dim) - 1.0) if dim == 3 else r[i, 2]
     x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
     y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
     z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
@@ -85,7 +89,7 @@ def sweep_uniforms(key, n, dim):
     return out
 
 
-@jit
+@kernel
 def fill_cells(r, box, ncell, cell_head, cell_next, cell_prev, cell_of):
     cell_head[:] = -1
     for i in range(r.shape[0] - 1, -1, -1):
@@ -93,7 +97,7 @@ def fill_cells(r, box, ncell, cell_head, cell_next, cell_prev, cell_of):
                     cell_prev, cell_of)
 
 
-@jit
+@kernel
 def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     """True if a sphere of radius[i] at (x, y, z) overlaps any particle j != i."""
     cx = cell_coord(x, box[0], ncell[0])
@@ -117,7 +121,7 @@ def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     return False
 
 
-@jit
+@kernel
 def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, u, dim):
     """One sweep of displacement moves r_i += step (2 u_i - 1), u_i the sweep's uniforms:
     the rows of ``u`` (N, dim), or if u is empty those of ``key`` (uint64; module
@@ -140,7 +144,7 @@ def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step,
     return accepted
 
 
-@jit
+@kernel
 def wrap_positions(r, box):
     """Positions wrapped into the box (a coordinate that rounds to L becomes 0)."""
     for k in range(r.shape[0]):
@@ -149,7 +153,7 @@ def wrap_positions(r, box):
         r[k, 2] = _in_box(r[k, 2], box[2])
 
 
-@jit
+@kernel
 def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     """Sum over j != i of max(0, R_i + R_j - |r_ij|) for particle i placed at (x, y, z)."""
     cx = cell_coord(x, box[0], ncell[0])
@@ -175,7 +179,7 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     return total
 
 
-@jit
+@kernel
 def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, u, dim):
     """Sweep of moves accepted when the moved particle's overlap depth does not grow.
 
@@ -235,7 +239,7 @@ def _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, o
     return m
 
 
-@jit
+@kernel
 def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
     """Indices of all particles overlapping some other one, into out; returns the count."""
     m = 0
@@ -246,7 +250,7 @@ def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
     return m
 
 
-@jit
+@kernel
 def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, kick, margin, near,
               out):
     """Push each particle of ``idx`` out of its overlaps (Gauss-Seidel descent).
@@ -340,7 +344,7 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
     return m
 
 
-@jit
+@kernel
 def distinct(values, m, seen, out):
     """Distinct entries of values[:m] into out (first-occurrence order); returns their number.
 
