@@ -39,10 +39,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from granulargas._numba import inlined, jit
+from granulargas._numba import inlined_ir, kernel
 
 
-@inlined
+@inlined_ir
 def _momentum_and_largest(v, dim, masses, shared):
     """(p_x, p_y, p_z, total mass, largest |velocity component|) of ``v[:, :dim]``."""
     p0 = 0.0
@@ -62,7 +62,7 @@ def _momentum_and_largest(v, dim, masses, shared):
     return p0, p1, p2, msum, vmax
 
 
-@inlined
+@inlined_ir
 def _scaled_peculiar_energy(v, i, dim, m, scale, u0, u1, u2):
     """m_i c_i^2 of the velocity of row i times ``scale``, less the scaled mean (u0, u1, u2)."""
     c0 = v[i, 0] * scale - u0
@@ -74,7 +74,7 @@ def _scaled_peculiar_energy(v, i, dim, m, scale, u0, u1, u2):
     return e * m
 
 
-@jit
+@kernel
 def energy_moments(v, dim, masses):
     """(T, a2, a3) of the velocities ``v[:, :dim]`` with masses (N,) or one shared mass (1,).
 
@@ -107,7 +107,7 @@ def energy_moments(v, dim, masses):
     return s1 * vmax * vmax / (dim * n), a2, a3
 
 
-@jit
+@kernel
 def kinetic_energy_momentum(v, dim, masses):
     """(sum m v^2 / 2, p_x, p_y, p_z) of the velocities ``v[:, :dim]`` (p_z = 0 in 2D),
     masses (N,) or one shared mass (1,); no temporary arrays."""
@@ -128,7 +128,7 @@ def kinetic_energy_momentum(v, dim, masses):
     return 0.5 * e, p0, p1, p2
 
 
-@jit
+@kernel
 def rough_moments(v, dim, masses, w, inertia):
     """(T_tr, T_rot, a20, a02, a11) of velocities ``v[:, :dim]`` and spins ``w`` (module docstring).
 

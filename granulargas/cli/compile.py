@@ -24,23 +24,25 @@ from granulargas.errors import ConfigError, SimulationError
 from granulargas.run.advise import method_line, summary_line
 from granulargas.run.runner import run_config
 from granulargas.run.validity import raise_if_invalid
-from granulargas.run.variants import BY_NAME, tiny_config
+from granulargas.run.variants import BY_NAME, tiny_config, walled_twin
 
 
 def build(name: str) -> None:
     """Compile (or load from the cache) the kernels of variant ``name`` in this process: a
     tiny run of that kind by the steps of ``granulargas run`` (the checks before the run,
-    the run, the advice after it)."""
+    the run, the advice after it), and for an engine variant without walls the same run in
+    a box with walls at rest (its second build)."""
     variant = BY_NAME[name]
     if variant.build is not None:
         variant.build()
         return
     with tempfile.TemporaryDirectory(prefix="granulargas-compile-") as tmp:
-        config = tiny_config(variant, tmp)
-        raise_if_invalid(config)
-        run_config(config, quiet=True, log=lambda line: None)
-        summary_line(config)
-        method_line(config)
+        configs = [tiny_config(variant, tmp)] + ([walled_twin(variant, tmp)] if variant.walled else [])
+        for config in configs:
+            raise_if_invalid(config)
+            run_config(config, quiet=True, log=lambda line: None)
+            summary_line(config)
+            method_line(config)
 
 
 @dataclass

@@ -1,4 +1,4 @@
-"""Compiled restitution lookup used by the engine (a numba leaf module).
+"""Restitution lookup: compiled for the engine (a numba leaf module), numpy for Python callers.
 
 The table (built by :mod:`granulargas.contact.table`) is a piecewise cubic in
 ``s = sqrt(beta)`` on a uniform grid ``s_k = k h``, ``k = 0..n``: on interval
@@ -12,6 +12,8 @@ engine can report a status code instead of extrapolating.
 """
 
 import math
+
+import numpy as np
 
 from granulargas._numba import jit
 
@@ -44,7 +46,6 @@ def table_lookup(beta, inv_h, coeffs):
     return coeffs[k, 0] + t * (coeffs[k, 1] + t * (coeffs[k, 2] + t * coeffs[k, 3]))
 
 
-@jit
 def table_beta_limit(inv_h, coeffs):
     """Largest beta the table covers: lookups need beta < this value.
 
@@ -56,13 +57,18 @@ def table_beta_limit(inv_h, coeffs):
     return s * s
 
 
-@jit
 def table_lookup_many(betas, inv_h, coeffs, out):
-    """``out[i] = table_lookup(betas[i], inv_h, coeffs)``; returns the count of misses (-1)."""
-    misses = 0
-    for i in range(betas.shape[0]):
-        v = table_lookup(betas[i], inv_h, coeffs)
-        out[i] = v
-        if v < 0.0:
-            misses += 1
-    return misses
+    """``out[i] = table_lookup(betas[i], inv_h, coeffs)``; returns the count of misses (-1).
+
+    numpy, for lookups from Python: the same operations in the same order as the compiled
+    :func:`table_lookup`, hence the same bits.
+    """
+    with np.errstate(invalid="ignore"):
+        x = np.sqrt(betas) * inv_h
+    inside = x < coeffs.shape[0]  # False for nan
+    x = np.where(inside, x, 0.0)
+    k = x.astype(np.int64)
+    t = x - k
+    c = coeffs[k]
+    out[:] = np.where(inside, c[:, 0] + t * (c[:, 1] + t * (c[:, 2] + t * c[:, 3])), -1.0)
+    return int(inside.size - np.count_nonzero(inside))

@@ -188,7 +188,7 @@ def _small_push(i, t, small, where, cs):
     return True
 
 
-@inlined
+@inlined_ir
 def _small_remove(k, small, where, cs):
     last = cs.size - 1
     cs.size = last
@@ -509,10 +509,11 @@ def cal_after_next(cal, skip):
     return int(small[c2, 1]) if c2 > 0 else -1
 
 
-@inlined
+@inlined_ir
 def cal_first(cal):
     """:func:`cal_peek` inlined where the window is usually open: the root of the small heap,
-    or the call when the heap is empty."""
+    or the call when the heap is empty. (Inlined in IR: a library of its own would be
+    compiled for nothing but the two call sites of each build of the loop.)"""
     return int(cal.small[0, 1]) if cal.state[0].size > 0 else cal_peek(cal)
 
 

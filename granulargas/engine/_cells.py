@@ -15,7 +15,7 @@ that join or leave (Smallenburg, Eur. Phys. J. E 45, 22 (2022)). Cells are at
 least 2 R_max + shell wide, so the 27 (2D: 9) cells around c_i hold every
 candidate. A full build is every list expiring at once: the lists start empty and each
 rebuild adds its particle to the lists of its new neighbours
-(:meth:`granulargas.engine.simulation.Simulation._expire_all_lists`).
+(:meth:`granulargas.engine.simulation.Simulation._first_events_by_the_loop`).
 
 Particle data come as one record per particle, ``rec[i] = (x, y, z, vx, vy,
 vz, t_i, R_i)`` (64 bytes, one cache line): positions at the particle's own

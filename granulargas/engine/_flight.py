@@ -32,7 +32,7 @@ import math
 
 import numpy as np
 
-from granulargas._numba import inlined
+from granulargas._numba import inlined, inlined_ir
 from granulargas.engine._geometry import collision_delay, exit_delay, min_image
 
 #: safe steps of :func:`expiry_delay` at most
@@ -188,7 +188,7 @@ def expiry_delay(dx, dy, dz, vx, vy, vz, radius, flight):
     return s
 
 
-@inlined
+@inlined_ir
 def face_delay(rel, v, g, width, lower, upper):
     """Time until a coordinate ``rel`` from the lower face of its cell (width ``width``),
     moving at v with acceleration g, reaches a face it may cross: (delay, side 0 lower

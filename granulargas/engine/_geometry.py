@@ -24,7 +24,7 @@ that overlaps and recedes is left alone: it separates.
 
 import math
 
-from granulargas._numba import inlined
+from granulargas._numba import inlined, inlined_ir
 
 
 @inlined
@@ -96,7 +96,7 @@ def exit_delay(dx, dy, dz, vx, vy, vz, radius):
     return (q - b) / v2
 
 
-@inlined
+@inlined_ir
 def wall_delay(x, v, radius, length):
     """Time until a sphere at coordinate x, moving at v along a wall axis, touches a wall.
 

@@ -919,7 +919,8 @@ def prefetch_next_lists(i1, p, ev, lists, cells, cal, prm, shear):
 
 # ------------------------------------------------------------------------ loop
 @kernel
-def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear=None, stress=None):
+def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear=None, stress=None,
+            walls=None):
     """Process events in time order until ``until`` (or a budget); see module doc.
 
     Parameters
@@ -943,6 +944,9 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
         an argument of its own so that numba removes its branches when it is None.
     stress : None or STRESS record
         The pressure tensor's sums (``engine.stress``), likewise.
+    walls : None or Walls
+        ``engine.walls`` in a box with wall axes; None without any (no wall event can occur),
+        so that the build of a box without walls carries none of the walls' code.
 
     Returns
     -------
@@ -955,7 +959,6 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
     cells = engine.cells
     cal = engine.calendar
     c = engine.counters[0]
-    walls = engine.walls
     contacts = engine.contacts
     spins = engine.spins
     species = engine.species
@@ -1023,18 +1026,19 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
             clock = tick(probe, REBUILD, clock)
             if status != DONE:
                 break
-        elif j == WALL:
-            status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, prm.flight, prm.wallkinds, shear, stress, spins,
-                                  species)
-            clock = tick(probe, P_WALL, clock)
-            if status != DONE:
-                if status == COLLAPSE:
-                    ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
-                                 contacts, prm.flight, prm.wallkinds, shear)
-                    if not cal_update(i, ti, cal):
-                        status = CALENDAR
-                    c.events += 1
-                break
+        elif j == WALL:  # (never without wall axes: that build has no walls)
+            if walls is not None:
+                status = execute_wall(i, ev.tag[i], te, p, c, walls, prm, prm.flight, prm.wallkinds, shear, stress,
+                                      spins, species)
+                clock = tick(probe, P_WALL, clock)
+                if status != DONE:
+                    if status == COLLAPSE:
+                        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
+                                     contacts, prm.flight, prm.wallkinds, shear)
+                        if not cal_update(i, ti, cal):
+                            status = CALENDAR
+                        c.events += 1
+                    break
         else:
             # ---- stale event: the partner changed course; just re-predict
             stream(i, te, rec, p.img, prm.space.period, prm.flight)
@@ -1079,7 +1083,8 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
 
 
 @kernel
-def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear=None, stress=None):
+def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear=None, stress=None,
+                   walls=None):
     """:func:`advance` with the white-noise driving: the driving step is a global event.
 
     Runs :func:`advance` up to the next driving step (k + 1/2) dt_k (:func:`predict_kick`;
@@ -1093,7 +1098,7 @@ def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisi
         t_kick = predict_kick(c, prm)
         stop = t_kick if t_kick < until else until
         status = advance(engine, onlists, oncells, prm, stop, events_end - c.events, max_collisions, probe, shear,
-                         stress)
+                         stress, walls)
         if status != DONE or t_kick > until:
             return status
         status = execute_kick(c.time, engine.particles, engine.events, engine.lists, onlists, oncells,
@@ -1106,7 +1111,8 @@ def advance_driven(engine, onlists, oncells, prm, until, max_events, max_collisi
 
 
 @kernel
-def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear, stress):
+def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collisions, probe, shear, stress,
+                    walls=None):
     """:func:`advance` under Lees-Edwards boundaries, with their global events: the slides of
     the cell mode (:func:`granulargas.engine._shear.slide_scan`), the thermostat's rescaling
     (:func:`execute_rescale`) and the white-noise driving's steps (:func:`execute_kick`).
@@ -1122,7 +1128,7 @@ def advance_sheared(engine, onlists, oncells, prm, until, max_events, max_collis
         t_next = min(t_kick, t_slide, t_rescale)
         stop = t_next if t_next < until else until
         status = advance(engine, onlists, oncells, prm, stop, events_end - c.events, max_collisions, probe, shear,
-                         stress)
+                         stress, walls)
         if status != DONE or t_next > until:
             return status
         clock = probe_start(probe)

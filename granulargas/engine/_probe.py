@@ -13,6 +13,7 @@ Parts of one event (indices into the probe array; ``probe[PARTS + k]`` counts
 the calls of part k):
 """
 
+import numpy as np
 from llvmlite import ir
 from numba import types
 from numba.core import cgutils
@@ -20,7 +21,9 @@ from numba.extending import intrinsic
 
 from granulargas._numba import inlined
 
-POP, COLLIDE, REBUILD, WALL, STALE, PREDICT, UPDATE, PREFETCH, PEEK, GLOBAL = range(10)
+#: int64, not Python ints: numba types a Python int constant as its literal and would compile
+#: :func:`probe` once per part
+POP, COLLIDE, REBUILD, WALL, STALE, PREDICT, UPDATE, PREFETCH, PEEK, GLOBAL = (np.int64(k) for k in range(10))
 PART_NAMES = ["pop + validate", "collide (+ partner)", "list rebuild", "wall", "stale",
               "predict i", "update i", "prefetch", "peek next", "global events"]
 PARTS = len(PART_NAMES)

@@ -515,7 +515,7 @@ class Simulation:
     def _build(self, target=_INT_MAX):
         """Internal state from the public state (a pure function of it). ``target``: the
         collision count at which the present run stops (the lists mode's build runs the loop,
-        :meth:`_expire_all_lists`)."""
+        :meth:`_first_events_by_the_loop`)."""
         n, d = self._positions.shape
         spc = self._space
         p3 = np.zeros((n, 3))
@@ -554,11 +554,16 @@ class Simulation:
             lists = _state.Grid(head=np.empty(ncells, dtype=np.int32), cell=cell,
                                 width=spc.box / spc.ncell, pair_t=pair_t,
                                 fresh=np.full(FRESH_SIZE if sh is None else SHEAR_FRESH_SIZE, -1, dtype=np.int64))
-            if sh is None:
-                build_grid(rec, lists, spc)
-            else:
+            if sh is not None:
                 _shear.build_grid_le(self._time, rec, lists, spc, sh)
-            self._finish_build(particles, events, lists, None, order, qt=qt, where=where)
+                self._finish_build(particles, events, lists, None, order, qt=qt, where=where)
+                return
+            build_grid(rec, lists, spc)
+            partner[:] = _loop.STALE  # every particle re-predicted now, by the loop
+            tag[:] = 0
+            qt[:] = self._time
+            self._finish_build(particles, events, lists, None, order, qt=qt, where=where, expired=True)
+            self._first_events_by_the_loop(target)
             return
         partner, tag, where, qt = _state.event_rows(n)
         events = _state.Events(partner=partner, tag=tag)
@@ -574,7 +579,7 @@ class Simulation:
             tag[:] = 0
             qt[:] = self._time
             self._finish_build(particles, events, lists, cells, order, qt=qt, where=where, expired=True)
-            self._expire_all_lists(target)
+            self._first_events_by_the_loop(target)
             return
         while True:
             lists = _state.Lists(centre=centre, nbl=np.empty((n, self._nb_width), dtype=np.int32),
@@ -631,29 +636,37 @@ class Simulation:
             self._cell_width = slots
         return cells
 
-    def _expire_all_lists(self, target=_INT_MAX):
-        """The neighbour lists and every particle's first event, by the event loop itself: every
-        list expires at the present time (``_build`` sets the centres, the cells, empty lists and
-        these expiries), and the loop rebuilds each list and predicts its particle's event as at
-        any expiry. A particle's prediction follows its own rebuild, so it sees its whole list
-        (the lists of the particles not yet rebuilt are partial, but every pair is predicted by
-        its later-rebuilt particle). The build's expiries are not counted as events of the run;
-        the calendar is then placed anew, its width matched to the predicted events.
+    def _first_events_by_the_loop(self, target=_INT_MAX):
+        """Every particle's first event, by the event loop itself (no kernel of its own to compile).
+
+        Neighbour lists: every list expires at the present time (``_build`` sets the centres, the
+        cells, empty lists and these expiries), and the loop rebuilds each list and predicts its
+        particle's event as at any expiry. A particle's prediction follows its own rebuild, so it
+        sees its whole list (the lists of the particles not yet rebuilt are partial, but every
+        pair is predicted by its later-rebuilt particle). Cell crossings: every particle has a
+        stale event at the present time, and the loop predicts it as after any stale event (each
+        prediction scans the cells around its particle and stores only its own best pair, so the
+        order does not matter). The build's events are not counted as events of the run; the
+        calendar is then placed anew, its width matched to the predicted events.
 
         A pair that overlaps and approaches collides at once, during the build; if that
-        collision is the run's last (``target``), the build's remaining expiries stay in the
+        collision is the run's last (``target``), the build's remaining events stay in the
         calendar as ordinary events at this time (and count as events when they are executed).
         """
         c = self._counters
-        expiries = int(c["expiries"])
-        # every expiry is in the calendar's first window; the predictions to come need windows
-        # of the width the events will have: 48 events per window among N, each some half
-        # shell's flight away (far smaller or larger widths put the next events beyond the
-        # window count's integer range, or all of them into the first window)
+        kind = "stale" if self.neighbours == "cells" else "expiries"
+        before = int(c[kind])
+        # every build event is in the calendar's first window; the predictions to come need
+        # windows of the width the events will have: 48 events per window among N, each some
+        # half shell's (cell's) flight away (far smaller or larger widths put the next events
+        # beyond the window count's integer range, or all of them into the first window)
         rec = self._engine.particles.rec
+        spc = self._space
+        d = self.dimension
+        reach = float(np.min(spc.box[:d] / spc.ncell[:d])) if self.neighbours == "cells" else self.shell
         v2 = float(np.mean(np.sum(rec[:, 3:6] ** 2, axis=1)))
         g = 0.0 if self.gravity is None else float(np.sqrt(np.sum(np.square(self.gravity))))
-        flight = 0.5 * self.shell / math.sqrt(v2) if v2 > 0 else (math.sqrt(self.shell / g) if g > 0 else 1.0)
+        flight = 0.5 * reach / math.sqrt(v2) if v2 > 0 else (math.sqrt(reach / g) if g > 0 else 1.0)
         self._engine.calendar.state["width"][0] = PER_WINDOW * flight / self.n
         prm = self._params()
         # the loop stops right after any event once the count has reached its target: the build
@@ -662,7 +675,7 @@ class Simulation:
         while True:
             e = self._engine
             status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, self._time, 4 * self.n + 1000, target,
-                                   None, None, e.stress)
+                                   None, None, e.stress, self._walls_arg(e))
             if self._served(status):
                 prm = self._params()
             elif status in (_loop.DONE, _loop.MAX_COLLISIONS):
@@ -670,23 +683,24 @@ class Simulation:
             elif status != _loop.BUDGET:
                 self._raise(status)
         c = self._counters
-        built = int(c["expiries"]) - expiries
+        built = int(c[kind]) - before
         c["events"] = int(c["events"]) - built
-        c["expiries"] = expiries
+        c[kind] = before
         if status == _loop.MAX_COLLISIONS:
             return
         e = self._engine
         cal = allocate_calendar(self.n, qt=e.calendar.qt, where=e.calendar.where)
-        self._engine = e._replace(lists=e.lists._replace(nbl=self._compact_lists(e.lists.nbl, e.lists.nbn),
-                                                         scratch=self._new_scratch()),
-                                  calendar=cal)
+        if e.cells is not None:
+            e = e._replace(lists=e.lists._replace(nbl=self._compact_lists(e.lists.nbl, e.lists.nbn),
+                                                  scratch=self._new_scratch()))
+        self._engine = e._replace(calendar=cal)
         self._place_events(self._time)
 
     def _finish_build(self, particles, events, lists, cells, order, qt=None, where=None, expired=False):
         """Contacts, every particle's event, counters and the calendar (after the neighbour search;
         ``qt``, ``where``: the calendar's per-particle arrays, views into the mode's per-particle
-        rows). ``expired``: the events are set already, every list expiring now
-        (:meth:`_expire_all_lists`); the calendar's window holds them all."""
+        rows). ``expired``: the events are set already, every list expiring now or every event
+        stale (:meth:`_first_events_by_the_loop`); the calendar's window holds them all."""
         n = self.n
         spc = self._space
         rec = particles.rec
@@ -735,6 +749,11 @@ class Simulation:
                                      stress, spins, species)
         self._place_events(self._time)
         self._built = True
+
+    def _walls_arg(self, engine):
+        """The loop's ``walls`` argument: the walls' record in a box with wall axes, else None (the
+        loop is then compiled without the walls' code)."""
+        return engine.walls if self._space.wall_axes.size else None
 
     @property
     def _counters(self):
@@ -862,7 +881,8 @@ class Simulation:
             advance = _loop.advance_sheared
         while self.collisions < target:  # (a build's collisions at its own time count)
             e = self._engine
-            status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None, prm.space.shear, e.stress)
+            status = advance(e, *_loop.mode_flags(e.cells), prm, until, chunk, target, None, prm.space.shear, e.stress,
+                             self._walls_arg(e))
             if status == _loop.BUDGET:
                 if progress is not None:
                     progress(self)

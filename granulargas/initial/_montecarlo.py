@@ -31,7 +31,7 @@ import math
 import numba
 import numpy as np
 
-from granulargas._numba import inlined, inlined_ir, jit
+from granulargas._numba import inlined, jit, kernel
 from granulargas.engine._cells import _wrap, cell_coord, cell_index, cell_insert, cell_remove
 from granulargas.engine._geometry import min_image
 
@@ -52,6 +52,10 @@ def splitmix_uniform(key, n):
     return float(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
+#: the axes as int64 constants: a Python int would be typed as its literal, one compile per axis
+_X, _Y, _Z = np.int64(0), np.int64(1), np.int64(2)
+
+
 @inlined
 def _uniform(key, u, i, a, dim):
     """Uniform a (axis) of particle i: u[i, a] if u holds a sweep's numbers, else from the key."""
@@ -64,9 +68,9 @@ def _uniform(key, u, i, a, dim):
 def _trial(r, i, step, key, u, dim, box):
     """Trial position r_i + step (2 u - 1) (u of particle i: :func:`_uniform`), wrapped
     into the box; x = box[0] flags a move to skip (-tiny + L rounded to L)."""
-    x = r[i, 0] + step * (2.0 * _uniform(key, u, i, 0, dim) - 1.0)
-    y = r[i, 1] + step * (2.0 * _uniform(key, u, i, 1, dim) - 1.0)
-    z = r[i, 2] + step * (2.0 * _uniform(key, u, i, 2, dim) - 1.0) if dim == 3 else r[i, 2]
+    x = r[i, 0] + step * (2.0 * _uniform(key, u, i, _X, dim) - 1.0)
+    y = r[i, 1] + step * (2.0 * _uniform(key, u, i, _Y, dim) - 1.0)
+    z = r[i, 2] + step * (2.0 * _uniform(key, u, i, _Z, dim) - 1.0) if dim == 3 else r[i, 2]
     x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
     y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
     z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
@@ -85,7 +89,7 @@ def sweep_uniforms(key, n, dim):
     return out
 
 
-@jit
+@kernel
 def fill_cells(r, box, ncell, cell_head, cell_next, cell_prev, cell_of):
     cell_head[:] = -1
     for i in range(r.shape[0] - 1, -1, -1):
@@ -93,7 +97,7 @@ def fill_cells(r, box, ncell, cell_head, cell_next, cell_prev, cell_of):
                     cell_prev, cell_of)
 
 
-@jit
+@kernel
 def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     """True if a sphere of radius[i] at (x, y, z) overlaps any particle j != i."""
     cx = cell_coord(x, box[0], ncell[0])
@@ -117,7 +121,7 @@ def overlaps(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     return False
 
 
-@jit
+@kernel
 def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, u, dim):
     """One sweep of displacement moves r_i += step (2 u_i - 1), u_i the sweep's uniforms:
     the rows of ``u`` (N, dim), or if u is empty those of ``key`` (uint64; module
@@ -140,7 +144,7 @@ def sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step,
     return accepted
 
 
-@jit
+@kernel
 def wrap_positions(r, box):
     """Positions wrapped into the box (a coordinate that rounds to L becomes 0)."""
     for k in range(r.shape[0]):
@@ -149,7 +153,7 @@ def wrap_positions(r, box):
         r[k, 2] = _in_box(r[k, 2], box[2])
 
 
-@jit
+@kernel
 def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     """Sum over j != i of max(0, R_i + R_j - |r_ij|) for particle i placed at (x, y, z)."""
     cx = cell_coord(x, box[0], ncell[0])
@@ -175,7 +179,7 @@ def overlap_depth(i, x, y, z, r, radius, box, ncell, cell_head, cell_next):
     return total
 
 
-@jit
+@kernel
 def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, step, key, u, dim):
     """Sweep of moves accepted when the moved particle's overlap depth does not grow.
 
@@ -210,32 +214,7 @@ def relax_sweep(r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of,
     return overlapping
 
 
-@inlined_ir
-def _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, out, m):
-    """Append i's overlap partners to out[m:], return the new length."""
-    cx = cell_coord(x, box[0], ncell[0])
-    cy = cell_coord(y, box[1], ncell[1])
-    cz = cell_coord(z, box[2], ncell[2])
-    for oz in range(-1 if ncell[2] >= 3 else 0, 2 if ncell[2] >= 3 else 1):
-        kz = _wrap(cz + oz, ncell[2])
-        for oy in range(-1, 2):
-            row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
-            for ox in range(-1, 2):
-                j = cell_head[_wrap(cx + ox, ncell[0]) + row]
-                while j >= 0:
-                    if j != i:
-                        dx = min_image(x - r[j, 0], box[0])
-                        dy = min_image(y - r[j, 1], box[1])
-                        dz = min_image(z - r[j, 2], box[2])
-                        s = radius[i] + radius[j]
-                        if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
-                            out[m] = j
-                            m += 1
-                    j = cell_next[j]
-    return m
-
-
-@jit
+@kernel
 def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
     """Indices of all particles overlapping some other one, into out; returns the count."""
     m = 0
@@ -246,7 +225,7 @@ def overlapping(r, radius, box, ncell, cell_head, cell_next, out):
     return m
 
 
-@jit
+@kernel
 def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_of, kick, margin, near,
               out):
     """Push each particle of ``idx`` out of its overlaps (Gauss-Seidel descent).
@@ -276,71 +255,81 @@ def push_some(idx, r, radius, box, ncell, cell_head, cell_next, cell_prev, cell_
         pz = 0.0
         reach = radius[i]
         nn = 0
-        cx = cell_coord(x, box[0], ncell[0])
-        cy = cell_coord(y, box[1], ncell[1])
-        cz = cell_coord(z, box[2], ncell[2])
-        for oz in range(-1 if ncell[2] >= 3 else 0, 2 if ncell[2] >= 3 else 1):
-            kz = _wrap(cz + oz, ncell[2])
-            for oy in range(-1, 2):
-                row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
-                for ox in range(-1, 2):
-                    j = cell_head[_wrap(cx + ox, ncell[0]) + row]
-                    while j >= 0:
-                        if j != i:
-                            dx = min_image(x - r[j, 0], box[0])
-                            dy = min_image(y - r[j, 1], box[1])
-                            dz = min_image(z - r[j, 2], box[2])
-                            s = radius[i] + radius[j]
-                            d2 = dx * dx + dy * dy + dz * dz
-                            if d2 < s * s and d2 > 0.0:
-                                dd = d2**0.5
-                                f = (0.5 * (s - dd) + margin * s) / dd
-                                px += f * dx
-                                py += f * dy
-                                pz += f * dz
-                            if d2 < (s + reach) * (s + reach):
-                                if nn < cap:
-                                    near[nn] = j
-                                nn += 1
-                        j = cell_next[j]
-        if px == 0.0 and py == 0.0 and pz == 0.0:
-            continue
-        x += kick[k] * px
-        y += kick[k] * py
-        z += kick[k] * pz
-        x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
-        y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
-        z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
-        if x >= box[0] or y >= box[1] or z >= box[2]:
-            continue
-        c = cell_index(x, y, z, box, ncell)
-        if c != cell_of[i]:
-            cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
-            cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
-        r[i, 0] = x
-        r[i, 1] = y
-        r[i, 2] = z
         m0 = m
-        moved2 = kick[k] * kick[k] * (px * px + py * py + pz * pz)
-        if nn <= cap and moved2 < reach * reach:
-            for q in range(nn):
-                j = near[q]
-                dx = min_image(x - r[j, 0], box[0])
-                dy = min_image(y - r[j, 1], box[1])
-                dz = min_image(z - r[j, 2], box[2])
-                s = radius[i] + radius[j]
-                if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
-                    out[m] = j
-                    m += 1
-        else:
-            m = _overlap_partners(i, x, y, z, r, radius, box, ncell, cell_head, cell_next, out, m)
+        # one scan of the cells around (x, y, z) serves both passes: pass 0 at i's place (the
+        # push and the near particles), pass 1 at its new place when the near particles do
+        # not suffice (its new overlaps)
+        for scan in range(2):
+            cx = cell_coord(x, box[0], ncell[0])
+            cy = cell_coord(y, box[1], ncell[1])
+            cz = cell_coord(z, box[2], ncell[2])
+            for oz in range(-1 if ncell[2] >= 3 else 0, 2 if ncell[2] >= 3 else 1):
+                kz = _wrap(cz + oz, ncell[2])
+                for oy in range(-1, 2):
+                    row = ncell[0] * (_wrap(cy + oy, ncell[1]) + ncell[1] * kz)
+                    for ox in range(-1, 2):
+                        j = cell_head[_wrap(cx + ox, ncell[0]) + row]
+                        while j >= 0:
+                            if j != i:
+                                dx = min_image(x - r[j, 0], box[0])
+                                dy = min_image(y - r[j, 1], box[1])
+                                dz = min_image(z - r[j, 2], box[2])
+                                s = radius[i] + radius[j]
+                                d2 = dx * dx + dy * dy + dz * dz
+                                if scan == 1:
+                                    if d2 < s * s and m < out.shape[0]:
+                                        out[m] = j
+                                        m += 1
+                                else:
+                                    if d2 < s * s and d2 > 0.0:
+                                        dd = d2**0.5
+                                        f = (0.5 * (s - dd) + margin * s) / dd
+                                        px += f * dx
+                                        py += f * dy
+                                        pz += f * dz
+                                    if d2 < (s + reach) * (s + reach):
+                                        if nn < cap:
+                                            near[nn] = j
+                                        nn += 1
+                            j = cell_next[j]
+            if scan == 1:
+                break
+            if px == 0.0 and py == 0.0 and pz == 0.0:
+                break
+            x += kick[k] * px
+            y += kick[k] * py
+            z += kick[k] * pz
+            x = x - box[0] if x >= box[0] else (x + box[0] if x < 0.0 else x)
+            y = y - box[1] if y >= box[1] else (y + box[1] if y < 0.0 else y)
+            z = z - box[2] if z >= box[2] else (z + box[2] if z < 0.0 else z)
+            if x >= box[0] or y >= box[1] or z >= box[2]:
+                break
+            c = cell_index(x, y, z, box, ncell)
+            if c != cell_of[i]:
+                cell_remove(i, cell_head, cell_next, cell_prev, cell_of)
+                cell_insert(i, c, cell_head, cell_next, cell_prev, cell_of)
+            r[i, 0] = x
+            r[i, 1] = y
+            r[i, 2] = z
+            moved2 = kick[k] * kick[k] * (px * px + py * py + pz * pz)
+            if nn <= cap and moved2 < reach * reach:
+                for q in range(nn):
+                    j = near[q]
+                    dx = min_image(x - r[j, 0], box[0])
+                    dy = min_image(y - r[j, 1], box[1])
+                    dz = min_image(z - r[j, 2], box[2])
+                    s = radius[i] + radius[j]
+                    if dx * dx + dy * dy + dz * dz < s * s and m < out.shape[0]:
+                        out[m] = j
+                        m += 1
+                break
         if m > m0 and m < out.shape[0]:
             out[m] = i
             m += 1
     return m
 
 
-@jit
+@kernel
 def distinct(values, m, seen, out):
     """Distinct entries of values[:m] into out (first-occurrence order); returns their number.
 

@@ -9,9 +9,12 @@ kinds, one entry each: its name (``granulargas compile NAME``), what it is (the
 line a run prints before it compiles it), the tiny run that compiles it, and
 which runs use it. What does *not* make a variant: the dimension (2D runs use the
 3D kernels with z = 0), the collision rule (elastic, constant, viscoelastic and
-the TC model share one loop), walls and polydispersity (run-time data), the
-numbers of particles and of snapshots. Species do (``[[species]]``: the loops with the
-law per pair of species).
+the TC model share one loop), polydispersity (run-time data), the numbers of
+particles and of snapshots. Species do (``[[species]]``: the loops with the law per
+pair of species). Walls at rest are a second build of each engine variant without a
+wall scene (a box without wall axes compiles its loop without the walls' code): the
+variant's tiny build makes both, a periodic run and one with a wall axis
+(:func:`walled_twin`).
 
 A feature that adds a compiled variant adds one entry here: its tiny config (the
 keys that select it, on top of :data:`TINY`), the variants it builds on
@@ -117,6 +120,15 @@ class Variant:
     #: before the run can tell a bad config from a good one (a placement too dense for
     #: its radii fails there), and bad input gets one line on stderr: not announced
     announced: bool = True
+
+    @property
+    def walled(self) -> bool:
+        """Whether the variant has a second build with walls at rest (:func:`walled_twin`):
+        the engine's variants whose tiny run has no wall axis (collisions that take time
+        have periodic boundaries only)."""
+        return (self.build is None and self.config.get("run.method", "edmd") == "edmd"
+                and "wall" not in self.config.get("system.boundary", ())
+                and self.config.get("collision.duration") != "resolved")
 
 
 def _build_placement():
@@ -245,6 +257,16 @@ def tiny_config(variant: Variant, directory) -> RunConfig:
         text.append("[[species]]")
         text += [f"{name} = {_toml(value)}" for name, value in table.items()]
     return parse_config("\n".join(text) + "\n", source=f"<{variant.name}>")
+
+
+def walled_twin(variant: Variant, directory) -> RunConfig:
+    """The tiny run of ``variant`` in a box with walls at rest on z (its loop's second build,
+    with the walls' code; :attr:`Variant.walled`)."""
+    boundary = list(variant.config.get("system.boundary", ["periodic"] * 3))
+    boundary[2] = "wall"
+    twin = Variant(f"{variant.name}-walled", variant.what, {**variant.config, "system.boundary": boundary},
+                   variant.uses)
+    return tiny_config(twin, directory)
 
 
 def _toml(value) -> str:

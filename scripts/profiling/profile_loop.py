@@ -89,10 +89,10 @@ def profile(n, packing, walls=False, seed=1, neighbours="lists", shear=None, she
             target = min(c0 + ncoll, sim.collisions + n)
             if sheared:
                 status = _loop.advance_sheared(e, *_loop.mode_flags(e.cells), prm, np.inf, 10**12, target, probe,
-                                               prm.space.shear, e.stress)
+                                               prm.space.shear, e.stress, sim._walls_arg(e))
             else:
                 status = _loop.advance(e, *_loop.mode_flags(e.cells), prm, np.inf, 10**12, target, probe, None,
-                                       e.stress)
+                                       e.stress, sim._walls_arg(e))
             if status == OVERFLOW:
                 sim._grow_lists()
             elif status == CELL_OVERFLOW:

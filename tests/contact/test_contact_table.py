@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from granulargas.contact import ode, restitution_table
-from granulargas.contact.lookup import table_beta_limit, table_lookup
+from granulargas.contact.lookup import table_beta_limit, table_lookup, table_lookup_many
 from granulargas.errors import TableRangeError
 
 
@@ -33,6 +33,20 @@ def test_table_refuses_to_extrapolate(cache_dir):
     with pytest.raises(TableRangeError, match="outside the restitution table"):
         table.restitution(2.0)
     assert not table.covers([0.5, 2.0]) and table.covers([0.0, 0.5, 1.0])
+
+
+def test_lookups_from_python_give_the_engine_lookup_bit_for_bit(cache_dir):
+    table = restitution_table(2.0)
+    limit = table.beta_limit
+    rng = np.random.default_rng(7)
+    b = np.concatenate([rng.uniform(0, limit, 2000), rng.uniform(0, 1e-6, 100),
+                        [0.0, limit, limit * (1 - 1e-15), limit * (1 + 1e-9), 1e300, np.inf, np.nan, -1.0, -0.0]])
+    for coeffs in (table.coeffs, table.duration_coeffs):
+        out = np.empty_like(b)
+        misses = table_lookup_many(b, table.inv_h, coeffs, out)
+        engine = np.array([table_lookup(x, table.inv_h, coeffs) for x in b])
+        assert np.array_equal(out, engine)
+        assert misses == np.count_nonzero(engine == -1.0) == 5  # beyond the limit, 1e300, inf, nan, -1
 
 
 def test_extension_keeps_the_grid_and_the_values(cache_dir):

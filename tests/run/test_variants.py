@@ -18,7 +18,8 @@ from granulargas.errors import ConfigError
 from granulargas.io.config import load_config
 from granulargas.run import runner
 from granulargas.run.validity import raise_if_invalid
-from granulargas.run.variants import BY_NAME, VARIANTS, describe, run_neighbours, tiny_config, variants_for
+from granulargas.run.variants import (BY_NAME, VARIANTS, describe, run_neighbours, tiny_config, variants_for,
+                                      walled_twin)
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -79,6 +80,20 @@ def test_each_variant_tiny_run_passes_the_checks_of_a_run(tmp_path):
     for v in VARIANTS:
         if v.config is not None:
             raise_if_invalid(tiny_config(v, tmp_path))
+
+
+def test_engine_variants_without_walls_also_build_walls_at_rest(tmp_path):
+    """A box with walls compiles a loop of its own (the periodic one carries no walls' code):
+    ``granulargas compile`` builds it beside each engine variant whose tiny run is periodic, by
+    a run of the same variant with a wall axis."""
+    walled = [v.name for v in VARIANTS if v.walled]
+    assert {"lists", "cells", "lists-driven", "cells-driven", "lists-rough", "cells-mixture",
+            "cells-shear"} <= set(walled)
+    assert not {"placement", "dsmc", "resolved", "cells-walls", "lists-gravity"} & set(walled)
+    for name in walled:
+        twin = walled_twin(BY_NAME[name], tmp_path)
+        assert "wall" in twin.system.boundary and BY_NAME[name] in variants_for(twin), name
+        raise_if_invalid(twin)
 
 
 def test_sheared_runs_compile_the_sheared_loops(tmp_path):
@@ -253,7 +268,9 @@ def test_after_compile_a_first_run_compiles_nothing(tmp_path):
 
     built = granulargas("compile", "placement", "lists")
     assert "compiled  placement" in built.stdout and "compiled  lists" in built.stdout
-    run = granulargas("run", str(cfg), "--overwrite", "--set", "collision.restitution=0.7",
-                      "--set", "system.dimension=3", "--set", 'run.neighbours="lists"')
-    assert "compiling" not in run.stderr, run.stderr
-    assert "compiled code from the cache" in run.stdout
+    for walls in ("periodic", "wall"):
+        run = granulargas("run", str(cfg), "--overwrite", "--set", "collision.restitution=0.7",
+                          "--set", "system.dimension=3", "--set", 'run.neighbours="lists"',
+                          "--set", f'system.boundary=["periodic", "periodic", "{walls}"]')
+        assert "compiling" not in run.stderr, run.stderr
+        assert "compiled code from the cache" in run.stdout
