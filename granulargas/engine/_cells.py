@@ -106,7 +106,7 @@ def slot_remove(i, c, cell_ids, cell_n):
     cell_n[c] = last
 
 
-@inlined
+@inlined_ir
 def _gaps2(x, c, length, n):
     """Squared distances from x to the lower and upper faces of its cell c (0 if outside)."""
     w = length / n
@@ -117,7 +117,7 @@ def _gaps2(x, c, length, n):
     return lo * lo, hi * hi
 
 
-@inlined
+@inlined_ir
 def _pick(o, lo2, hi2):
     if o < 0:
         return lo2
@@ -283,7 +283,7 @@ def _wrap(c, n):
     return c
 
 
-@inlined
+@inlined_ir
 def _shift(c, n, length):
     """Periodic offset of unwrapped cell coordinate c: the cell's contents sit at x + shift."""
     if c < 0:

@@ -585,7 +585,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     return DONE
 
 
-@inlined
+@inlined_ir
 def _expired(i, st, c):
     """Count a list expiry whose rebuild returned ``st`` (0, or the error with i noted)."""
     if st != 0:
@@ -818,7 +818,7 @@ def execute_rescale(t, p, ev, lists, onlists, oncells, cal, c, prm, shear, stres
 
 
 # -------------------------------------------------------------------- prefetch
-@inlined
+@inlined_ir
 def _prefetch_particle(i, p, ev, lists, cal):
     """Prefetch hints for the per-particle rows an event of particle i touches (not
     ``img``, which only a wrap through the box writes)."""
