@@ -1117,6 +1117,17 @@ def stress_sums(rec, mass, sh, out):
         out[YZ] += m * cy * cz
 
 
+def stress_sums_of(rec, mass, sh, out):
+    """:func:`stress_sums` in numpy, for a build made from Python (no kernel compiled for it):
+    the same products, summed in the same order (``np.cumsum`` adds one term after the other),
+    hence the same bits."""
+    cx = rec[:, 3] if sh is None else rec[:, 3] - sh.rate * (rec[:, 1] - 1.5 * sh.ly)
+    cy = rec[:, 4]
+    cz = rec[:, 5]
+    for q, (a, b) in zip((XX, YY, ZZ, XY, XZ, YZ), ((cx, cx), (cy, cy), (cz, cz), (cx, cy), (cx, cz), (cy, cz))):
+        out[q] = np.cumsum(mass * a * b)[-1] if rec.shape[0] else 0.0
+
+
 # ------------------------------------------------------------------ global events
 @inlined
 def next_slide(sh, oncells):

@@ -735,7 +735,7 @@ class Simulation:
         stress = None
         if self.stress:
             stress = np.zeros(1, dtype=_shear.STRESS)
-            _shear.stress_sums(rec, particles.mass, spc.shear, stress[0]["s"])
+            _shear.stress_sums_of(rec, particles.mass, spc.shear, stress[0]["s"])
             stress[0]["k"] = self._stress_window[:6]
             stress[0]["w"] = self._stress_window[6:]
         tg = self.tangential  # rough particles; None: the loop compiles without spins

@@ -423,3 +423,25 @@ def test_stress_refused_under_gravity():
     st = random_state(60, 0.1, 3, seed=1)
     with pytest.raises(ConfigError, match="stress: the pressure tensor under gravity"):
         Simulation(st, CollisionRule.elastic(), stress=True, gravity=(0.0, 0.0, -1.0))
+
+
+@pytest.mark.parametrize("sheared", [False, True])
+def test_stress_sums_from_python_are_the_kernels_bit_for_bit(sheared):
+    """A build's kinetic stress sums come from numpy (``stress_sums_of``); the compiled loop's
+    global events use the kernel ``stress_sums``: both must give the same bits."""
+    from granulargas.engine import _shear
+
+    rng = np.random.default_rng(3)
+    n = 777
+    rec = np.zeros((n, 8))
+    rec[:, :3] = rng.uniform(0.0, 9.0, (n, 3))
+    rec[:, 3:6] = rng.normal(0.0, 1.0, (n, 3))
+    mass = rng.uniform(0.5, 2.0, n)
+    sh = _shear.shear_geometry(0.4, np.array([9.0, 9.0, 9.0]), np.array([4, 4, 4]), n) if sheared else None
+    kernel, numpy_sums = np.empty(6), np.empty(6)
+    _shear.stress_sums(rec, mass, sh, kernel)
+    _shear.stress_sums_of(rec, mass, sh, numpy_sums)
+    assert np.array_equal(kernel, numpy_sums)
+    assert np.allclose(numpy_sums[:3], [np.sum(mass * c * c) for c in
+                                        ((rec[:, 3] - 0.4 * (rec[:, 1] - 13.5)) if sheared else rec[:, 3],
+                                         rec[:, 4], rec[:, 5])])
