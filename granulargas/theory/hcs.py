@@ -135,20 +135,86 @@ def _first_sonine_columns(eps, dim):
     return {"a2": a2, "a3": np.zeros_like(a2), "zeta_factor": 1.0 + 3.0 * a2 / 16.0, "omega_factor": 1.0 - a2 / 16.0}
 
 
-@lru_cache(maxsize=None)
-def _splines(dim: int):
-    """Per quantity: (spline of the difference from first Sonine, nodes with eps = 1, errors, interpolation error)."""
+#: version of the cached spline file's layout (:func:`_spline_coefficients`)
+_SPLINE_FORMAT = 1
+
+
+def _fit_splines(eps, diff):
+    """scipy's cubic spline (not-a-knot) through (eps, diff) as (4, n-1) coefficients, and its
+    interpolation error: 1/16 of the largest deviation of the spline through every other node
+    from the left-out node (module doc)."""
     from scipy.interpolate import CubicSpline
 
-    col = read_table()[dim]
+    loo = [abs(CubicSpline(np.delete(eps, k), np.delete(diff, k))(eps[k]) - diff[k]) for k in range(1, eps.size - 1)]
+    return np.ascontiguousarray(CubicSpline(eps, diff).c), max(loo) / 16.0
+
+
+def _nodes(col, dim):
+    """The nodes of the splines (the table's eps and 1) and, per quantity, the difference from
+    first Sonine there."""
     eps = np.append(col["restitution"], 1.0)
     first = _first_sonine_columns(eps, dim)
+    return eps, {q: np.append(col[q], first[q][-1]) - first[q] for q in _QUANTITIES}
+
+
+@lru_cache(maxsize=None)
+def _spline_coefficients() -> dict:
+    """``{(dim, quantity): (coefficients (4, n-1), interpolation error)}`` of the table's splines.
+
+    Fitted by scipy once and kept in the table cache (``hcs-splines-<digest>.npz`` in
+    :func:`granulargas.contact.table.cache_dir`, keyed by the table's text and scipy's version),
+    so that a run reads them with numpy (importing ``scipy.interpolate`` costs about 0.4 s of a
+    new process's start-up), like the restitution tables.
+    """
+    import hashlib
+
+    import scipy
+
+    from granulargas.contact.table import cache_dir, load_cached, save_cached
+
+    text = TABLE_PATH.read_bytes()
+    key = {"format": _SPLINE_FORMAT, "table": hashlib.sha256(text).hexdigest(), "scipy": scipy.__version__}
+    path = cache_dir() / f"hcs-splines-{key['table'][:16]}.npz"
+    names = [f"{d}-{q}" for d in (2, 3) for q in _QUANTITIES]
+    arrays = load_cached(path, key)
+    if arrays is None or any(n not in arrays or n + "-error" not in arrays for n in names):
+        table = read_table()
+        arrays = {}
+        for d in (2, 3):
+            eps, diff = _nodes(table[d], d)
+            for q in _QUANTITIES:
+                arrays[f"{d}-{q}"], error = _fit_splines(eps, diff[q])
+                arrays[f"{d}-{q}-error"] = np.array(error)
+        save_cached(path, key, **arrays)
+    return {(d, q): (arrays[f"{d}-{q}"], float(arrays[f"{d}-{q}-error"])) for d in (2, 3) for q in _QUANTITIES}
+
+
+def _piecewise_cubic(nodes, coefficients, x: float) -> float:
+    """A spline's value at x from its (4, n-1) coefficients (scipy's ``PPoly`` layout: the
+    polynomial of interval k in powers of x - nodes[k], highest first; the end intervals
+    extend beyond the nodes)."""
+    k = min(max(int(np.searchsorted(nodes, x, side="right")) - 1, 0), nodes.size - 2)
+    t = x - nodes[k]
+    c = coefficients[:, k]
+    value = 0.0
+    power = 1.0
+    for m in (3, 2, 1, 0):  # powers summed in scipy's order, for its bits
+        value += c[m] * power
+        power *= t
+    return float(value)
+
+
+@lru_cache(maxsize=None)
+def _splines(dim: int):
+    """Per quantity: (spline coefficients of the difference from first Sonine, nodes with eps = 1,
+    errors, interpolation error)."""
+    col = read_table()[dim]
+    eps = np.append(col["restitution"], 1.0)
+    fitted = _spline_coefficients()
     out = {}
     for q in _QUANTITIES:
-        diff = np.append(col[q], first[q][-1]) - first[q]
-        err = np.append(col[q + "_error"], 0.0)
-        loo = [abs(CubicSpline(np.delete(eps, k), np.delete(diff, k))(eps[k]) - diff[k]) for k in range(1, eps.size - 1)]
-        out[q] = (CubicSpline(eps, diff), eps, err, max(loo) / 16.0)
+        coefficients, interp = fitted[dim, q]
+        out[q] = (coefficients, eps, np.append(col[q + "_error"], 0.0), interp)
     out["relaxation_rate"] = (col["restitution"], col["relaxation_rate"])
     return out
 
@@ -176,8 +242,8 @@ def hcs_reference(eps: float, dim: int = 3) -> HCSReference:
     first = _first_sonine_columns(eps, dim)
     vals = {}
     for q in _QUANTITIES:
-        spline, nodes, err, interp = s[q]
-        vals[q] = float(first[q] + spline(eps))
+        coefficients, nodes, err, interp = s[q]
+        vals[q] = float(first[q] + _piecewise_cubic(nodes, coefficients, eps))
         vals[q + "_error"] = float(math.hypot(np.interp(eps, nodes, err), interp))
     e_nodes, rate = s["relaxation_rate"]
     return HCSReference(DSMC_TABLE, eps, int(dim), relaxation_rate=float(np.interp(eps, e_nodes, rate)), **vals)

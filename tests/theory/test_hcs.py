@@ -134,3 +134,38 @@ def test_cooling_factors_are_pair_averages_of_the_hcs_velocities(dim):
     assert abs(c_omega - r.omega_factor) < 4 * math.hypot(e_omega, r.omega_factor_error)
     # and the measurement resolves the first-Sonine value of the cooling rate
     assert abs(c_zeta - (1 + 3 * th.sonine_a2(eps, dim) / 16)) > 4 * e_zeta
+
+
+def test_cached_splines_give_scipys_spline_bits(tmp_path, monkeypatch):
+    """The splines kept in the cache and evaluated with numpy give the bits of scipy's
+    ``CubicSpline`` through the same nodes, whether fitted in this process, read back from
+    the cache file, or refitted after the file was damaged."""
+    from scipy.interpolate import CubicSpline
+
+    from granulargas.theory import hcs
+
+    monkeypatch.setenv("GRANULARGAS_CACHE_DIR", str(tmp_path))
+    eps_grid = np.concatenate([np.linspace(0.1, 1.0, 181)[:-1], [0.1234567, 0.9999999]])
+    expected = {}
+    for dim in (2, 3):
+        col = read_table()[dim]
+        nodes = np.append(col["restitution"], 1.0)
+        first = first_sonine(1.0, dim).a2
+        diff = np.append(col["a2"], first) - th.sonine_a2(nodes, dim)
+        spline = CubicSpline(nodes, diff)
+        expected[dim] = [float(th.sonine_a2(e, dim) + spline(e)) for e in eps_grid]
+
+    def a2s():
+        hcs._spline_coefficients.cache_clear()
+        hcs._splines.cache_clear()
+        return {dim: [hcs_reference(float(e), dim).a2 for e in eps_grid] for dim in (2, 3)}
+
+    try:
+        assert a2s() == expected  # fitted here, and written
+        (cached,) = tmp_path.glob("hcs-splines-*.npz")
+        assert a2s() == expected  # read back
+        cached.write_bytes(b"not a numpy file")
+        assert a2s() == expected  # refitted
+    finally:
+        hcs._spline_coefficients.cache_clear()
+        hcs._splines.cache_clear()
