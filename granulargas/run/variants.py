@@ -239,9 +239,11 @@ def describe(variants) -> str:
     return parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
 
 
-def tiny_config(variant: Variant, directory) -> RunConfig:
-    """The tiny run that compiles ``variant`` (its output file in ``directory``)."""
-    keys = {**TINY, **variant.config, "output.file": str(Path(directory) / f"{variant.name}.h5")}
+def tiny_config(variant: Variant, directory, extra: dict | None = None, suffix: str = "") -> RunConfig:
+    """The tiny run that compiles ``variant`` (its output file in ``directory``); ``extra``: config
+    keys on top of the variant's, ``suffix``: added to its name (output file, config source)."""
+    name = variant.name + suffix
+    keys = {**TINY, **variant.config, **(extra or {}), "output.file": str(Path(directory) / f"{name}.h5")}
     species = keys.pop("species", [])
     sections: dict[str, dict] = {}
     for key, value in keys.items():
@@ -256,7 +258,7 @@ def tiny_config(variant: Variant, directory) -> RunConfig:
     for table in species:
         text.append("[[species]]")
         text += [f"{name} = {_toml(value)}" for name, value in table.items()]
-    return parse_config("\n".join(text) + "\n", source=f"<{variant.name}>")
+    return parse_config("\n".join(text) + "\n", source=f"<{name}>")
 
 
 def walled_twin(variant: Variant, directory) -> RunConfig:
@@ -264,9 +266,7 @@ def walled_twin(variant: Variant, directory) -> RunConfig:
     with the walls' code; :attr:`Variant.walled`)."""
     boundary = list(variant.config.get("system.boundary", ["periodic"] * 3))
     boundary[2] = "wall"
-    twin = Variant(f"{variant.name}-walled", variant.what, {**variant.config, "system.boundary": boundary},
-                   variant.uses)
-    return tiny_config(twin, directory)
+    return tiny_config(variant, directory, {"system.boundary": boundary}, suffix="-walled")
 
 
 def _toml(value) -> str:
