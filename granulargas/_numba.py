@@ -28,7 +28,10 @@ library of its own -- typed, lowered, optimised by LLVM with the code of all
 its callees, and turned into machine code -- and then links that code into the
 caller and optimises it again there; for a function with a single call site,
 whose code only its caller needs, that is work done twice, and IR inlining
-does it once. At several call sites (or nested several levels deep) the copies
+does it once -- unless the same code serves several builds of the loop: the pair
+collision (``collide_pair``) is compiled once as an :func:`inlined` library, which the
+first run caches and every later build (other neighbour mode, walls, driving) links and
+inlines without typing it again. At several call sites (or nested several levels deep) the copies
 and the typing repeat at each and cost more than the library saves: the loop's
 per-event steps (one call site in each build of the loop) are of this kind,
 the shared helpers are :func:`inlined` or plain kernels. The copy is made in

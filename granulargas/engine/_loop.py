@@ -162,6 +162,8 @@ COLLAPSE = 20
 TABLE_RANGE = 21
 WATCHDOG = 30
 CALENDAR = 31
+#: :func:`collide_pair` of a pair that separates (round-off): nothing happened
+RECEDING = -1
 
 # event kinds
 PAIR = 0
@@ -483,12 +485,13 @@ def _collapse_watch(i, te, p, prm):
     p.lastcoll[i] = te
 
 
-@inlined_ir
-def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress, spins, species):
-    """Pair collision of i and j at te: validate (approaching), collide, re-predict j.
+@inlined
+def collide_pair(i, j, te, p, c, prm, contacts, shear, stress, spins, species):
+    """The collision of i and j at te, both streamed to te: validate (approaching), collide,
+    count. Returns DONE, RECEDING (the pair separates: round-off, nothing happened) or
+    TABLE_RANGE / OBLIQUE_*_RANGE (``c.err_i``, ``c.err_j`` set).
 
-    Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
-    ``c.err_j`` set). With ``contacts`` (the resolved rule; None otherwise) the pair collides by
+    With ``contacts`` (the resolved rule; None otherwise) the pair collides by
     :func:`granulargas.engine._resolved.resolved_pair`; with ``spins`` (rough particles; None
     otherwise) by :func:`granulargas.engine._spin.rough_pair`, except the TC model's elastic
     collisions, which are also frictionless. With ``species`` (a mixture; None otherwise) the
@@ -496,12 +499,14 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     species (:mod:`granulargas.engine._species`); the tangential law is the same for every pair.
     ``shear``: the pair through its nearest Lees-Edwards image; ``stress``: the pressure tensor's
     sums take the collision (smooth particles only).
+
+    The same in both neighbour modes (no argument depends on the mode), so one compiled library
+    serves every build of the loop with these types, each inlining it (LLVM's ``alwaysinline``).
     """
     rec = p.rec
     period = prm.space.period
     rule = prm.rule
     flight = prm.flight
-    wallkinds = prm.wallkinds
     stream(i, te, rec, p.img, period, flight)
     stream(j, te, rec, p.img, period, flight)
     if shear is not None:
@@ -515,7 +520,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
         uz = rec[i, 5] - rec[j, 5]
     b = dx * ux + dy * uy + dz * uz
     if b >= 0.0:  # receding (round-off): nothing happens
-        return DONE
+        return RECEDING
     if contacts is not None:
         status = collide_resolved(i, j, te, dx, dy, dz, p, contacts, c, rule, period)
         if status != DONE:
@@ -567,6 +572,24 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     count_pair(species, i, j)
     _collapse_watch(i, te, p, prm)
     _collapse_watch(j, te, p, prm)
+    return DONE
+
+
+@inlined_ir
+def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts, shear, stress, spins, species):
+    """Pair collision of i and j at te (:func:`collide_pair`), then j's next event.
+
+    Returns DONE, or TABLE_RANGE / OBLIQUE_*_RANGE / COLLAPSE / CALENDAR (``c.err_i``,
+    ``c.err_j`` set).
+    """
+    status = collide_pair(i, j, te, p, c, prm, contacts, shear, stress, spins, species)
+    if status == RECEDING:
+        return DONE
+    if status != DONE:
+        return status
+    rec = p.rec
+    flight = prm.flight
+    wallkinds = prm.wallkinds
     if onlists is not None:
         tj = predict_listed(j, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, flight, wallkinds,
                             shear)
