@@ -289,3 +289,30 @@ def test_bad_state_raises_config_error(state, match):
 def test_a_state_is_required():
     with pytest.raises(TypeError, match="granulargas.state.State"):
         Simulation(np.zeros((4, 3)), CollisionRule.elastic())
+
+
+def test_the_pair_collision_has_one_signature_for_every_build_of_the_loop():
+    """``_loop.collide_pair`` is compiled once and shared by every build of the loop: its
+    arguments (particles, counters, parameters, contacts, shear, stress, spins, species) have
+    the same numba types in the cell-crossing and the neighbour-list mode, with walls and with
+    driving, so that the library the first run compiles serves the others."""
+    import numba
+
+    from granulargas.engine import WhiteNoise
+    from granulargas.initial import random_state
+    from tests.engine.factories import simulation
+
+    def argument_types(sim):
+        sim.run(np.inf, max_collisions=1)
+        e = sim._engine
+        args = (e.particles, e.counters[0], sim._params(), e.contacts, sim._params().space.shear, e.stress,
+                e.spins, e.species)
+        return tuple(numba.typeof(a) for a in args)
+
+    kinds = [make_sim(n=64, packing=0.2, seed=1, neighbours="cells"),
+             make_sim(n=64, packing=0.2, seed=1, neighbours="lists"),
+             simulation(random_state(64, 0.2, 3, seed=1, boundary=("periodic", "periodic", "wall")),
+                        neighbours="cells"),
+             make_sim(n=64, packing=0.2, seed=1, neighbours="lists", driving=WhiteNoise(0.3, 0.05, seed=2))]
+    types = [argument_types(sim) for sim in kinds]
+    assert all(t == types[0] for t in types[1:])
