@@ -242,8 +242,8 @@ def describe(variants) -> str:
 def tiny_config(variant: Variant, directory, extra: dict | None = None, suffix: str = "") -> RunConfig:
     """The tiny run that compiles ``variant`` (its output file in ``directory``); ``extra``: config
     keys on top of the variant's, ``suffix``: added to its name (output file, config source)."""
-    name = variant.name + suffix
-    keys = {**TINY, **variant.config, **(extra or {}), "output.file": str(Path(directory) / f"{name}.h5")}
+    label = variant.name + suffix
+    keys = {**TINY, **variant.config, **(extra or {}), "output.file": str(Path(directory) / f"{label}.h5")}
     species = keys.pop("species", [])
     sections: dict[str, dict] = {}
     for key, value in keys.items():
@@ -258,7 +258,7 @@ def tiny_config(variant: Variant, directory, extra: dict | None = None, suffix: 
     for table in species:
         text.append("[[species]]")
         text += [f"{name} = {_toml(value)}" for name, value in table.items()]
-    return parse_config("\n".join(text) + "\n", source=f"<{name}>")
+    return parse_config("\n".join(text) + "\n", source=f"<{label}>")
 
 
 def walled_twin(variant: Variant, directory) -> RunConfig:

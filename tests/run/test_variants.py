@@ -93,6 +93,7 @@ def test_engine_variants_without_walls_also_build_walls_at_rest(tmp_path):
     for name in walled:
         twin = walled_twin(BY_NAME[name], tmp_path)
         assert "wall" in twin.system.boundary and BY_NAME[name] in variants_for(twin), name
+        assert twin.source == f"<{name}-walled>" and twin.output.file.endswith(f"{name}-walled.h5")
         raise_if_invalid(twin)
 
 
