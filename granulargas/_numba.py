@@ -95,10 +95,13 @@ third of a small run's start-up). The cache here loads without it and installs o
 the runtime's symbols that machine code calls (:func:`_install_runtime_symbols`); a
 function that is not in the cache is compiled, and numba's compiler refreshes the
 context itself first. That refresh is most of numba's first compilation in a process
-(about 0.4 s of CPU for a one-line function, 0.03 s for the next one), and about half
-of it is scipy: numba's array maths checks for BLAS by importing ``scipy.linalg``,
-whose array-API layer imports ``numpy.f2py`` (about 0.2 s together). A run that
-compiles anything pays it once, as does a run whose theory imports scipy.
+(about 0.2 s of CPU for a one-line function, 0.03 s for the next one). Numba's array
+maths, which the refresh imports, probes for BLAS (for ``np.dot``) by importing
+``scipy.linalg``, whose array-API layer imports ``numpy.f2py``: another 0.3 s of CPU,
+which a run that needs no scipy otherwise (the elastic and constant-restitution theory)
+would pay for a flag. Before the first compilation :func:`_import_array_maths` imports
+the array maths with a probe that only looks for scipy (a dependency of the package); a
+compiled ``np.dot`` still loads BLAS and checks it when it is lowered.
 
 Start-up. The first run of each kind compiles its kernels (several seconds of
 CPU) and every later run loads them from the cache (milliseconds).
@@ -111,7 +114,9 @@ starts, and adds up the time they take, so that a run can count it as start-up;
 
 import functools
 import hashlib
+import importlib.util
 import os
+import sys
 import time
 
 import numba
@@ -168,6 +173,16 @@ def _package_stamped(locator):
 class _CacheImpl(caching.CompileResultCacheImpl):
     _locator_classes = [_package_stamped(c) for c in caching.CompileResultCacheImpl._locator_classes]
 
+    def reduce(self, cres):
+        """numba's reduction of a compiled function for the cache, without the text of its typed
+        IR (``str(cres.type_annotation)``, which only ``inspect_types`` shows: about 1 ms per
+        function, 0.1 s of CPU over a quickstart's compilations)."""
+        return cres._replace(type_annotation=_NOT_CACHED)._reduce()
+
+
+#: what ``inspect_types`` shows for a function loaded from the cache
+_NOT_CACHED = "(the typed IR is not cached: compile without the cache to inspect it)"
+
 
 class _FunctionCache(caching.FunctionCache):
     """numba's per-function cache, with the package-wide source stamp (module docstring)."""
@@ -179,7 +194,33 @@ class _FunctionCache(caching.FunctionCache):
         only the runtime's symbols that loaded machine code may call are installed."""
         _install_runtime_symbols(target_context)
         with self._guard_against_spurious_io_errors():
-            return self._load_overload(sig, target_context)
+            loaded = self._load_overload(sig, target_context)
+        if loaded is None:  # numba compiles next
+            _import_array_maths()
+        return loaded
+
+
+def _import_array_maths():
+    """Import numba's array maths (which the compiler's first refresh would) with its BLAS
+    probe reduced to finding scipy, not importing ``scipy.linalg`` (module docstring,
+    "Loading"); once per process, and nothing if numba has imported it already."""
+    if "numba.np.arraymath" in sys.modules:
+        return
+    from numba.np import linalg
+
+    probe = getattr(linalg, "ensure_blas", None)
+    if probe is None:
+        return
+
+    def scipy_present():
+        if importlib.util.find_spec("scipy") is None:
+            raise ImportError("scipy is required for linear algebra")
+
+    linalg.ensure_blas = scipy_present
+    try:
+        import numba.np.arraymath  # noqa: F401
+    finally:
+        linalg.ensure_blas = probe
 
 
 def _install_runtime_symbols(target_context):

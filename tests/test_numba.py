@@ -130,3 +130,77 @@ def test_a_cached_function_loads_without_refreshing_numbas_target_context(tmp_pa
 
     assert run() == "[0, 1, 1, 3] 10.0 0 True"  # compiled: numba refreshes its context
     assert run() == "[0, 1, 1, 3] 10.0 2 False"  # loaded: no refresh
+
+
+_BLAS = """
+import numpy as np
+
+from granulargas._numba import jit, kernel
+
+
+@kernel
+def total(values):
+    s = 0.0
+    for v in values:
+        s += v
+    return s
+
+
+@jit
+def dot(a, b):
+    return np.dot(a, b)
+"""
+
+
+def test_the_first_compilation_finds_blas_without_importing_scipy_linalg(tmp_path):
+    """numba's array maths probes for BLAS by importing scipy.linalg; the package's first
+    compilation imports the array maths with a probe that only finds scipy. np.dot still
+    compiles against BLAS (and imports scipy.linalg when it is lowered)."""
+    pkg = tmp_path / "blaspkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "funcs.py").write_text(_BLAS)
+    code = textwrap.dedent("""
+        import sys
+        import numpy as np
+        from blaspkg.funcs import dot, total
+        t = total(np.arange(5.0))
+        before = "scipy.linalg" in sys.modules
+        from numba.np import arraymath, linalg
+        probe_restored = linalg.ensure_blas.__name__ == "ensure_blas"
+        d = dot(np.arange(3.0), np.arange(3.0))
+        print(t, before, arraymath._HAVE_BLAS, probe_restored, d, "scipy.linalg" in sys.modules)
+    """)
+    path = [str(tmp_path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("GRANULARGAS_NO_CACHE", None)
+    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
+                         check=True).stdout.strip()
+    assert out == "10.0 False True True 5.0 True"
+
+
+def test_a_function_loaded_from_the_cache_says_that_its_typed_ir_is_not_kept(tmp_path):
+    pkg = tmp_path / "annpkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "funcs.py").write_text(_BLAS)
+    code = textwrap.dedent("""
+        import io, contextlib
+        import numpy as np
+        from annpkg.funcs import total
+        total(np.arange(5.0))
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text):
+            total.inspect_types()
+        print(sum(total.stats.cache_hits.values()), "not cached" in text.getvalue())
+    """)
+    path = [str(tmp_path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("GRANULARGAS_NO_CACHE", None)
+
+    def run():
+        return subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
+                              check=True).stdout.strip()
+
+    assert run() == "0 False"  # compiled here: numba's own listing of the typed IR
+    assert run() == "1 True"

@@ -598,8 +598,13 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     if not cal_update_ring(j, tj, cal):
         return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
-        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts,
-                     flight, wallkinds, shear)
+        # the list mode's own prediction: its builds of the loop compile no ``predict``
+        if onlists is not None:
+            ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, flight,
+                                wallkinds, shear)
+        if oncells is not None:
+            ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts,
+                         flight, wallkinds, shear)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
         c.events += 1
         c.err_i = i
@@ -1056,8 +1061,12 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
                 clock = tick(probe, P_WALL, clock)
                 if status != DONE:
                     if status == COLLAPSE:
-                        ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell,
-                                     contacts, prm.flight, prm.wallkinds, shear)
+                        if onlists is not None:
+                            ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell,
+                                                contacts, prm.flight, prm.wallkinds, shear)
+                        if oncells is not None:
+                            ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space,
+                                         prm.half_shell, contacts, prm.flight, prm.wallkinds, shear)
                         if not cal_update(i, ti, cal):
                             status = CALENDAR
                         c.events += 1
