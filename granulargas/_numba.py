@@ -110,9 +110,20 @@ events, sent only when a function is compiled, never when it is loaded from the
 cache): it announces the first one, so that the pause is explained before it
 starts, and adds up the time they take, so that a run can count it as start-up;
 :func:`cache_location` is where the compiled code is kept.
+
+Garbage collection while compiling. Numba's compiler makes millions of small Python objects
+(IR nodes, types, LLVM IR text) that live until the compilation ends, and Python's cyclic
+garbage collector, run after every 700 net allocations, traverses them again and again:
+about a tenth of a compilation's CPU time (1.3 s of a quickstart's 12 s of compiling, 0.75 s
+of a dense 3D run's 6.5 s after it). :class:`_CompilerGC`, listening to every compilation,
+raises the first generation's threshold to :data:`GC_THRESHOLD_COMPILING` while one runs
+(nested ones included) and restores the previous thresholds after it: 0.4 and 0.2 s of
+collecting in those two runs, for some 15 MB more memory at the peak. Cycles are still
+collected, only less often.
 """
 
 import functools
+import gc
 import hashlib
 import importlib.util
 import os
@@ -345,6 +356,36 @@ class CompileWatch(event.Listener):
     def __exit__(self, *exc):
         event.unregister("numba:compile", self)
         return False
+
+
+#: Python's first-generation garbage-collection threshold while numba compiles (module docstring)
+GC_THRESHOLD_COMPILING = 20_000
+
+
+class _CompilerGC(event.Listener):
+    """The garbage collector's thresholds raised while numba compiles (module docstring).
+
+    Numba sends ``numba:compile`` under its global compiler lock, so compilations in several
+    threads do not interleave here; a compilation within a compilation (a callee) counts as
+    part of the outermost one."""
+
+    def __init__(self):
+        self._depth = 0
+        self._saved = None
+
+    def on_start(self, ev):
+        if self._depth == 0:
+            self._saved = gc.get_threshold()
+            gc.set_threshold(max(GC_THRESHOLD_COMPILING, self._saved[0]), *self._saved[1:])
+        self._depth += 1
+
+    def on_end(self, ev):
+        self._depth -= 1
+        if self._depth == 0:
+            gc.set_threshold(*self._saved)
+
+
+event.register("numba:compile", _CompilerGC())
 
 
 def announcement(what: str) -> str:

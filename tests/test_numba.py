@@ -204,3 +204,27 @@ def test_a_function_loaded_from_the_cache_says_that_its_typed_ir_is_not_kept(tmp
 
     assert run() == "0 False"  # compiled here: numba's own listing of the typed IR
     assert run() == "1 True"
+
+
+def test_the_garbage_collector_runs_less_often_while_numba_compiles():
+    """The first generation's threshold is raised for a compilation and restored after it."""
+    import gc
+
+    import numba
+    from numba.core import event
+
+    seen = []
+
+    class Probe(event.Listener):  # registered after the package's own listener: sees its threshold
+        def on_start(self, ev):
+            seen.append(gc.get_threshold())
+
+        def on_end(self, ev):
+            pass
+
+    before = gc.get_threshold()
+    with event.install_listener("numba:compile", Probe()):
+        assert numba.njit(lambda x: x + 1)(1) == 2
+    assert seen and seen[0][0] == max(_numba.GC_THRESHOLD_COMPILING, before[0])
+    assert seen[0][1:] == before[1:]
+    assert gc.get_threshold() == before
