@@ -117,9 +117,11 @@ garbage collector, run after every 700 net allocations, traverses them again and
 about a tenth of a compilation's CPU time (1.3 s of a quickstart's 12 s of compiling, 0.75 s
 of a dense 3D run's 6.5 s after it). :class:`_CompilerGC`, listening to every compilation,
 raises the first generation's threshold to :data:`GC_THRESHOLD_COMPILING` while one runs
-(nested ones included) and restores the previous thresholds after it: 0.4 and 0.2 s of
-collecting in those two runs, for some 15 MB more memory at the peak. Cycles are still
-collected, only less often.
+(nested ones included) and restores the previous thresholds after it: 0.4-0.5 and 0.2 s of
+collecting in those two runs, for some 15 MB more memory at the peak. The net saving is
+smaller than the collector's own time, 0.2-0.5 s of CPU per first run side by side
+(``scripts/benchmarks/startup.py --trees``): cycles are still collected, only less often and
+later, and memory that is freed later is reused less while it is still in cache.
 """
 
 import functools
