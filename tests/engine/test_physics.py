@@ -143,6 +143,8 @@ def test_inelastic_collapse_detected_tc_model_and_viscoelastic_run_through(seed)
         sim.run(2000.0)
     assert "CollisionRule.constant(eps, tc_time=...)" in str(err.value)  # a Python caller gets the Python cure
     assert err.value.where.startswith("at t = ")
+    assert sim.neighbours == "lists"  # the list loop's own prediction after the collapse
+    assert check(sim) == []  # the loop stopped with its lists, cells and calendar whole
     for rule in [CollisionRule.constant(0.3, tc_time=1e-4),
                  CollisionRule.viscoelastic(1.5, hermite_table(pade_eps))]:
         sim = Simulation(st, rule)
