@@ -75,6 +75,26 @@ def test_source_stamp_changes_with_any_source_file_and_only_with_sources(tmp_pat
     assert stamp(str(tmp_path)) not in (s0, s1)
 
 
+
+def _fresh_interpreter(tmp_path, package, source):
+    """Write ``package`` (one module ``funcs`` holding ``source``) under ``tmp_path``; returns
+    ``run(code)``: the stripped output of ``code`` in a fresh interpreter that imports it, with
+    its numba cache in ``tmp_path``."""
+    pkg = tmp_path / package
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "funcs.py").write_text(source)
+    path = [str(tmp_path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
+    env.pop("GRANULARGAS_NO_CACHE", None)
+
+    def run(code):
+        return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], env=env, cwd=tmp_path,
+                              capture_output=True, text=True, check=True).stdout.strip()
+
+    return run
+
+
 _LOADED = """
 import numpy as np
 
@@ -104,11 +124,8 @@ def total(values):
 def test_a_cached_function_loads_without_refreshing_numbas_target_context(tmp_path):
     """Loaded machine code runs (allocation, hashing) without the context refresh that a
     compilation needs; a compilation still refreshes it."""
-    pkg = tmp_path / "loadedpkg"
-    pkg.mkdir()
-    (pkg / "__init__.py").write_text("")
-    (pkg / "funcs.py").write_text(_LOADED)
-    code = textwrap.dedent("""
+    run = _fresh_interpreter(tmp_path, "loadedpkg", _LOADED)
+    code = """
         import numpy as np
         from numba.core.base import BaseContext
         refreshed = []
@@ -119,17 +136,9 @@ def test_a_cached_function_loads_without_refreshing_numbas_target_context(tmp_pa
         t = total(np.arange(5.0))
         hits = sum(histogram.stats.cache_hits.values()) + sum(total.stats.cache_hits.values())
         print(h.tolist(), t, hits, len(refreshed) > 0)
-    """)
-    path = [str(tmp_path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    env.pop("GRANULARGAS_NO_CACHE", None)
-
-    def run():
-        return subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
-                              check=True).stdout.strip()
-
-    assert run() == "[0, 1, 1, 3] 10.0 0 True"  # compiled: numba refreshes its context
-    assert run() == "[0, 1, 1, 3] 10.0 2 False"  # loaded: no refresh
+    """
+    assert run(code) == "[0, 1, 1, 3] 10.0 0 True"  # compiled: numba refreshes its context
+    assert run(code) == "[0, 1, 1, 3] 10.0 2 False"  # loaded: no refresh
 
 
 _BLAS = """
@@ -156,11 +165,8 @@ def test_the_first_compilation_finds_blas_without_importing_scipy_linalg(tmp_pat
     """numba's array maths probes for BLAS by importing scipy.linalg; the package's first
     compilation imports the array maths with a probe that only finds scipy. np.dot still
     compiles against BLAS (and imports scipy.linalg when it is lowered)."""
-    pkg = tmp_path / "blaspkg"
-    pkg.mkdir()
-    (pkg / "__init__.py").write_text("")
-    (pkg / "funcs.py").write_text(_BLAS)
-    code = textwrap.dedent("""
+    run = _fresh_interpreter(tmp_path, "blaspkg", _BLAS)
+    out = run("""
         import sys
         import numpy as np
         from blaspkg.funcs import dot, total
@@ -171,20 +177,12 @@ def test_the_first_compilation_finds_blas_without_importing_scipy_linalg(tmp_pat
         d = dot(np.arange(3.0), np.arange(3.0))
         print(t, before, arraymath._HAVE_BLAS, probe_restored, d, "scipy.linalg" in sys.modules)
     """)
-    path = [str(tmp_path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    env.pop("GRANULARGAS_NO_CACHE", None)
-    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
-                         check=True).stdout.strip()
     assert out == "10.0 False True True 5.0 True"
 
 
 def test_a_function_loaded_from_the_cache_says_that_its_typed_ir_is_not_kept(tmp_path):
-    pkg = tmp_path / "annpkg"
-    pkg.mkdir()
-    (pkg / "__init__.py").write_text("")
-    (pkg / "funcs.py").write_text(_BLAS)
-    code = textwrap.dedent("""
+    run = _fresh_interpreter(tmp_path, "annpkg", _BLAS)
+    code = """
         import io, contextlib
         import numpy as np
         from annpkg.funcs import total
@@ -193,17 +191,9 @@ def test_a_function_loaded_from_the_cache_says_that_its_typed_ir_is_not_kept(tmp
         with contextlib.redirect_stdout(text):
             total.inspect_types()
         print(sum(total.stats.cache_hits.values()), "not cached" in text.getvalue())
-    """)
-    path = [str(tmp_path)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(path), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
-    env.pop("GRANULARGAS_NO_CACHE", None)
-
-    def run():
-        return subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True,
-                              check=True).stdout.strip()
-
-    assert run() == "0 False"  # compiled here: numba's own listing of the typed IR
-    assert run() == "1 True"
+    """
+    assert run(code) == "0 False"  # compiled here: numba's own listing of the typed IR
+    assert run(code) == "1 True"
 
 
 def test_the_garbage_collector_runs_less_often_while_numba_compiles():
