@@ -141,19 +141,7 @@ def test_a_cached_function_loads_without_refreshing_numbas_target_context(tmp_pa
     assert run(code) == "[0, 1, 1, 3] 10.0 2 False"  # loaded: no refresh
 
 
-_BLAS = """
-import numpy as np
-
-from granulargas._numba import jit, kernel
-
-
-@kernel
-def total(values):
-    s = 0.0
-    for v in values:
-        s += v
-    return s
-
+_WITH_DOT = _LOADED + """
 
 @jit
 def dot(a, b):
@@ -165,7 +153,7 @@ def test_the_first_compilation_finds_blas_without_importing_scipy_linalg(tmp_pat
     """numba's array maths probes for BLAS by importing scipy.linalg; the package's first
     compilation imports the array maths with a probe that only finds scipy. np.dot still
     compiles against BLAS (and imports scipy.linalg when it is lowered)."""
-    run = _fresh_interpreter(tmp_path, "blaspkg", _BLAS)
+    run = _fresh_interpreter(tmp_path, "blaspkg", _WITH_DOT)
     out = run("""
         import sys
         import numpy as np
@@ -181,7 +169,7 @@ def test_the_first_compilation_finds_blas_without_importing_scipy_linalg(tmp_pat
 
 
 def test_a_function_loaded_from_the_cache_says_that_its_typed_ir_is_not_kept(tmp_path):
-    run = _fresh_interpreter(tmp_path, "annpkg", _BLAS)
+    run = _fresh_interpreter(tmp_path, "annpkg", _LOADED)
     code = """
         import io, contextlib
         import numpy as np

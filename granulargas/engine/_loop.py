@@ -465,6 +465,21 @@ def predict_cells(i, t, rec, count, events, grid, space, flight, wallkinds, shea
     return settle_event(i, t, best, p, tag, rec, events, space, flight, wallkinds)
 
 
+@inlined_ir
+def predict_after_collapse(i, t, p, events, lists, onlists, oncells, prm, contacts, shear):
+    """i's next event after an inelastic collapse (a rare path that ends the loop with its
+    calendar whole): the list mode's own inlined :func:`predict_listed`, so that its builds of
+    the loop compile no :func:`predict`; the cell mode calls :func:`predict` (a third copy of the
+    IR-inlined :func:`predict_cells` would cost its first compile more)."""
+    if onlists is not None:
+        ti = predict_listed(i, t, p.rec, p.count, events, lists, prm.space, prm.half_shell, contacts, prm.flight,
+                            prm.wallkinds, shear)
+    if oncells is not None:
+        ti = predict(i, t, p.rec, p.count, events, lists, onlists, oncells, prm.space, prm.half_shell, contacts,
+                     prm.flight, prm.wallkinds, shear)
+    return ti
+
+
 @kernel
 def predict_all(t, rec, count, events, lists, onlists, oncells, space, half_shell, contacts, flight, wallkinds,
                 shear, times):
@@ -598,13 +613,7 @@ def execute_pair(i, j, te, p, ev, lists, onlists, oncells, cal, c, prm, contacts
     if not cal_update_ring(j, tj, cal):
         return CALENDAR
     if p.rapid[i] >= prm.collapse_count or p.rapid[j] >= prm.collapse_count:
-        # the list mode's own prediction: its builds of the loop compile no ``predict``
-        if onlists is not None:
-            ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell, contacts, flight,
-                                wallkinds, shear)
-        if oncells is not None:
-            ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space, prm.half_shell, contacts,
-                         flight, wallkinds, shear)
+        ti = predict_after_collapse(i, te, p, ev, lists, onlists, oncells, prm, contacts, shear)
         status = COLLAPSE if cal_update(i, ti, cal) else CALENDAR
         c.events += 1
         c.err_i = i
@@ -1061,12 +1070,7 @@ def advance(engine, onlists, oncells, prm, until, max_events, max_collisions, pr
                 clock = tick(probe, P_WALL, clock)
                 if status != DONE:
                     if status == COLLAPSE:
-                        if onlists is not None:
-                            ti = predict_listed(i, te, rec, p.count, ev, lists, prm.space, prm.half_shell,
-                                                contacts, prm.flight, prm.wallkinds, shear)
-                        if oncells is not None:
-                            ti = predict(i, te, rec, p.count, ev, lists, onlists, oncells, prm.space,
-                                         prm.half_shell, contacts, prm.flight, prm.wallkinds, shear)
+                        ti = predict_after_collapse(i, te, p, ev, lists, onlists, oncells, prm, contacts, shear)
                         if not cal_update(i, ti, cal):
                             status = CALENDAR
                         c.events += 1

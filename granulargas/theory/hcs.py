@@ -149,10 +149,15 @@ def _fit_splines(eps, diff):
     return np.ascontiguousarray(CubicSpline(eps, diff).c), max(loo) / 16.0
 
 
+def _node_restitutions(col):
+    """The nodes of the splines: the table's eps and 1."""
+    return np.append(col["restitution"], 1.0)
+
+
 def _nodes(col, dim):
-    """The nodes of the splines (the table's eps and 1) and, per quantity, the difference from
-    first Sonine there."""
-    eps = np.append(col["restitution"], 1.0)
+    """The nodes of the splines (:func:`_node_restitutions`) and, per quantity, the difference
+    from first Sonine there."""
+    eps = _node_restitutions(col)
     first = _first_sonine_columns(eps, dim)
     return eps, {q: np.append(col[q], first[q][-1]) - first[q] for q in _QUANTITIES}
 
@@ -209,7 +214,7 @@ def _splines(dim: int):
     """Per quantity: (spline coefficients of the difference from first Sonine, nodes with eps = 1,
     errors, interpolation error)."""
     col = read_table()[dim]
-    eps = np.append(col["restitution"], 1.0)
+    eps = _node_restitutions(col)
     fitted = _spline_coefficients()
     out = {}
     for q in _QUANTITIES:
